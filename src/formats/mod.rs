@@ -1,0 +1,108 @@
+//! The project's versioned JSON files (documented in `docs/formats.md`): marks, tracks2d and
+//! skeleton3d, with one error type that always names the file, and atomic saving.
+
+mod atomic;
+mod error;
+mod marks;
+mod skeleton3d;
+mod tracks2d;
+
+pub use atomic::write_atomically;
+pub use error::FormatError;
+pub use marks::{MARKS_FORMAT, Marks};
+pub use skeleton3d::{Frame3d, SKELETON3D_FORMAT, Skeleton3d};
+pub use tracks2d::{FrameTracks, PointSource, SourceInfo, TRACKS2D_FORMAT, TrackedPoint, Tracks2d};
+
+use crate::skeleton::{JOINT_COUNT, Joint};
+use serde::Deserialize;
+use std::path::Path;
+
+/// The version of every format this build writes and reads.
+pub const FORMAT_VERSION: u32 = 1;
+
+/// Reads a whole file as text, naming it in the error.
+fn read_text(path: &Path) -> Result<String, FormatError> {
+    std::fs::read_to_string(path).map_err(|source| FormatError::Io {
+        path: path.to_owned(),
+        source,
+    })
+}
+
+/// Parses JSON, naming the file and the line in the error.
+fn parse_json<T: for<'de> Deserialize<'de>>(text: &str, path: &Path) -> Result<T, FormatError> {
+    serde_json::from_str(text).map_err(|source| FormatError::Json {
+        path: path.to_owned(),
+        source,
+    })
+}
+
+/// Checks the optional `format` and `version` fields of a file.
+fn check_header(
+    path: &Path,
+    expected: &'static str,
+    format: Option<&str>,
+    version: Option<u32>,
+) -> Result<(), FormatError> {
+    if let Some(found) = format
+        && found != expected
+    {
+        return Err(FormatError::WrongFormat {
+            path: path.to_owned(),
+            found: found.to_owned(),
+            expected,
+        });
+    }
+    if let Some(v) = version
+        && v != FORMAT_VERSION
+    {
+        return Err(FormatError::UnsupportedVersion {
+            path: path.to_owned(),
+            version: v,
+            supported: FORMAT_VERSION,
+        });
+    }
+    Ok(())
+}
+
+/// Maps a file's list of joint names onto the model: for each model joint, its column in the file.
+fn joint_columns(path: &Path, names: &[String]) -> Result<[usize; JOINT_COUNT], FormatError> {
+    let mut columns = [usize::MAX; JOINT_COUNT];
+    for (col, name) in names.iter().enumerate() {
+        let joint = Joint::from_name(name).ok_or_else(|| FormatError::UnknownJoint {
+            path: path.to_owned(),
+            name: name.clone(),
+        })?;
+        if columns[joint.index()] != usize::MAX {
+            return Err(FormatError::DuplicateJoint {
+                path: path.to_owned(),
+                joint,
+            });
+        }
+        columns[joint.index()] = col;
+    }
+    for joint in Joint::ALL {
+        if columns[joint.index()] == usize::MAX {
+            return Err(FormatError::MissingJoint {
+                path: path.to_owned(),
+                joint,
+                frame: None,
+            });
+        }
+    }
+    Ok(columns)
+}
+
+/// The 16 joint names in file order, as written in the `joints` field.
+fn joint_names() -> Vec<String> {
+    Joint::ALL.iter().map(|j| j.name().to_owned()).collect()
+}
+
+/// Serialises to pretty JSON and saves atomically.
+fn save_json<T: serde::Serialize>(value: &T, path: &Path) -> Result<(), FormatError> {
+    let mut text = serde_json::to_string_pretty(value).map_err(|source| FormatError::Json {
+        path: path.to_owned(),
+        source,
+    })?;
+    text.push('\n');
+    write_atomically(path, text.as_bytes())
+}

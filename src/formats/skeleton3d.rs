@@ -1,0 +1,205 @@
+//! `skeleton3d.json`: the reconstructed 3D skeleton per frame, in camera coordinates
+//! (metres, X right, Y down, Z forward), with the camera and the bone lengths used.
+
+use super::{
+    FORMAT_VERSION, FormatError, check_header, joint_columns, joint_names, parse_json, read_text,
+    save_json,
+};
+use crate::camera::PinholeCamera;
+use crate::skeleton::{Bone, Joint, PerJoint};
+use nalgebra::Point3;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// The `format` tag of skeleton3d files.
+pub const SKELETON3D_FORMAT: &str = "videomocap.skeleton3d";
+
+/// The 16 joints of one frame in camera space.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Frame3d {
+    /// Frame index in the video (0-based).
+    pub index: usize,
+    /// Joint positions in camera space, metres.
+    pub points: PerJoint<Point3<f64>>,
+}
+
+/// A reconstructed 3D skeleton sequence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Skeleton3d {
+    /// The camera the points are expressed in.
+    pub camera: PinholeCamera,
+    /// Length of each bone in metres, keyed `"parent-child"`.
+    pub bone_lengths_m: BTreeMap<String, f64>,
+    /// Frames in increasing index order.
+    pub frames: Vec<Frame3d>,
+}
+
+#[derive(Serialize, Deserialize)]
+struct FrameFile {
+    index: usize,
+    points: Vec<[f64; 3]>,
+}
+
+#[derive(Serialize, Deserialize)]
+struct SkeletonFile {
+    #[serde(default)]
+    format: Option<String>,
+    #[serde(default)]
+    version: Option<u32>,
+    camera: PinholeCamera,
+    joints: Vec<String>,
+    bone_lengths_m: BTreeMap<String, f64>,
+    frames: Vec<FrameFile>,
+}
+
+impl Skeleton3d {
+    /// Reads and checks a skeleton3d file.
+    pub fn load(path: &Path) -> Result<Self, FormatError> {
+        Self::parse(&read_text(path)?, path)
+    }
+
+    /// Parses a skeleton from JSON text; `path` names the source in errors.
+    pub fn parse(text: &str, path: &Path) -> Result<Self, FormatError> {
+        let raw: SkeletonFile = parse_json(text, path)?;
+        check_header(path, SKELETON3D_FORMAT, raw.format.as_deref(), raw.version)?;
+        let columns = joint_columns(path, &raw.joints)?;
+        let cam = raw.camera;
+        if !(cam.focal_px.is_finite() && cam.focal_px > 0.0)
+            || !cam.cx.is_finite()
+            || !cam.cy.is_finite()
+        {
+            return Err(FormatError::Invalid {
+                path: path.to_owned(),
+                problem: format!(
+                    "camera focal_px must be positive and finite and cx, cy finite (got {}, {}, {})",
+                    cam.focal_px, cam.cx, cam.cy
+                ),
+            });
+        }
+        for (key, &len) in &raw.bone_lengths_m {
+            if Bone::from_key(key).is_none() {
+                return Err(FormatError::Invalid {
+                    path: path.to_owned(),
+                    problem: format!("unknown bone \"{key}\" in bone_lengths_m"),
+                });
+            }
+            if !(len.is_finite() && len > 0.0) {
+                return Err(FormatError::Invalid {
+                    path: path.to_owned(),
+                    problem: format!("bone \"{key}\" has length {len}; it must be positive"),
+                });
+            }
+        }
+        let mut frames = Vec::with_capacity(raw.frames.len());
+        let mut previous: Option<usize> = None;
+        for f in raw.frames {
+            if f.points.len() != raw.joints.len() {
+                return Err(FormatError::WrongLength {
+                    path: path.to_owned(),
+                    frame: f.index,
+                    field: "points",
+                    found: f.points.len(),
+                    expected: raw.joints.len(),
+                });
+            }
+            if previous.is_some_and(|p| f.index <= p) {
+                return Err(FormatError::Invalid {
+                    path: path.to_owned(),
+                    problem: format!("frame {} is out of order or repeated", f.index),
+                });
+            }
+            previous = Some(f.index);
+            for joint in Joint::ALL {
+                if !f.points[columns[joint.index()]]
+                    .iter()
+                    .all(|v| v.is_finite())
+                {
+                    return Err(FormatError::NonFinite {
+                        path: path.to_owned(),
+                        joint,
+                        frame: Some(f.index),
+                    });
+                }
+            }
+            frames.push(Frame3d {
+                index: f.index,
+                points: PerJoint::from_fn(|j| {
+                    let [x, y, z] = f.points[columns[j.index()]];
+                    Point3::new(x, y, z)
+                }),
+            });
+        }
+        Ok(Skeleton3d {
+            camera: cam,
+            bone_lengths_m: raw.bone_lengths_m,
+            frames,
+        })
+    }
+
+    /// Saves atomically, joints in model order.
+    pub fn save(&self, path: &Path) -> Result<(), FormatError> {
+        let file = SkeletonFile {
+            format: Some(SKELETON3D_FORMAT.to_owned()),
+            version: Some(FORMAT_VERSION),
+            camera: self.camera,
+            joints: joint_names(),
+            bone_lengths_m: self.bone_lengths_m.clone(),
+            frames: self
+                .frames
+                .iter()
+                .map(|f| FrameFile {
+                    index: f.index,
+                    points: f.points.0.iter().map(|p| [p.x, p.y, p.z]).collect(),
+                })
+                .collect(),
+        };
+        save_json(&file, path)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Skeleton3d {
+        Skeleton3d {
+            camera: PinholeCamera::centred(1000.0, 640, 480),
+            bone_lengths_m: [("left_knee-left_ankle".to_owned(), 0.42)].into(),
+            frames: vec![Frame3d {
+                index: 0,
+                points: PerJoint::from_fn(|j| Point3::new(j.index() as f64 * 0.1, -0.5, 3.0)),
+            }],
+        }
+    }
+
+    #[test]
+    fn save_and_load_round_trip() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("skeleton3d.json");
+        sample().save(&path).unwrap();
+        assert_eq!(Skeleton3d::load(&path).unwrap(), sample());
+    }
+
+    #[test]
+    fn a_bad_focal_length_or_unknown_bone_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.json");
+        sample().save(&path).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let bad = text.replace("\"focal_px\": 1000.0", "\"focal_px\": -1.0");
+        assert!(
+            Skeleton3d::parse(&bad, &path)
+                .unwrap_err()
+                .to_string()
+                .contains("focal_px")
+        );
+        let bad = text.replace("left_knee-left_ankle", "knee-ankle");
+        assert!(
+            Skeleton3d::parse(&bad, &path)
+                .unwrap_err()
+                .to_string()
+                .contains("knee-ankle")
+        );
+    }
+}

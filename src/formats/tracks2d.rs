@@ -1,0 +1,299 @@
+//! `tracks2d.json`: the tracker's output, every joint's image position per frame with its
+//! reliability and whether it was interpolated.
+
+use super::{
+    FORMAT_VERSION, FormatError, check_header, joint_columns, joint_names, parse_json, read_text,
+    save_json,
+};
+use crate::camera::point_in_frame;
+use crate::skeleton::{Joint, PerJoint};
+use nalgebra::Point2;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The `format` tag of tracks2d files.
+pub const TRACKS2D_FORMAT: &str = "videomocap.tracks2d";
+
+/// The video the tracks belong to.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SourceInfo {
+    /// The video file or image directory, as given when tracking.
+    pub path: PathBuf,
+    /// Frame width in pixels (after display rotation).
+    pub width: u32,
+    /// Frame height in pixels (after display rotation).
+    pub height: u32,
+    /// Frames per second.
+    pub fps: f64,
+    /// Number of frames in the video.
+    pub frame_count: usize,
+}
+
+/// How a tracked point was obtained.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum PointSource {
+    /// Found in the image (or marked by hand).
+    Tracked,
+    /// Filled in between reliable frames (occlusion handling).
+    Interpolated,
+}
+
+/// One joint in one frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrackedPoint {
+    /// Position in image pixels.
+    pub pos: Point2<f64>,
+    /// Reliability in `[0, 1]` (the block similarity mapped to this range).
+    pub confidence: f32,
+    /// Tracked or interpolated.
+    pub source: PointSource,
+}
+
+/// All 16 joints in one frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameTracks {
+    /// Frame index in the video (0-based).
+    pub index: usize,
+    /// The joints.
+    pub points: PerJoint<TrackedPoint>,
+}
+
+/// A whole tracking result.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tracks2d {
+    /// The video tracked.
+    pub source: SourceInfo,
+    /// Tracked frames in increasing index order.
+    pub frames: Vec<FrameTracks>,
+}
+
+#[derive(Serialize, Deserialize)]
+struct FrameFile {
+    index: usize,
+    points: Vec<[f64; 2]>,
+    confidence: Vec<f32>,
+    interpolated: Vec<bool>,
+}
+
+#[derive(Serialize, Deserialize)]
+struct TracksFile {
+    #[serde(default)]
+    format: Option<String>,
+    #[serde(default)]
+    version: Option<u32>,
+    source: SourceInfo,
+    joints: Vec<String>,
+    frames: Vec<FrameFile>,
+}
+
+impl Tracks2d {
+    /// Reads and checks a tracks2d file.
+    pub fn load(path: &Path) -> Result<Self, FormatError> {
+        Self::parse(&read_text(path)?, path)
+    }
+
+    /// Parses tracks from JSON text; `path` names the source in errors.
+    pub fn parse(text: &str, path: &Path) -> Result<Self, FormatError> {
+        let raw: TracksFile = parse_json(text, path)?;
+        check_header(path, TRACKS2D_FORMAT, raw.format.as_deref(), raw.version)?;
+        let columns = joint_columns(path, &raw.joints)?;
+        let src = raw.source;
+        if src.width == 0 || src.height == 0 || !(src.fps.is_finite() && src.fps > 0.0) {
+            return Err(FormatError::Invalid {
+                path: path.to_owned(),
+                problem: format!(
+                    "source has size {}×{} at {} fps; both sides and the frame rate must be positive",
+                    src.width, src.height, src.fps
+                ),
+            });
+        }
+        let mut frames = Vec::with_capacity(raw.frames.len());
+        let mut previous: Option<usize> = None;
+        for f in raw.frames {
+            let n = raw.joints.len();
+            for (field, found) in [
+                ("points", f.points.len()),
+                ("confidence", f.confidence.len()),
+                ("interpolated", f.interpolated.len()),
+            ] {
+                if found != n {
+                    return Err(FormatError::WrongLength {
+                        path: path.to_owned(),
+                        frame: f.index,
+                        field,
+                        found,
+                        expected: n,
+                    });
+                }
+            }
+            if previous.is_some_and(|p| f.index <= p) {
+                return Err(FormatError::Invalid {
+                    path: path.to_owned(),
+                    problem: format!("frame {} is out of order or repeated", f.index),
+                });
+            }
+            previous = Some(f.index);
+            let mut points = Vec::with_capacity(n);
+            for joint in Joint::ALL {
+                let col = columns[joint.index()];
+                let [x, y] = f.points[col];
+                let confidence = f.confidence[col];
+                if !(x.is_finite() && y.is_finite() && confidence.is_finite()) {
+                    return Err(FormatError::NonFinite {
+                        path: path.to_owned(),
+                        joint,
+                        frame: Some(f.index),
+                    });
+                }
+                if !(0.0..=1.0).contains(&confidence) {
+                    return Err(FormatError::Invalid {
+                        path: path.to_owned(),
+                        problem: format!(
+                            "joint {joint} in frame {}: confidence {confidence} is outside [0, 1]",
+                            f.index
+                        ),
+                    });
+                }
+                let pos = Point2::new(x, y);
+                if !point_in_frame(&pos, src.width, src.height) {
+                    return Err(FormatError::OutsideFrame {
+                        path: path.to_owned(),
+                        joint,
+                        x,
+                        y,
+                        width: src.width,
+                        height: src.height,
+                        frame: Some(f.index),
+                    });
+                }
+                points.push(TrackedPoint {
+                    pos,
+                    confidence,
+                    source: if f.interpolated[col] {
+                        PointSource::Interpolated
+                    } else {
+                        PointSource::Tracked
+                    },
+                });
+            }
+            frames.push(FrameTracks {
+                index: f.index,
+                points: PerJoint::from_fn(|j| points[j.index()]),
+            });
+        }
+        Ok(Tracks2d {
+            source: src,
+            frames,
+        })
+    }
+
+    /// Saves atomically, joints in model order.
+    pub fn save(&self, path: &Path) -> Result<(), FormatError> {
+        let file = TracksFile {
+            format: Some(TRACKS2D_FORMAT.to_owned()),
+            version: Some(FORMAT_VERSION),
+            source: self.source.clone(),
+            joints: joint_names(),
+            frames: self
+                .frames
+                .iter()
+                .map(|f| FrameFile {
+                    index: f.index,
+                    points: f.points.0.iter().map(|p| [p.pos.x, p.pos.y]).collect(),
+                    confidence: f.points.0.iter().map(|p| p.confidence).collect(),
+                    interpolated: f
+                        .points
+                        .0
+                        .iter()
+                        .map(|p| p.source == PointSource::Interpolated)
+                        .collect(),
+                })
+                .collect(),
+        };
+        save_json(&file, path)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Tracks2d {
+        Tracks2d {
+            source: SourceInfo {
+                path: PathBuf::from("clip.mp4"),
+                width: 640,
+                height: 480,
+                fps: 30.0,
+                frame_count: 2,
+            },
+            frames: (0..2)
+                .map(|i| FrameTracks {
+                    index: i,
+                    points: PerJoint::from_fn(|j| TrackedPoint {
+                        pos: Point2::new(100.0 + j.index() as f64, 50.0 + i as f64),
+                        confidence: 0.75,
+                        source: if j == Joint::LeftWrist && i == 1 {
+                            PointSource::Interpolated
+                        } else {
+                            PointSource::Tracked
+                        },
+                    }),
+                })
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn save_and_load_round_trip() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("tracks2d.json");
+        sample().save(&path).unwrap();
+        assert_eq!(Tracks2d::load(&path).unwrap(), sample());
+    }
+
+    #[test]
+    fn joints_may_come_in_another_order() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.json");
+        sample().save(&path).unwrap();
+        let mut v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        // Swap the first two columns everywhere.
+        v["joints"].as_array_mut().unwrap().swap(0, 1);
+        for f in v["frames"].as_array_mut().unwrap() {
+            for key in ["points", "confidence", "interpolated"] {
+                f[key].as_array_mut().unwrap().swap(0, 1);
+            }
+        }
+        let t = Tracks2d::parse(&v.to_string(), &path).unwrap();
+        assert_eq!(t, sample());
+    }
+
+    #[test]
+    fn short_arrays_and_points_off_the_frame_are_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.json");
+        sample().save(&path).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v["frames"][1]["confidence"].as_array_mut().unwrap().pop();
+        let err = Tracks2d::parse(&v.to_string(), &path)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("frame 1") && err.contains("confidence"),
+            "{err}"
+        );
+
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v["frames"][0]["points"][6] = serde_json::json!([900.0, 10.0]);
+        let err = Tracks2d::parse(&v.to_string(), &path)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("left_wrist") && err.contains("outside"),
+            "{err}"
+        );
+    }
+}

@@ -1,0 +1,242 @@
+//! The 16 joints of the VBA human model (Pan et al., Fig. 2a), in the project's fixed order.
+
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::ops::{Index, IndexMut};
+
+/// One of the 16 joints. Left and right are the subject's own.
+///
+/// The order of the variants is the order used by every file format and every per-joint array.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Joint {
+    HeadTop,
+    Neck,
+    Chest,
+    Pelvis,
+    LeftShoulder,
+    LeftElbow,
+    LeftWrist,
+    RightShoulder,
+    RightElbow,
+    RightWrist,
+    LeftHip,
+    LeftKnee,
+    LeftAnkle,
+    RightHip,
+    RightKnee,
+    RightAnkle,
+}
+
+/// Number of joints in the model.
+pub const JOINT_COUNT: usize = 16;
+
+impl Joint {
+    /// All joints in file order.
+    pub const ALL: [Joint; JOINT_COUNT] = [
+        Joint::HeadTop,
+        Joint::Neck,
+        Joint::Chest,
+        Joint::Pelvis,
+        Joint::LeftShoulder,
+        Joint::LeftElbow,
+        Joint::LeftWrist,
+        Joint::RightShoulder,
+        Joint::RightElbow,
+        Joint::RightWrist,
+        Joint::LeftHip,
+        Joint::LeftKnee,
+        Joint::LeftAnkle,
+        Joint::RightHip,
+        Joint::RightKnee,
+        Joint::RightAnkle,
+    ];
+
+    /// The joint's position in file order (0..16).
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// The joint's name as written in files (`head_top`, `left_wrist`, …).
+    pub fn name(self) -> &'static str {
+        match self {
+            Joint::HeadTop => "head_top",
+            Joint::Neck => "neck",
+            Joint::Chest => "chest",
+            Joint::Pelvis => "pelvis",
+            Joint::LeftShoulder => "left_shoulder",
+            Joint::LeftElbow => "left_elbow",
+            Joint::LeftWrist => "left_wrist",
+            Joint::RightShoulder => "right_shoulder",
+            Joint::RightElbow => "right_elbow",
+            Joint::RightWrist => "right_wrist",
+            Joint::LeftHip => "left_hip",
+            Joint::LeftKnee => "left_knee",
+            Joint::LeftAnkle => "left_ankle",
+            Joint::RightHip => "right_hip",
+            Joint::RightKnee => "right_knee",
+            Joint::RightAnkle => "right_ankle",
+        }
+    }
+
+    /// Parses a file name of a joint; `None` for anything else.
+    pub fn from_name(name: &str) -> Option<Joint> {
+        Joint::ALL.into_iter().find(|j| j.name() == name)
+    }
+
+    /// Where exactly to put the joint when marking it by hand (shown in the GUI and the docs).
+    pub fn definition(self) -> &'static str {
+        match self {
+            Joint::HeadTop => "top of the skull (vertex), on the head's middle line",
+            Joint::Neck => {
+                "base of the neck: midpoint between the shoulders at the level of the 7th cervical vertebra"
+            }
+            Joint::Chest => {
+                "sternum, on the trunk's middle line about a third of the way from neck to pelvis"
+            }
+            Joint::Pelvis => "midpoint of the two hip joints",
+            Joint::LeftShoulder | Joint::RightShoulder => {
+                "centre of the shoulder joint (head of the humerus), under the acromion"
+            }
+            Joint::LeftElbow | Joint::RightElbow => {
+                "centre of the elbow joint, between the epicondyles"
+            }
+            Joint::LeftWrist | Joint::RightWrist => {
+                "centre of the wrist, between the styloid processes"
+            }
+            Joint::LeftHip | Joint::RightHip => {
+                "centre of the hip joint (head of the femur), at the level of the greater trochanter"
+            }
+            Joint::LeftKnee | Joint::RightKnee => {
+                "centre of the knee joint, between the femoral condyles"
+            }
+            Joint::LeftAnkle | Joint::RightAnkle => {
+                "centre of the ankle joint, between the malleoli"
+            }
+        }
+    }
+
+    /// The parent in the bone tree rooted at the pelvis; `None` for the pelvis.
+    pub fn parent(self) -> Option<Joint> {
+        use Joint::*;
+        Some(match self {
+            Pelvis => return None,
+            Chest => Pelvis,
+            Neck => Chest,
+            HeadTop => Neck,
+            LeftShoulder | RightShoulder => Chest,
+            LeftElbow => LeftShoulder,
+            LeftWrist => LeftElbow,
+            RightElbow => RightShoulder,
+            RightWrist => RightElbow,
+            LeftHip | RightHip => Pelvis,
+            LeftKnee => LeftHip,
+            LeftAnkle => LeftKnee,
+            RightKnee => RightHip,
+            RightAnkle => RightKnee,
+        })
+    }
+
+    /// The same joint on the other side of the body (itself for joints on the middle line).
+    pub fn mirrored(self) -> Joint {
+        use Joint::*;
+        match self {
+            LeftShoulder => RightShoulder,
+            LeftElbow => RightElbow,
+            LeftWrist => RightWrist,
+            RightShoulder => LeftShoulder,
+            RightElbow => LeftElbow,
+            RightWrist => LeftWrist,
+            LeftHip => RightHip,
+            LeftKnee => RightKnee,
+            LeftAnkle => RightAnkle,
+            RightHip => LeftHip,
+            RightKnee => LeftKnee,
+            RightAnkle => LeftAnkle,
+            other => other,
+        }
+    }
+}
+
+impl fmt::Display for Joint {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// One value per joint, indexed by [`Joint`]: positions, confidences, flags.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct PerJoint<T>(pub [T; JOINT_COUNT]);
+
+impl<T> PerJoint<T> {
+    /// Builds the array by calling `f` for each joint in file order.
+    pub fn from_fn(mut f: impl FnMut(Joint) -> T) -> Self {
+        PerJoint(std::array::from_fn(|i| f(Joint::ALL[i])))
+    }
+
+    /// Maps every value, keeping the joint order.
+    pub fn map<U>(&self, mut f: impl FnMut(Joint, &T) -> U) -> PerJoint<U> {
+        PerJoint::from_fn(|j| f(j, &self.0[j.index()]))
+    }
+
+    /// Joints paired with their values, in file order.
+    pub fn iter(&self) -> impl Iterator<Item = (Joint, &T)> {
+        Joint::ALL.into_iter().zip(self.0.iter())
+    }
+}
+
+impl<T> Index<Joint> for PerJoint<T> {
+    type Output = T;
+    fn index(&self, joint: Joint) -> &T {
+        &self.0[joint.index()]
+    }
+}
+
+impl<T> IndexMut<Joint> for PerJoint<T> {
+    fn index_mut(&mut self, joint: Joint) -> &mut T {
+        &mut self.0[joint.index()]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_in_file_order() {
+        let names: Vec<&str> = Joint::ALL.iter().map(|j| j.name()).collect();
+        assert_eq!(
+            names.join(","),
+            "head_top,neck,chest,pelvis,left_shoulder,left_elbow,left_wrist,right_shoulder,\
+             right_elbow,right_wrist,left_hip,left_knee,left_ankle,right_hip,right_knee,right_ankle"
+        );
+        for (i, j) in Joint::ALL.iter().enumerate() {
+            assert_eq!(j.index(), i);
+            assert_eq!(Joint::from_name(j.name()), Some(*j));
+        }
+        assert_eq!(Joint::from_name("nose"), None);
+    }
+
+    #[test]
+    fn every_joint_but_the_pelvis_reaches_the_pelvis() {
+        for j in Joint::ALL {
+            let mut cur = j;
+            let mut steps = 0;
+            while let Some(p) = cur.parent() {
+                cur = p;
+                steps += 1;
+                assert!(steps < JOINT_COUNT, "cycle at {j}");
+            }
+            assert_eq!(cur, Joint::Pelvis);
+        }
+    }
+
+    #[test]
+    fn mirroring_twice_is_identity() {
+        for j in Joint::ALL {
+            assert_eq!(j.mirrored().mirrored(), j);
+        }
+        assert_eq!(Joint::LeftKnee.mirrored(), Joint::RightKnee);
+    }
+}

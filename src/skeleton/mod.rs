@@ -1,0 +1,10 @@
+//! The human model shared by every stage: the 16 joints, the bone tree rooted at the pelvis,
+//! the body parts tracked as blocks, and proportions scaled to a subject.
+
+mod bone;
+mod joint;
+mod proportions;
+
+pub use bone::{BONE_COUNT, BodyPart, Bone, Breadth};
+pub use joint::{JOINT_COUNT, Joint, PerJoint};
+pub use proportions::{DEFAULT_HEIGHT_M, Proportions, ProportionsError, SubjectModel};

@@ -1,0 +1,412 @@
+//! Synthetic clips with ground truth: a textured person posed by motion capture or a procedural
+//! motion, rendered by a pinhole camera from a chosen view, written as an MP4 or a PNG sequence
+//! with `gt.json` (2D, 3D, visibility, intrinsics, bone lengths) and `marks.json` for frame 0.
+//! This is the ground truth for every accuracy test and benchmark.
+
+mod ground_truth;
+mod motion;
+mod render;
+
+pub use ground_truth::{GroundTruth, GroundTruthFrame};
+pub use motion::{
+    Motion, ProceduralMotion, from_bvh, normalise_orientation, procedural, stature_of,
+};
+pub use render::{Rendered, SensorEffects, background, render_frame};
+
+use crate::bvh::BvhError;
+use crate::camera::PinholeCamera;
+use crate::formats::{FormatError, Marks};
+use crate::skeleton::{Bone, Joint, PerJoint, SubjectModel};
+use crate::video::VideoError;
+use nalgebra::{Matrix3, Point3, Rotation3, Vector3};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Where the camera stands relative to the subject's facing at the first frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum View {
+    /// In front, at chest height.
+    Frontal,
+    /// 45° to the subject's left, at chest height.
+    Oblique,
+    /// 90° to the subject's left (profile).
+    Side,
+    /// 30° to the left and 30° above (a camera on a shelf).
+    Raised,
+}
+
+impl View {
+    /// Parses `frontal`, `oblique`, `side` or `raised`.
+    pub fn from_name(name: &str) -> Option<View> {
+        match name {
+            "frontal" => Some(View::Frontal),
+            "oblique" => Some(View::Oblique),
+            "side" => Some(View::Side),
+            "raised" => Some(View::Raised),
+            _ => None,
+        }
+    }
+
+    /// Azimuth (towards the subject's left) and elevation, degrees.
+    fn angles_deg(self) -> (f64, f64) {
+        match self {
+            View::Frontal => (0.0, 0.0),
+            View::Oblique => (45.0, 0.0),
+            View::Side => (90.0, 0.0),
+            View::Raised => (30.0, 30.0),
+        }
+    }
+}
+
+/// Where a clip's motion comes from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum MotionSource {
+    /// A procedural motion.
+    Procedural(ProceduralMotion),
+    /// A BVH file from `start_s` seconds.
+    Bvh { path: PathBuf, start_s: f64 },
+}
+
+/// How to write the frames.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VideoOutput {
+    /// `video.mp4` (H.264 through FFmpeg).
+    Mp4,
+    /// `frames/000000.png` …
+    PngSequence,
+}
+
+/// Everything that defines a synthetic clip.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SynthParams {
+    /// The motion.
+    pub motion: MotionSource,
+    /// Number of frames.
+    pub frames: usize,
+    /// Frames per second.
+    pub fps: u32,
+    /// Image width, pixels (even for MP4).
+    pub width: u32,
+    /// Image height, pixels (even for MP4).
+    pub height: u32,
+    /// Camera placement.
+    pub view: View,
+    /// Focal length, pixels.
+    pub focal_px: f64,
+    /// Wanted stature of the person in the image, pixels (the camera distance follows; it grows
+    /// further if some frame would leave the image).
+    pub person_px: f64,
+    /// Sensor noise and flicker.
+    pub effects: SensorEffects,
+    /// Background texture seed.
+    pub background_seed: u64,
+    /// Output kind.
+    pub output: VideoOutput,
+}
+
+impl Default for SynthParams {
+    /// 100 frames of walking, 640×480 at 30 fps, oblique view, person 300 px tall, light noise.
+    fn default() -> Self {
+        SynthParams {
+            motion: MotionSource::Procedural(ProceduralMotion::Walk),
+            frames: 100,
+            fps: 30,
+            width: 640,
+            height: 480,
+            view: View::Oblique,
+            focal_px: 600.0,
+            person_px: 300.0,
+            effects: SensorEffects {
+                noise_sigma: 2.0,
+                flicker: 0.02,
+                seed: 1,
+            },
+            background_seed: 7,
+            output: VideoOutput::Mp4,
+        }
+    }
+}
+
+/// A synthetic clip could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum SynthError {
+    #[error(transparent)]
+    Motion(#[from] BvhError),
+    #[error(transparent)]
+    Video(#[from] VideoError),
+    #[error(transparent)]
+    Write(#[from] FormatError),
+    #[error("{path}: cannot create: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("bad parameters: {0}")]
+    Params(String),
+    #[error("cancelled")]
+    Cancelled,
+}
+
+/// What was written.
+#[derive(Debug, Clone)]
+pub struct SynthResult {
+    /// The video file or the PNG directory.
+    pub video: PathBuf,
+    /// The ground truth file.
+    pub ground_truth: PathBuf,
+    /// The marks of frame 0.
+    pub marks: PathBuf,
+    /// Frames written.
+    pub frames: usize,
+    /// The camera used.
+    pub camera: PinholeCamera,
+    /// Mean seconds to render one frame (excluding encoding).
+    pub render_s_per_frame: f64,
+}
+
+/// Places the camera: looking at the clip's mean pelvis from the view's direction, at the distance
+/// that gives the wanted stature in pixels, moved back until every joint of every frame is on the
+/// image with a 3% margin. Returns the world→camera rotation and the camera centre.
+fn place_camera(
+    motion: &Motion,
+    params: &SynthParams,
+    camera: &PinholeCamera,
+) -> (Matrix3<f64>, Vector3<f64>) {
+    let n = motion.frames.len().max(1) as f64;
+    let target: Vector3<f64> = motion
+        .frames
+        .iter()
+        .map(|p| p[Joint::Pelvis].coords)
+        .sum::<Vector3<f64>>()
+        / n
+        + Vector3::y() * 0.05;
+    let (az, el) = params.view.angles_deg();
+    // Facing +Z; azimuth turns towards the subject's left (+X), elevation upwards.
+    let dir = Rotation3::from_axis_angle(&Vector3::y_axis(), az.to_radians())
+        * Rotation3::from_axis_angle(&(-Vector3::x_axis()), el.to_radians())
+        * Vector3::z();
+    let stature = stature_of(motion);
+    let mut distance = camera.focal_px * stature / params.person_px.max(1.0);
+    let z = -dir; // camera looks back at the subject
+    let down = -(Vector3::y() - z * z.dot(&Vector3::y())).normalize();
+    let x = down.cross(&z);
+    let r = Matrix3::from_rows(&[x.transpose(), down.transpose(), z.transpose()]);
+    let margin = 0.03 * f64::from(camera.width.min(camera.height));
+    for _ in 0..40 {
+        let centre = target + dir * distance;
+        let fits = motion.frames.iter().all(|p| {
+            p.0.iter().all(|q| {
+                let c = Point3::from(r * (q.coords - centre));
+                camera.project(&c).is_some_and(|uv| {
+                    uv.x >= margin
+                        && uv.y >= margin
+                        && uv.x <= f64::from(camera.width) - 1.0 - margin
+                        && uv.y <= f64::from(camera.height) - 1.0 - margin
+                        && c.z > 0.3
+                })
+            })
+        });
+        if fits {
+            break;
+        }
+        distance *= 1.1;
+    }
+    (r, target + dir * distance)
+}
+
+/// Loads or builds the motion of a clip.
+pub fn load_motion(params: &SynthParams) -> Result<Motion, SynthError> {
+    let fps = f64::from(params.fps);
+    Ok(match &params.motion {
+        MotionSource::Procedural(kind) => {
+            procedural(*kind, &SubjectModel::default(), params.frames, fps)
+        }
+        MotionSource::Bvh { path, start_s } => from_bvh(path, *start_s, params.frames, fps)?,
+    })
+}
+
+/// Renders a clip into `out_dir`, calling `progress(done, total)` after each frame; stops with
+/// [`SynthError::Cancelled`] when `cancel` becomes true.
+pub fn render_clip(
+    params: &SynthParams,
+    out_dir: &Path,
+    progress: &mut dyn FnMut(usize, usize),
+    cancel: &AtomicBool,
+) -> Result<SynthResult, SynthError> {
+    if params.frames == 0 || params.width < 16 || params.height < 16 || params.fps == 0 {
+        return Err(SynthError::Params(format!(
+            "{} frames of {}×{} at {} fps: need at least 1 frame, 16×16 pixels and 1 fps",
+            params.frames, params.width, params.height, params.fps
+        )));
+    }
+    if !(params.focal_px.is_finite() && params.focal_px > 0.0) {
+        return Err(SynthError::Params(format!(
+            "focal length {} px must be positive",
+            params.focal_px
+        )));
+    }
+    std::fs::create_dir_all(out_dir).map_err(|source| SynthError::Io {
+        path: out_dir.to_owned(),
+        source,
+    })?;
+    let motion = load_motion(params)?;
+    let camera = PinholeCamera::centred(params.focal_px, params.width, params.height);
+    let (camera_from_world, centre) = place_camera(&motion, params, &camera);
+    let stature = stature_of(&motion);
+    let bg = background(params.width, params.height, params.background_seed);
+
+    let video_path = match params.output {
+        VideoOutput::Mp4 => out_dir.join("video.mp4"),
+        VideoOutput::PngSequence => out_dir.join("frames"),
+    };
+    let mut sink = FrameSink::open(params, &video_path)?;
+    let mut gt_frames = Vec::with_capacity(motion.frames.len());
+    let mut bone_sums = vec![0.0; Bone::ALL.len()];
+    let mut render_s = 0.0;
+    let total = motion.frames.len();
+    let mut first_points2d = None;
+    for (i, world) in motion.frames.iter().enumerate() {
+        if cancel.load(Ordering::Relaxed) {
+            return Err(SynthError::Cancelled);
+        }
+        let cam_pts: PerJoint<Point3<f64>> =
+            world.map(|_, p| Point3::from(camera_from_world * (p.coords - centre)));
+        let t0 = std::time::Instant::now();
+        let r = render_frame(&camera, &cam_pts, stature, &bg, &params.effects, i);
+        render_s += t0.elapsed().as_secs_f64();
+        sink.write(i, &r.image)?;
+        for (k, b) in Bone::ALL.iter().enumerate() {
+            bone_sums[k] += (cam_pts[b.child] - cam_pts[b.parent]).norm();
+        }
+        if i == 0 {
+            first_points2d = Some(r.points2d);
+        }
+        gt_frames.push(GroundTruthFrame {
+            index: i,
+            points2d: r
+                .points2d
+                .0
+                .iter()
+                .map(|p| [round4(p.x), round4(p.y)])
+                .collect(),
+            points3d: cam_pts
+                .0
+                .iter()
+                .map(|p| [round6(p.x), round6(p.y), round6(p.z)])
+                .collect(),
+            visible: r.visible.0.to_vec(),
+        });
+        progress(i + 1, total);
+    }
+    sink.finish()?;
+    let gt = GroundTruth {
+        source: format!(
+            "videomocap synth: motion {}, view {:?}, {} frames at {} fps",
+            motion.origin, params.view, total, params.fps
+        ),
+        fps: f64::from(params.fps),
+        width: params.width,
+        height: params.height,
+        focal_px: camera.focal_px,
+        cx: camera.cx,
+        cy: camera.cy,
+        joints: Joint::ALL.iter().map(|j| j.name().to_owned()).collect(),
+        derived_joints: Vec::new(),
+        bone_lengths_m: Bone::ALL
+            .iter()
+            .enumerate()
+            .map(|(k, b)| (b.key(), round6(bone_sums[k] / total as f64)))
+            .collect(),
+        frames: gt_frames,
+    };
+    let gt_path = out_dir.join("gt.json");
+    gt.save(&gt_path)?;
+    let marks_path = out_dir.join("marks.json");
+    if let Some(points) = first_points2d {
+        Marks {
+            frame: 0,
+            points: points.map(|_, p| nalgebra::Point2::new(round4(p.x), round4(p.y))),
+        }
+        .save(&marks_path)?;
+    }
+    Ok(SynthResult {
+        video: video_path,
+        ground_truth: gt_path,
+        marks: marks_path,
+        frames: total,
+        camera,
+        render_s_per_frame: render_s / total.max(1) as f64,
+    })
+}
+
+fn round4(v: f64) -> f64 {
+    (v * 1e4).round() / 1e4
+}
+
+fn round6(v: f64) -> f64 {
+    (v * 1e6).round() / 1e6
+}
+
+/// Writes frames to an MP4 or a PNG directory.
+enum FrameSink {
+    #[cfg(feature = "ffmpeg")]
+    Mp4(crate::video::Mp4Writer),
+    Png(PathBuf),
+}
+
+impl FrameSink {
+    fn open(params: &SynthParams, path: &Path) -> Result<FrameSink, SynthError> {
+        match params.output {
+            #[cfg(feature = "ffmpeg")]
+            VideoOutput::Mp4 => {
+                let enc = crate::video::EncodeParams {
+                    fps: params.fps,
+                    gop: params.fps * 2,
+                    max_b_frames: 2,
+                    crf: 18,
+                };
+                Ok(FrameSink::Mp4(crate::video::Mp4Writer::create(
+                    path,
+                    params.width,
+                    params.height,
+                    &enc,
+                )?))
+            }
+            #[cfg(not(feature = "ffmpeg"))]
+            VideoOutput::Mp4 => Err(SynthError::Video(VideoError::FfmpegDisabled {
+                path: path.to_owned(),
+            })),
+            VideoOutput::PngSequence => {
+                std::fs::create_dir_all(path).map_err(|source| SynthError::Io {
+                    path: path.to_owned(),
+                    source,
+                })?;
+                Ok(FrameSink::Png(path.to_owned()))
+            }
+        }
+    }
+
+    fn write(&mut self, index: usize, image: &image::RgbImage) -> Result<(), SynthError> {
+        match self {
+            #[cfg(feature = "ffmpeg")]
+            FrameSink::Mp4(w) => Ok(w.write(image)?),
+            FrameSink::Png(dir) => {
+                let path = dir.join(format!("{index:06}.png"));
+                image.save(&path).map_err(|e| {
+                    SynthError::Video(VideoError::Image {
+                        path,
+                        reason: e.to_string(),
+                    })
+                })
+            }
+        }
+    }
+
+    fn finish(self) -> Result<(), SynthError> {
+        match self {
+            #[cfg(feature = "ffmpeg")]
+            FrameSink::Mp4(w) => Ok(w.finish()?),
+            FrameSink::Png(_) => Ok(()),
+        }
+    }
+}

@@ -1,0 +1,384 @@
+//! Motions that drive synthetic clips: real motion capture (BVH, any rig in the mapping table)
+//! or procedural motions built from the subject's bone lengths. Both come out as the 16 joints in
+//! a world frame: metres, Y up, the subject facing +Z at the first frame (so its left is +X).
+
+use crate::bvh::{Bvh, BvhError, map_to_model};
+use crate::skeleton::{Bone, JOINT_COUNT, Joint, PerJoint, SubjectModel};
+use nalgebra::{Point3, Rotation3, Unit, Vector3};
+use std::f64::consts::PI;
+use std::path::Path;
+
+/// A posed body per frame in the world frame (metres, Y up).
+#[derive(Debug, Clone)]
+pub struct Motion {
+    /// Joint positions per output frame.
+    pub frames: Vec<PerJoint<Point3<f64>>>,
+    /// Output frames per second.
+    pub fps: f64,
+    /// Where the motion came from (file name or procedural kind), for the record.
+    pub origin: String,
+}
+
+/// The procedural motions (for tests that need no files).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ProceduralMotion {
+    /// Walking forward at 1.2 m/s, 1 stride per second.
+    Walk,
+    /// Standing and waving the right hand above the head.
+    Wave,
+    /// Jumping jacks at one per second.
+    JumpingJacks,
+}
+
+impl ProceduralMotion {
+    /// Parses `walk`, `wave` or `jumping-jacks`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "walk" => Some(Self::Walk),
+            "wave" => Some(Self::Wave),
+            "jumping-jacks" | "jumping_jacks" => Some(Self::JumpingJacks),
+            _ => None,
+        }
+    }
+
+    /// The name accepted by [`ProceduralMotion::from_name`].
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Walk => "walk",
+            Self::Wave => "wave",
+            Self::JumpingJacks => "jumping-jacks",
+        }
+    }
+}
+
+/// Limb angles of a simple kinematic body, radians.
+#[derive(Debug, Clone, Copy, Default)]
+struct LimbAngles {
+    /// Rotation away from the body's middle in the frontal plane (0 = hanging down).
+    abduction: f64,
+    /// Rotation forward in the sagittal plane (0 = hanging down).
+    flexion: f64,
+    /// Bend of the elbow or knee (0 = straight).
+    bend: f64,
+}
+
+/// Places the 16 joints of a body standing at `pelvis` (Y up, facing +Z, left = +X).
+fn pose(
+    subject: &SubjectModel,
+    pelvis: Point3<f64>,
+    arms: [LimbAngles; 2],
+    legs: [LimbAngles; 2],
+) -> PerJoint<Point3<f64>> {
+    let len = |a: Joint, b: Joint| subject.bone_length(Bone::new(a, b));
+    let up = Vector3::y();
+    let mut p = PerJoint([Point3::origin(); JOINT_COUNT]);
+    p[Joint::Pelvis] = pelvis;
+    p[Joint::Chest] = pelvis + up * len(Joint::Pelvis, Joint::Chest);
+    p[Joint::Neck] = p[Joint::Chest] + up * len(Joint::Chest, Joint::Neck);
+    p[Joint::HeadTop] = p[Joint::Neck] + up * len(Joint::Neck, Joint::HeadTop);
+    let half_width = subject.shoulder_width_m / 2.0;
+    for (side, sign) in [(0usize, 1.0), (1, -1.0)] {
+        let (sh, el, wr, hip, kn, an) = if side == 0 {
+            use Joint::*;
+            (
+                LeftShoulder,
+                LeftElbow,
+                LeftWrist,
+                LeftHip,
+                LeftKnee,
+                LeftAnkle,
+            )
+        } else {
+            use Joint::*;
+            (
+                RightShoulder,
+                RightElbow,
+                RightWrist,
+                RightHip,
+                RightKnee,
+                RightAnkle,
+            )
+        };
+        let cs = len(Joint::Chest, sh);
+        let rise = (cs * cs - half_width * half_width).max(0.0).sqrt();
+        p[sh] = p[Joint::Chest] + Vector3::new(sign * half_width.min(cs), rise, 0.0);
+        let (upper, lower) = limb_directions(arms[side], sign);
+        p[el] = p[sh] + upper * len(sh, el);
+        p[wr] = p[el] + lower * len(el, wr);
+        p[hip] = pelvis + Vector3::new(sign * len(Joint::Pelvis, hip), 0.0, 0.0);
+        let (thigh, shank) = limb_directions(legs[side], sign);
+        // Knees bend backwards, elbows forwards.
+        let shank = reflect_bend(thigh, shank);
+        p[kn] = p[hip] + thigh * len(hip, kn);
+        p[an] = p[kn] + shank * len(kn, an);
+    }
+    p
+}
+
+/// Directions of the upper and lower segments of a limb hanging from its root.
+fn limb_directions(a: LimbAngles, side_sign: f64) -> (Vector3<f64>, Vector3<f64>) {
+    let down = -Vector3::y();
+    // Abduction turns about the forward axis, towards the body's own side.
+    let abduct = Rotation3::from_axis_angle(&Vector3::z_axis(), side_sign * a.abduction);
+    // Flexion turns about the left axis, bringing "down" towards forward (+Z).
+    let flex = Rotation3::from_axis_angle(&Unit::new_normalize(-Vector3::x()), a.flexion);
+    let upper = flex * abduct * down;
+    // The bend turns the lower segment forward within the limb's sagittal plane.
+    let axis = Unit::try_new(upper.cross(&Vector3::z()), 1e-9).unwrap_or(-Vector3::x_axis());
+    let lower = Rotation3::from_axis_angle(&axis, a.bend) * upper;
+    (upper, lower)
+}
+
+/// Mirrors the bend of a lower segment about its upper segment (knees bend backwards).
+fn reflect_bend(upper: Vector3<f64>, lower: Vector3<f64>) -> Vector3<f64> {
+    let along = upper * upper.dot(&lower);
+    let across = lower - along;
+    let z = Vector3::z();
+    let across = if across.dot(&z) > 0.0 {
+        -across
+    } else {
+        across
+    };
+    (along + across).normalize()
+}
+
+/// Builds a procedural motion of `frames` frames at `fps`.
+pub fn procedural(
+    kind: ProceduralMotion,
+    subject: &SubjectModel,
+    frames: usize,
+    fps: f64,
+) -> Motion {
+    let leg_len = subject.length_to(Joint::LeftKnee) + subject.length_to(Joint::LeftAnkle);
+    let ankle_height = 0.039 * subject.height_m;
+    let stand = leg_len + ankle_height;
+    let out = (0..frames)
+        .map(|i| {
+            let t = i as f64 / fps;
+            let w = 2.0 * PI * t; // one cycle per second
+            match kind {
+                ProceduralMotion::Walk => {
+                    let hip = 0.42 * w.sin();
+                    let legs = [
+                        LimbAngles {
+                            flexion: hip,
+                            bend: 0.1 + 0.55 * (w + 0.9 * PI).sin().max(0.0),
+                            ..Default::default()
+                        },
+                        LimbAngles {
+                            flexion: -hip,
+                            bend: 0.1 + 0.55 * (w - 0.1 * PI).sin().max(0.0),
+                            ..Default::default()
+                        },
+                    ];
+                    let arms = [
+                        LimbAngles {
+                            abduction: 0.12,
+                            flexion: -0.35 * w.sin(),
+                            bend: 0.3,
+                        },
+                        LimbAngles {
+                            abduction: 0.12,
+                            flexion: 0.35 * w.sin(),
+                            bend: 0.3,
+                        },
+                    ];
+                    let pelvis = Point3::new(0.0, stand - 0.03 + 0.02 * (2.0 * w).cos(), 1.2 * t);
+                    pose(subject, pelvis, arms, legs)
+                }
+                ProceduralMotion::Wave => {
+                    let arms = [
+                        LimbAngles {
+                            abduction: 0.15,
+                            flexion: 0.1,
+                            bend: 0.2,
+                        },
+                        LimbAngles {
+                            abduction: 2.3,
+                            flexion: 0.2,
+                            bend: 0.5 + 0.45 * (1.5 * w).sin(),
+                        },
+                    ];
+                    let legs = [LimbAngles {
+                        abduction: 0.06,
+                        ..Default::default()
+                    }; 2];
+                    let pelvis = Point3::new(0.03 * (0.5 * w).sin(), stand - 0.01, 0.0);
+                    pose(subject, pelvis, arms, legs)
+                }
+                ProceduralMotion::JumpingJacks => {
+                    let phase = 0.5 - 0.5 * w.cos(); // 0 closed … 1 open
+                    let arms = [LimbAngles {
+                        abduction: 0.15 + 2.55 * phase,
+                        flexion: 0.0,
+                        bend: 0.15,
+                    }; 2];
+                    let legs = [LimbAngles {
+                        abduction: 0.04 + 0.3 * phase,
+                        ..Default::default()
+                    }; 2];
+                    let hop = 0.08 * (2.0 * w).sin().max(0.0);
+                    let drop = leg_len * (1.0 - (0.04 + 0.3 * phase).cos());
+                    let pelvis = Point3::new(0.0, stand - drop + hop, 0.0);
+                    pose(subject, pelvis, arms, legs)
+                }
+            }
+        })
+        .collect();
+    Motion {
+        frames: out,
+        fps,
+        origin: kind.name().to_owned(),
+    }
+}
+
+/// Reads a BVH, maps it onto the 16 joints, resamples it to `fps` from `start_s` seconds for
+/// `frames` frames (fewer if the file ends), and turns it so that Y is up and the subject faces
+/// +Z at the first frame.
+pub fn from_bvh(path: &Path, start_s: f64, frames: usize, fps: f64) -> Result<Motion, BvhError> {
+    let bvh = Bvh::load(path)?;
+    let mapped = map_to_model(&bvh, path)?;
+    let n = mapped.frames.len();
+    let mut out = Vec::with_capacity(frames);
+    for i in 0..frames {
+        let t = (start_s + i as f64 / fps) * mapped.fps;
+        if t > (n - 1) as f64 {
+            break;
+        }
+        let f0 = t.floor() as usize;
+        let f1 = (f0 + 1).min(n - 1);
+        let a = t - f0 as f64;
+        out.push(PerJoint::from_fn(|j| {
+            mapped.frames[f0][j] + (mapped.frames[f1][j] - mapped.frames[f0][j]) * a
+        }));
+    }
+    if out.is_empty() {
+        return Err(BvhError::NoFrames {
+            path: path.to_owned(),
+        });
+    }
+    let name = path
+        .file_name()
+        .unwrap_or_default()
+        .to_string_lossy()
+        .into_owned();
+    Ok(normalise_orientation(Motion {
+        frames: out,
+        fps,
+        origin: name,
+    }))
+}
+
+/// Rotates a motion so that the trunk's mean direction is +Y, the subject faces +Z at the first
+/// frame, and the lowest ankle over the clip is at 3.9% of the stature above Y = 0 (Winter's
+/// ankle height) — roughly standing on the floor.
+pub fn normalise_orientation(mut motion: Motion) -> Motion {
+    let Some(first) = motion.frames.first().cloned() else {
+        return motion;
+    };
+    let trunk: Vector3<f64> = motion
+        .frames
+        .iter()
+        .map(|p| p[Joint::Neck] - p[Joint::Pelvis])
+        .sum();
+    let up = trunk.try_normalize(1e-9).unwrap_or_else(Vector3::y);
+    let left = (first[Joint::LeftHip] - first[Joint::RightHip])
+        + (first[Joint::LeftShoulder] - first[Joint::RightShoulder]);
+    let left = (left - up * up.dot(&left))
+        .try_normalize(1e-9)
+        .unwrap_or_else(|| {
+            // Degenerate: any horizontal direction.
+            up.cross(&Vector3::z())
+                .try_normalize(1e-9)
+                .unwrap_or_else(Vector3::x)
+        });
+    let forward = left.cross(&up);
+    // Rows map world axes: new X = left, new Y = up, new Z = forward.
+    let r = nalgebra::Matrix3::from_rows(&[left.transpose(), up.transpose(), forward.transpose()]);
+    let origin = first[Joint::Pelvis];
+    for frame in &mut motion.frames {
+        for p in frame.0.iter_mut() {
+            *p = Point3::from(r * (*p - origin));
+        }
+    }
+    let lowest = motion
+        .frames
+        .iter()
+        .flat_map(|f| [f[Joint::LeftAnkle].y, f[Joint::RightAnkle].y])
+        .fold(f64::INFINITY, f64::min);
+    let stature = stature_of(&motion);
+    let lift = 0.039 * stature - lowest;
+    for frame in &mut motion.frames {
+        for p in frame.0.iter_mut() {
+            p.y += lift;
+        }
+    }
+    motion
+}
+
+/// Rough stature of the body in a motion: leg, trunk and head lengths of the first frame,
+/// over their share of stature in the proportions table (0.961).
+pub fn stature_of(motion: &Motion) -> f64 {
+    let Some(p) = motion.frames.first() else {
+        return 0.0;
+    };
+    let d = |a: Joint, b: Joint| (p[a] - p[b]).norm();
+    (d(Joint::LeftAnkle, Joint::LeftKnee)
+        + d(Joint::LeftKnee, Joint::LeftHip)
+        + d(Joint::Pelvis, Joint::Chest)
+        + d(Joint::Chest, Joint::Neck)
+        + d(Joint::Neck, Joint::HeadTop))
+        / 0.961
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn procedural_bodies_keep_their_bone_lengths() {
+        let s = SubjectModel::default();
+        for kind in [
+            ProceduralMotion::Walk,
+            ProceduralMotion::Wave,
+            ProceduralMotion::JumpingJacks,
+        ] {
+            let m = procedural(kind, &s, 40, 30.0);
+            for p in &m.frames {
+                for b in Bone::ALL {
+                    let d = (p[b.child] - p[b.parent]).norm();
+                    assert!((d - s.bone_length(b)).abs() < 1e-9, "{kind:?} {}", b.key());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_subjects_left_is_plus_x_and_knees_bend_backwards() {
+        let s = SubjectModel::default();
+        let m = procedural(ProceduralMotion::Walk, &s, 30, 30.0);
+        for p in &m.frames {
+            assert!(p[Joint::LeftHip].x > p[Joint::RightHip].x);
+            for (hip, knee, ankle) in [
+                (Joint::LeftHip, Joint::LeftKnee, Joint::LeftAnkle),
+                (Joint::RightHip, Joint::RightKnee, Joint::RightAnkle),
+            ] {
+                // The knee is ahead of the hip–ankle line (it bends with the shank going back).
+                let mid = nalgebra::center(&p[hip], &p[ankle]);
+                assert!(p[knee].z >= mid.z - 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn motion_capture_is_turned_upright_and_facing_forward() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/cmu_02_01_walk.bvh");
+        let m = from_bvh(&path, 0.0, 60, 30.0).unwrap();
+        assert_eq!(m.frames.len(), 60);
+        let p = &m.frames[0];
+        assert!(p[Joint::HeadTop].y > p[Joint::Neck].y && p[Joint::Neck].y > p[Joint::Pelvis].y);
+        assert!(p[Joint::LeftHip].x > p[Joint::RightHip].x);
+        let stature = stature_of(&m);
+        assert!((1.4..2.1).contains(&stature), "stature {stature}");
+    }
+}

@@ -1,0 +1,415 @@
+//! Video files through FFmpeg (ffmpeg-next) with frame-accurate random access.
+//!
+//! On open, the demuxer is run once over the whole file (packets only, no decoding) to list every
+//! frame's presentation timestamp and every keyframe. Frame `i` is then the `i`-th timestamp in
+//! presentation order, whatever the B-frames or the keyframe spacing. To decode it we seek to the
+//! last keyframe at or before it, flush the decoder and decode forward until that timestamp comes
+//! out; a request for the frame right after the last one decoded just decodes on, with no seek.
+
+use super::{VideoError, VideoInfo, VideoSource, rotate_clockwise};
+use ff::packet::Ref as _;
+use ffmpeg_next as ff;
+use image::RgbImage;
+use std::path::{Path, PathBuf};
+use std::sync::Once;
+
+static INIT: Once = Once::new();
+
+fn init() {
+    INIT.call_once(|| {
+        // Only fails if FFmpeg's global init fails, which it does not in versions ≥ 4.
+        let _ = ff::init();
+        ff::util::log::set_level(ff::util::log::Level::Fatal);
+    });
+}
+
+/// Frames between the last decoded frame and a later request beyond which a seek is cheaper
+/// than decoding on (a seek costs up to one GOP of decoding; most GOPs are ≤ 250 frames).
+const DECODE_ON_LIMIT: usize = 48;
+
+/// A video file read through FFmpeg.
+pub struct FfmpegSource {
+    input: ff::format::context::Input,
+    decoder: ff::decoder::Video,
+    stream_index: usize,
+    time_base: f64,
+    /// Presentation timestamps (stream time base) of all frames, ascending: frame i has `pts[i]`.
+    pts: Vec<i64>,
+    /// Indexes (into `pts`) of the keyframes, ascending.
+    keyframes: Vec<usize>,
+    scaler: Option<(ff::software::scaling::Context, ff::format::Pixel, u32, u32)>,
+    /// Index of the last frame the decoder produced, if it is positioned after it.
+    last_decoded: Option<usize>,
+    /// Whether end of stream was sent to the decoder since the last seek.
+    eof_sent: bool,
+    info: VideoInfo,
+}
+
+fn not_a_video(path: &Path, e: impl std::fmt::Display) -> VideoError {
+    VideoError::NotAVideo {
+        path: path.to_owned(),
+        reason: e.to_string(),
+    }
+}
+
+/// Reads the display rotation (clockwise degrees, multiple of 90) from a stream's display matrix.
+fn display_rotation(stream: &ff::format::stream::Stream) -> u32 {
+    for side in stream.side_data() {
+        if side.kind() == ff::codec::packet::side_data::Type::DisplayMatrix
+            && side.data().len() >= 36
+        {
+            let mut m = [0i32; 9];
+            for (k, chunk) in side.data().chunks_exact(4).take(9).enumerate() {
+                m[k] = i32::from_ne_bytes([chunk[0], chunk[1], chunk[2], chunk[3]]);
+            }
+            // SAFETY: `m` holds the 9 entries av_display_rotation_get reads.
+            let ccw = unsafe { ff::ffi::av_display_rotation_get(m.as_ptr()) };
+            if !ccw.is_finite() {
+                return 0;
+            }
+            // As FFmpeg's own autorotate: the display matrix angle is counter-clockwise.
+            let cw = (-ccw).rem_euclid(360.0);
+            return ((cw / 90.0).round() as u32 % 4) * 90;
+        }
+    }
+    0
+}
+
+impl FfmpegSource {
+    /// Opens a video file and indexes its frames.
+    pub fn open(path: &Path) -> Result<FfmpegSource, VideoError> {
+        init();
+        std::fs::File::open(path).map_err(|source| VideoError::Io {
+            path: path.to_owned(),
+            source,
+        })?;
+        let mut input = ff::format::input(path).map_err(|e| not_a_video(path, e))?;
+        let stream = input
+            .streams()
+            .best(ff::media::Type::Video)
+            .ok_or_else(|| VideoError::NoVideoStream {
+                path: path.to_owned(),
+            })?;
+        let stream_index = stream.index();
+        let tb = stream.time_base();
+        let time_base = f64::from(tb.numerator()) / f64::from(tb.denominator().max(1));
+        let rotation_deg = display_rotation(&stream);
+        let avg_rate = stream.avg_frame_rate();
+        let mut ctx = ff::codec::Context::from_parameters(stream.parameters())
+            .map_err(|e| not_a_video(path, e))?;
+        ctx.set_threading(ff::codec::threading::Config {
+            kind: ff::codec::threading::Type::Frame,
+            count: 0,
+            ..Default::default()
+        });
+        let decoder = ctx.decoder().video().map_err(|e| not_a_video(path, e))?;
+        let codec = decoder
+            .codec()
+            .map_or_else(|| "unknown".to_owned(), |c| c.name().to_owned());
+        let (coded_w, coded_h) = (decoder.width(), decoder.height());
+
+        // Index: every packet of the stream, in file order.
+        let mut packets: Vec<(i64, bool)> = Vec::new();
+        let mut ordinal = 0i64;
+        for (s, packet) in input.packets() {
+            if s.index() != stream_index {
+                continue;
+            }
+            // SAFETY: reading the flags field of a valid packet.
+            let discard = unsafe { (*packet.as_ptr()).flags } & ff::ffi::AV_PKT_FLAG_DISCARD != 0;
+            if discard || packet.is_corrupt() {
+                continue;
+            }
+            let ts = packet.pts().or(packet.dts()).unwrap_or(ordinal);
+            packets.push((ts, packet.is_key()));
+            ordinal += 1;
+        }
+        if packets.is_empty() || coded_w == 0 || coded_h == 0 {
+            return Err(VideoError::NoFrames {
+                path: path.to_owned(),
+            });
+        }
+        let mut pts: Vec<i64> = packets.iter().map(|p| p.0).collect();
+        pts.sort_unstable();
+        pts.dedup();
+        let mut keyframes: Vec<usize> = packets
+            .iter()
+            .filter(|p| p.1)
+            .filter_map(|p| pts.binary_search(&p.0).ok())
+            .collect();
+        keyframes.sort_unstable();
+        keyframes.dedup();
+        if keyframes.first() != Some(&0) {
+            keyframes.insert(0, 0);
+        }
+
+        let frame_count = pts.len();
+        let span = (pts[frame_count - 1] - pts[0]) as f64 * time_base;
+        let avg_fps = if avg_rate.numerator() > 0 && avg_rate.denominator() > 0 {
+            f64::from(avg_rate.numerator()) / f64::from(avg_rate.denominator())
+        } else if span > 0.0 {
+            (frame_count - 1) as f64 / span
+        } else {
+            DEFAULT_FPS_WHEN_UNKNOWN
+        };
+        let variable_frame_rate = is_variable(&pts);
+        let fps = if variable_frame_rate && span > 0.0 {
+            (frame_count - 1) as f64 / span
+        } else {
+            avg_fps
+        };
+        let (width, height) = if rotation_deg % 180 == 90 {
+            (coded_h, coded_w)
+        } else {
+            (coded_w, coded_h)
+        };
+        let info = VideoInfo {
+            path: path.to_owned(),
+            width,
+            height,
+            fps,
+            frame_count,
+            duration_s: span + 1.0 / fps,
+            rotation_deg,
+            codec,
+            variable_frame_rate,
+        };
+        // Back to the start for decoding.
+        input.seek(i64::MIN + 1, ..).ok();
+        let mut me = FfmpegSource {
+            input,
+            decoder,
+            stream_index,
+            time_base,
+            pts,
+            keyframes,
+            scaler: None,
+            last_decoded: None,
+            eof_sent: false,
+            info,
+        };
+        me.seek_to_keyframe_before(0)?;
+        Ok(me)
+    }
+
+    fn path(&self) -> PathBuf {
+        self.info.path.clone()
+    }
+
+    fn decode_error(&self, index: usize, e: impl std::fmt::Display) -> VideoError {
+        VideoError::Decode {
+            path: self.path(),
+            index,
+            reason: e.to_string(),
+        }
+    }
+
+    /// Positions the demuxer at the keyframe `k`-th in `self.keyframes` and resets the decoder.
+    fn seek_to_keyframe(&mut self, k: usize) -> Result<(), VideoError> {
+        let frame = self.keyframes.get(k).copied().unwrap_or(0);
+        let target = self.pts[frame];
+        // avformat_seek_file with stream -1 takes AV_TIME_BASE (µs); round down so the seek
+        // never lands after the keyframe.
+        let ts_us = (target as f64 * self.time_base * 1e6).floor() as i64;
+        let result = if k == 0 {
+            self.input.seek(i64::MIN + 1, ..)
+        } else {
+            self.input.seek(ts_us, ..ts_us)
+        };
+        result.map_err(|e| self.decode_error(frame, format!("seek failed: {e}")))?;
+        self.decoder.flush();
+        self.last_decoded = None;
+        self.eof_sent = false;
+        Ok(())
+    }
+
+    /// Seeks to the last keyframe at or before frame `index`.
+    fn seek_to_keyframe_before(&mut self, index: usize) -> Result<usize, VideoError> {
+        let k = self
+            .keyframes
+            .partition_point(|&f| f <= index)
+            .saturating_sub(1);
+        self.seek_to_keyframe(k)?;
+        Ok(k)
+    }
+
+    /// Decodes the next frame in presentation order; `None` at end of stream.
+    fn next_decoded(&mut self, for_index: usize) -> Result<Option<ff::frame::Video>, VideoError> {
+        let mut frame = ff::frame::Video::empty();
+        loop {
+            match self.decoder.receive_frame(&mut frame) {
+                Ok(()) => return Ok(Some(frame)),
+                Err(ff::Error::Eof) => return Ok(None),
+                Err(ff::Error::Other { errno }) if errno == ff::util::error::EAGAIN => {}
+                Err(e) => return Err(self.decode_error(for_index, e)),
+            }
+            if self.eof_sent {
+                return Ok(None);
+            }
+            // Feed the next packet of our stream, or end of stream.
+            let mut fed = false;
+            while let Some((s, packet)) = self.input.packets().next() {
+                if s.index() != self.stream_index {
+                    continue;
+                }
+                // A damaged packet is skipped; the decoder conceals or drops its frame.
+                let _ = self.decoder.send_packet(&packet);
+                fed = true;
+                break;
+            }
+            if !fed {
+                self.decoder
+                    .send_eof()
+                    .map_err(|e| self.decode_error(for_index, e))?;
+                self.eof_sent = true;
+            }
+        }
+    }
+
+    /// Index of a decoded frame from its timestamp (nearest listed timestamp).
+    fn index_of(&self, frame: &ff::frame::Video) -> Option<usize> {
+        let ts = frame.timestamp().or(frame.pts())?;
+        match self.pts.binary_search(&ts) {
+            Ok(i) => Some(i),
+            Err(i) => {
+                // Not listed (should not happen): take the nearest neighbour.
+                let before = i.checked_sub(1);
+                let after = (i < self.pts.len()).then_some(i);
+                match (before, after) {
+                    (Some(b), Some(a)) => Some(if ts - self.pts[b] <= self.pts[a] - ts {
+                        b
+                    } else {
+                        a
+                    }),
+                    (Some(b), None) => Some(b),
+                    (None, a) => a,
+                }
+            }
+        }
+    }
+
+    /// Decodes forward until frame `index` comes out. Returns `None` if it was passed or the
+    /// stream ended first.
+    fn decode_forward_to(&mut self, index: usize) -> Result<Option<ff::frame::Video>, VideoError> {
+        while let Some(frame) = self.next_decoded(index)? {
+            let Some(i) = self.index_of(&frame) else {
+                continue;
+            };
+            self.last_decoded = Some(i);
+            if i == index {
+                return Ok(Some(frame));
+            }
+            if i > index {
+                return Ok(None);
+            }
+        }
+        Ok(None)
+    }
+
+    fn to_rgb(&mut self, frame: &ff::frame::Video, index: usize) -> Result<RgbImage, VideoError> {
+        let (fmt, w, h) = (frame.format(), frame.width(), frame.height());
+        let rebuild =
+            !matches!(&self.scaler, Some((_, f, sw, sh)) if *f == fmt && *sw == w && *sh == h);
+        if rebuild {
+            let ctx = ff::software::scaling::Context::get(
+                fmt,
+                w,
+                h,
+                ff::format::Pixel::RGB24,
+                w,
+                h,
+                ff::software::scaling::Flags::BILINEAR,
+            )
+            .map_err(|e| self.decode_error(index, e))?;
+            self.scaler = Some((ctx, fmt, w, h));
+        }
+        let mut rgb = ff::frame::Video::empty();
+        if let Some((ctx, ..)) = self.scaler.as_mut() {
+            ctx.run(frame, &mut rgb).map_err(|e| VideoError::Decode {
+                path: self.info.path.clone(),
+                index,
+                reason: e.to_string(),
+            })?;
+        }
+        // Rows carry padding: copy them one by one.
+        let stride = rgb.stride(0);
+        let data = rgb.data(0);
+        let row_bytes = w as usize * 3;
+        let mut out = Vec::with_capacity(row_bytes * h as usize);
+        for y in 0..h as usize {
+            let start = y * stride;
+            let row = data.get(start..start + row_bytes).ok_or_else(|| {
+                self.decode_error(index, "converted frame is smaller than expected")
+            })?;
+            out.extend_from_slice(row);
+        }
+        let image = RgbImage::from_raw(w, h, out)
+            .ok_or_else(|| self.decode_error(index, "converted frame has the wrong size"))?;
+        Ok(rotate_clockwise(image, self.info.rotation_deg))
+    }
+}
+
+/// Frame rate reported when the file gives none and has a single frame.
+const DEFAULT_FPS_WHEN_UNKNOWN: f64 = 30.0;
+
+/// Whether frame intervals differ by more than 10% of the median interval.
+fn is_variable(pts: &[i64]) -> bool {
+    if pts.len() < 3 {
+        return false;
+    }
+    let mut d: Vec<i64> = pts.windows(2).map(|w| w[1] - w[0]).collect();
+    d.sort_unstable();
+    let median = d[d.len() / 2] as f64;
+    let (lo, hi) = (d[0] as f64, d[d.len() - 1] as f64);
+    median > 0.0 && (hi - lo) > 0.1 * median
+}
+
+// SAFETY: every FFmpeg object in `FfmpegSource` (demuxer, decoder, scaler) is owned by it alone
+// and only touched through `&mut self`; FFmpeg contexts may move between threads as long as they
+// are not used from two at once, which `&mut` rules out.
+unsafe impl Send for FfmpegSource {}
+
+impl VideoSource for FfmpegSource {
+    fn info(&self) -> &VideoInfo {
+        &self.info
+    }
+
+    fn time_of(&self, index: usize) -> f64 {
+        match (self.pts.get(index), self.pts.first()) {
+            (Some(p), Some(p0)) => (p - p0) as f64 * self.time_base,
+            _ => index as f64 / self.info.fps,
+        }
+    }
+
+    fn decode(&mut self, index: usize) -> Result<RgbImage, VideoError> {
+        if index >= self.pts.len() {
+            return Err(VideoError::FrameOutOfRange {
+                path: self.path(),
+                index,
+                count: self.pts.len(),
+            });
+        }
+        // Decode on from the current position when the target is a little ahead.
+        let ahead = self
+            .last_decoded
+            .is_some_and(|last| index > last && index - last <= DECODE_ON_LIMIT);
+        if ahead && let Some(frame) = self.decode_forward_to(index)? {
+            return self.to_rgb(&frame, index);
+        }
+        // Seek to the keyframe before; if that lands too late (inexact index), step back.
+        let mut k = self.seek_to_keyframe_before(index)?;
+        loop {
+            if let Some(frame) = self.decode_forward_to(index)? {
+                return self.to_rgb(&frame, index);
+            }
+            if k == 0 {
+                return Err(self.decode_error(
+                    index,
+                    "the frame could not be decoded (damaged or truncated file?)",
+                ));
+            }
+            k -= 1;
+            self.seek_to_keyframe(k)?;
+        }
+    }
+}
