@@ -225,7 +225,7 @@ impl Body {
         ]);
         let joint_radius = PerJoint::from_fn(|j| {
             s * match j {
-                HeadTop => 0.0,
+                HeadTop => radius::HEAD.2,
                 Neck => radius::SPINE_CHEST * 0.8,
                 Chest => radius::SPINE_CHEST,
                 Pelvis => radius::SPINE_PELVIS,

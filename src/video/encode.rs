@@ -57,7 +57,7 @@ impl Mp4Writer {
         height: u32,
         params: &EncodeParams,
     ) -> Result<Mp4Writer, VideoError> {
-        let _ = ff::init();
+        super::ffmpeg::init();
         if width % 2 != 0 || height % 2 != 0 || width == 0 || height == 0 || params.fps == 0 {
             return Err(encode_error(
                 path,
@@ -169,6 +169,7 @@ impl Mp4Writer {
         let mut packet = ff::Packet::empty();
         while self.encoder.receive_packet(&mut packet).is_ok() {
             packet.set_stream(0);
+            packet.set_duration(1);
             packet.rescale_ts(self.encoder_time_base, stream_tb);
             packet
                 .write_interleaved(&mut self.output)

@@ -15,7 +15,8 @@ use std::sync::Once;
 
 static INIT: Once = Once::new();
 
-fn init() {
+/// Initialises FFmpeg once and silences its log (errors reach the user through our own types).
+pub(super) fn init() {
     INIT.call_once(|| {
         // Only fails if FFmpeg's global init fails, which it does not in versions ≥ 4.
         let _ = ff::init();
@@ -145,18 +146,16 @@ impl FfmpegSource {
 
         let frame_count = pts.len();
         let span = (pts[frame_count - 1] - pts[0]) as f64 * time_base;
-        let avg_fps = if avg_rate.numerator() > 0 && avg_rate.denominator() > 0 {
-            f64::from(avg_rate.numerator()) / f64::from(avg_rate.denominator())
-        } else if span > 0.0 {
-            (frame_count - 1) as f64 / span
-        } else {
-            DEFAULT_FPS_WHEN_UNKNOWN
-        };
         let variable_frame_rate = is_variable(&pts);
-        let fps = if variable_frame_rate && span > 0.0 {
-            (frame_count - 1) as f64 / span
-        } else {
-            avg_fps
+        // Constant rate: the median frame interval (exact, whatever the container's average
+        // says); variable rate: frames over span; a single frame: the container's average.
+        let fps = match median_interval(&pts) {
+            Some(d) if !variable_frame_rate => 1.0 / (d as f64 * time_base),
+            _ if span > 0.0 => (frame_count - 1) as f64 / span,
+            _ if avg_rate.numerator() > 0 && avg_rate.denominator() > 0 => {
+                f64::from(avg_rate.numerator()) / f64::from(avg_rate.denominator())
+            }
+            _ => DEFAULT_FPS_WHEN_UNKNOWN,
         };
         let (width, height) = if rotation_deg % 180 == 90 {
             (coded_h, coded_w)
@@ -352,16 +351,20 @@ impl FfmpegSource {
 /// Frame rate reported when the file gives none and has a single frame.
 const DEFAULT_FPS_WHEN_UNKNOWN: f64 = 30.0;
 
-/// Whether frame intervals differ by more than 10% of the median interval.
-fn is_variable(pts: &[i64]) -> bool {
-    if pts.len() < 3 {
-        return false;
-    }
+/// Median interval between consecutive timestamps, if there are at least two.
+fn median_interval(pts: &[i64]) -> Option<i64> {
     let mut d: Vec<i64> = pts.windows(2).map(|w| w[1] - w[0]).collect();
     d.sort_unstable();
-    let median = d[d.len() / 2] as f64;
-    let (lo, hi) = (d[0] as f64, d[d.len() - 1] as f64);
-    median > 0.0 && (hi - lo) > 0.1 * median
+    d.get(d.len() / 2).copied().filter(|&m| m > 0)
+}
+
+/// Whether frame intervals differ from the median by more than 10% of it (variable frame rate).
+fn is_variable(pts: &[i64]) -> bool {
+    let Some(median) = median_interval(pts) else {
+        return false;
+    };
+    pts.windows(2)
+        .any(|w| ((w[1] - w[0]) - median).abs() as f64 > 0.1 * median as f64)
 }
 
 // SAFETY: every FFmpeg object in `FfmpegSource` (demuxer, decoder, scaler) is owned by it alone

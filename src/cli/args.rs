@@ -1,0 +1,213 @@
+//! Command-line arguments (clap). `main.rs` parses them and hands over to `cli` or `gui`.
+
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+
+const EXAMPLES: &str = "\
+Examples:
+  videomocap                                   open the desktop app
+  videomocap gui sample_videos/pose2sim_balancing_cam01/video.mp4
+  videomocap info clip.mp4 --json
+  videomocap run clip.mp4 --marks marks.json --out-dir out/ --height-m 1.75
+  videomocap track clip.mp4 --marks marks.json -o tracks2d.json
+  videomocap lift tracks2d.json -o skeleton3d.json --fov-deg 60 --bvh motion.bvh
+  videomocap synth --motion walk --view side --frames 150 -o synth_walk/
+  videomocap synth --motion tests/data/cmu_02_01_walk.bvh --view oblique -o walk/
+  videomocap bench
+
+Exit codes: 0 success, 1 processing failed, 2 bad usage or bad input.";
+
+/// Single-camera video motion capture: mark 16 joints, track them, lift to 3D, export BVH.
+#[derive(Debug, Parser)]
+#[command(name = "videomocap", version, about, after_help = EXAMPLES)]
+pub struct Cli {
+    /// What to do; without a command the desktop app opens.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+    #[command(flatten)]
+    pub global: GlobalArgs,
+}
+
+/// Options every command takes.
+#[derive(Debug, Clone, Args)]
+pub struct GlobalArgs {
+    /// No progress bars or messages on stderr.
+    #[arg(long, short, global = true)]
+    pub quiet: bool,
+    /// Print a JSON summary on stdout (for scripts).
+    #[arg(long, global = true)]
+    pub json: bool,
+}
+
+/// The commands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Open the desktop app, optionally on a video or image folder.
+    Gui {
+        /// Video file or directory of images.
+        video: Option<PathBuf>,
+    },
+    /// Print a video's size, frame rate, frame count, duration and rotation.
+    Info {
+        /// Video file or directory of images.
+        video: PathBuf,
+    },
+    /// Track the 16 joints from the marks of one frame through the video.
+    Track(TrackArgs),
+    /// Reconstruct the 3D skeleton from 2D tracks.
+    Lift(LiftArgs),
+    /// Export a 3D skeleton to BVH and CSV.
+    Export(ExportArgs),
+    /// Every step: track, lift and export into one directory.
+    Run(RunArgs),
+    /// Second pipeline: point volumes to kinematic motion.
+    Volume(VolumeArgs),
+    /// Render a synthetic clip with ground truth.
+    Synth(SynthArgs),
+    /// Measure decoding and rendering speed and print a table.
+    Bench(BenchArgs),
+}
+
+/// `track`.
+#[derive(Debug, Args)]
+pub struct TrackArgs {
+    /// Video file or directory of images.
+    pub video: PathBuf,
+    /// The 16 joints marked on one frame (marks.json).
+    #[arg(long)]
+    pub marks: PathBuf,
+    /// Where to write tracks2d.json.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+}
+
+/// Camera and subject options shared by `lift` and `run`.
+#[derive(Debug, Clone, Args)]
+pub struct LiftOptions {
+    /// Focal length in pixels.
+    #[arg(long, conflicts_with = "fov_deg")]
+    pub focal_px: Option<f64>,
+    /// Horizontal field of view in degrees (instead of --focal-px).
+    #[arg(long)]
+    pub fov_deg: Option<f64>,
+    /// The subject's height in metres (scales the bone lengths).
+    #[arg(long)]
+    pub height_m: Option<f64>,
+}
+
+/// `lift`.
+#[derive(Debug, Args)]
+pub struct LiftArgs {
+    /// tracks2d.json from `track`.
+    pub tracks: PathBuf,
+    /// Where to write skeleton3d.json.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub options: LiftOptions,
+    /// Also write a BVH here.
+    #[arg(long)]
+    pub bvh: Option<PathBuf>,
+}
+
+/// `export`.
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    /// skeleton3d.json from `lift`.
+    pub skeleton: PathBuf,
+    /// Where to write the BVH.
+    #[arg(long)]
+    pub bvh: PathBuf,
+    /// Also write a CSV of 3D joint positions here.
+    #[arg(long)]
+    pub csv: Option<PathBuf>,
+}
+
+/// `run`.
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// Video file or directory of images.
+    pub video: PathBuf,
+    /// The 16 joints marked on one frame (marks.json).
+    #[arg(long)]
+    pub marks: PathBuf,
+    /// Directory for tracks2d.json, skeleton3d.json and motion.bvh.
+    #[arg(long)]
+    pub out_dir: PathBuf,
+    #[command(flatten)]
+    pub options: LiftOptions,
+}
+
+/// `volume`.
+#[derive(Debug, Args)]
+pub struct VolumeArgs {
+    /// Directory of per-frame point clouds (PLY, XYZ) or voxel grids.
+    pub input: PathBuf,
+    /// Output directory.
+    #[arg(long)]
+    pub out_dir: PathBuf,
+}
+
+/// `synth`.
+#[derive(Debug, Args)]
+pub struct SynthArgs {
+    /// Motion: walk, wave, jumping-jacks, or a BVH file.
+    #[arg(long, default_value = "walk")]
+    pub motion: String,
+    /// Start time in the BVH, seconds.
+    #[arg(long, default_value_t = 0.0)]
+    pub start_s: f64,
+    /// Number of frames.
+    #[arg(long, default_value_t = 100)]
+    pub frames: usize,
+    /// Frames per second.
+    #[arg(long, default_value_t = 30)]
+    pub fps: u32,
+    /// Image width, pixels.
+    #[arg(long, default_value_t = 640)]
+    pub width: u32,
+    /// Image height, pixels.
+    #[arg(long, default_value_t = 480)]
+    pub height: u32,
+    /// Camera view: frontal, oblique, side, raised.
+    #[arg(long, default_value = "oblique")]
+    pub view: String,
+    /// Focal length, pixels.
+    #[arg(long, conflicts_with = "fov_deg")]
+    pub focal_px: Option<f64>,
+    /// Horizontal field of view, degrees (default 56°).
+    #[arg(long)]
+    pub fov_deg: Option<f64>,
+    /// Stature of the person in the image, pixels (default 0.65 × height).
+    #[arg(long)]
+    pub person_px: Option<f64>,
+    /// Sensor noise, standard deviation in 8-bit levels.
+    #[arg(long, default_value_t = 2.0)]
+    pub noise: f64,
+    /// Brightness flicker, relative amplitude.
+    #[arg(long, default_value_t = 0.02)]
+    pub flicker: f64,
+    /// Random seed (noise, background).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Write a PNG sequence instead of an MP4.
+    #[arg(long)]
+    pub png: bool,
+    /// Output directory.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+/// `bench`.
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    /// What to measure: all, decode, synth.
+    #[arg(default_value = "all")]
+    pub what: String,
+    /// Frames per measured clip.
+    #[arg(long, default_value_t = 300)]
+    pub frames: usize,
+}

@@ -1,0 +1,147 @@
+//! `videomocap bench`: speed figures printed as a table. Decoding is compared with the `ffmpeg`
+//! command decoding the same file to RGB in the same run (ratios, not absolute times, are what
+//! matter on a shared machine).
+
+use super::args::{BenchArgs, GlobalArgs};
+use super::{ExitError, say};
+use anyhow::{Context, anyhow};
+use std::path::Path;
+use std::process::Command;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+use videomocap::synth::{SynthParams, VideoOutput, render_clip};
+use videomocap::video::{OpenOptions, Video};
+
+pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+    if cfg!(debug_assertions) {
+        say(
+            global,
+            "note: this is a debug build; run `cargo run --release -- bench` for real figures",
+        );
+    }
+    let dir = tempfile::tempdir().map_err(ExitError::failed)?;
+    let mut rows: Vec<[String; 4]> = Vec::new();
+    if matches!(a.what.as_str(), "all" | "decode") {
+        for (w, h) in [(640, 480), (1920, 1080)] {
+            let file = dir.path().join(format!("bench_{w}x{h}.mp4"));
+            say(
+                global,
+                &format!("making a {w}×{h} H.264 clip of {} frames …", a.frames),
+            );
+            make_clip(&file, w, h, a.frames).map_err(ExitError::failed)?;
+            let ours = our_decode_fps(&file).map_err(ExitError::failed)?;
+            let theirs = ffmpeg_decode_fps(&file, a.frames).map_err(ExitError::failed)?;
+            rows.push([
+                format!("decode {w}×{h} to RGB"),
+                format!("{ours:.0} frames/s"),
+                format!("{theirs:.0} frames/s"),
+                format!("{:.2}", ours / theirs),
+            ]);
+        }
+    }
+    if matches!(a.what.as_str(), "all" | "synth") {
+        let params = SynthParams {
+            frames: 100,
+            output: VideoOutput::Mp4,
+            ..SynthParams::default()
+        };
+        let out = dir.path().join("synth");
+        let t0 = Instant::now();
+        let r = render_clip(&params, &out, &mut |_, _| {}, &AtomicBool::new(false))
+            .map_err(ExitError::failed)?;
+        let total = t0.elapsed().as_secs_f64();
+        rows.push([
+            "synth render 640×480 (per frame)".into(),
+            format!("{:.1} ms", r.render_s_per_frame * 1e3),
+            "-".into(),
+            "-".into(),
+        ]);
+        rows.push([
+            "synth 100 frames 640×480 incl. MP4".into(),
+            format!("{total:.2} s"),
+            "-".into(),
+            "-".into(),
+        ]);
+    }
+    if rows.is_empty() {
+        return Err(ExitError::bad_input(anyhow!(
+            "bench {}: expected all, decode or synth",
+            a.what
+        )));
+    }
+    if global.json {
+        let v: Vec<_> = rows
+            .iter()
+            .map(|r| serde_json::json!({"what": r[0], "ours": r[1], "ffmpeg": r[2], "ratio": r[3]}))
+            .collect();
+        println!("{}", serde_json::Value::Array(v));
+    } else {
+        println!(
+            "{:<38} {:>16} {:>16} {:>8}",
+            "measure", "videomocap", "ffmpeg", "ratio"
+        );
+        for r in &rows {
+            println!("{:<38} {:>16} {:>16} {:>8}", r[0], r[1], r[2], r[3]);
+        }
+    }
+    Ok(())
+}
+
+fn make_clip(path: &Path, w: u32, h: u32, frames: usize) -> anyhow::Result<()> {
+    let status = Command::new("ffmpeg")
+        .args([
+            "-hide_banner",
+            "-loglevel",
+            "error",
+            "-y",
+            "-f",
+            "lavfi",
+            "-i",
+        ])
+        .arg(format!("testsrc2=size={w}x{h}:rate=30"))
+        .args(["-vf", "noise=alls=12:allf=t", "-frames:v"])
+        .arg(frames.to_string())
+        .args([
+            "-c:v", "libx264", "-preset", "veryfast", "-pix_fmt", "yuv420p", "-g", "250", "-bf",
+            "2",
+        ])
+        .arg(path)
+        .status()
+        .context("bench needs the ffmpeg command (apt-get install ffmpeg)")?;
+    if !status.success() {
+        return Err(anyhow!("ffmpeg could not make {}", path.display()));
+    }
+    Ok(())
+}
+
+fn our_decode_fps(path: &Path) -> anyhow::Result<f64> {
+    let options = OpenOptions {
+        cache_bytes: 0,
+        ..OpenOptions::default()
+    };
+    let mut video = Video::open(path, &options)?;
+    let n = video.info().frame_count;
+    let t0 = Instant::now();
+    for i in 0..n {
+        video.frame(i)?;
+    }
+    Ok(n as f64 / t0.elapsed().as_secs_f64())
+}
+
+fn ffmpeg_decode_fps(path: &Path, frames: usize) -> anyhow::Result<f64> {
+    let out = Command::new("ffmpeg")
+        .args(["-hide_banner", "-nostats", "-benchmark", "-i"])
+        .arg(path)
+        .args(["-pix_fmt", "rgb24", "-f", "null", "-"])
+        .output()
+        .context("running ffmpeg -benchmark")?;
+    let text = String::from_utf8_lossy(&out.stderr);
+    let rtime = text
+        .split_whitespace()
+        .find_map(|w| {
+            w.strip_prefix("rtime=")
+                .and_then(|v| v.trim_end_matches('s').parse::<f64>().ok())
+        })
+        .ok_or_else(|| anyhow!("ffmpeg -benchmark printed no rtime: {text}"))?;
+    Ok(frames as f64 / rtime)
+}

@@ -1,0 +1,191 @@
+//! Bad input through the command line: each case exits with code 2 and a message naming the
+//! file and the problem, never a panic.
+
+use assert_cmd::Command;
+use std::path::{Path, PathBuf};
+
+fn sample_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("sample_videos/pose2sim_balancing_cam01")
+}
+
+/// Runs the binary and returns (exit code, stderr).
+fn run(args: &[&str]) -> (i32, String) {
+    let out = Command::cargo_bin("videomocap")
+        .unwrap()
+        .args(args)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!stderr.contains("panicked"), "panic: {stderr}");
+    (out.status.code().unwrap_or(-1), stderr)
+}
+
+fn assert_bad(args: &[&str], must_contain: &[&str]) {
+    let (code, stderr) = run(args);
+    assert_eq!(code, 2, "{args:?}: {stderr}");
+    for s in must_contain {
+        assert!(stderr.contains(s), "{args:?}: expected {s:?} in {stderr:?}");
+    }
+}
+
+#[test]
+fn a_missing_path_is_named() {
+    assert_bad(
+        &["info", "no/such/video.mp4"],
+        &["no/such/video.mp4", "No such file"],
+    );
+}
+
+#[test]
+fn a_file_that_is_not_a_video_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("notes.mp4");
+    std::fs::write(&p, "this is not a video\n".repeat(100)).unwrap();
+    let ps = p.to_str().unwrap();
+    assert_bad(&["info", ps], &[ps, "not a video"]);
+}
+
+#[test]
+fn a_truncated_video_is_named_or_opens_shorter() {
+    let dir = tempfile::tempdir().unwrap();
+    let bytes = std::fs::read(sample_dir().join("video.mp4")).unwrap();
+    let p = dir.path().join("half.mp4");
+    std::fs::write(&p, &bytes[..bytes.len() / 2]).unwrap();
+    let ps = p.to_str().unwrap();
+    // The sample keeps its index at the end: half a file has none.
+    assert_bad(&["info", ps], &[ps]);
+}
+
+#[test]
+fn a_zero_frame_video_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("empty.mp4");
+    let ok = std::process::Command::new("ffmpeg")
+        .args([
+            "-loglevel",
+            "error",
+            "-y",
+            "-f",
+            "lavfi",
+            "-i",
+            "testsrc2=size=64x48:rate=10",
+            "-frames:v",
+            "0",
+            "-c:v",
+            "libx264",
+        ])
+        .arg(&p)
+        .status()
+        .expect("the ffmpeg command is needed for this test (scripts/setup.sh installs it)");
+    assert!(ok.success());
+    let ps = p.to_str().unwrap();
+    assert_bad(&["info", ps], &[ps]);
+}
+
+#[test]
+fn image_directories_with_no_images_or_mixed_sizes_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let ds = dir.path().to_str().unwrap().to_owned();
+    assert_bad(&["info", &ds], &[&ds, "no PNG or JPEG"]);
+    image::RgbImage::new(8, 6)
+        .save(dir.path().join("a1.png"))
+        .unwrap();
+    image::RgbImage::new(8, 7)
+        .save(dir.path().join("a2.png"))
+        .unwrap();
+    assert_bad(&["info", &ds], &["a1.png", "a2.png", "8×7"]);
+}
+
+fn marks_case(
+    name: &str,
+    edit: impl FnOnce(&mut serde_json::Value),
+) -> (tempfile::TempDir, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(sample_dir().join("marks.json")).unwrap())
+            .unwrap();
+    edit(&mut v);
+    let p = dir.path().join(name);
+    std::fs::write(&p, v.to_string()).unwrap();
+    let s = p.to_str().unwrap().to_owned();
+    (dir, s)
+}
+
+#[test]
+fn bad_marks_are_named_with_the_joint() {
+    let video = sample_dir().join("video.mp4");
+    let video = video.to_str().unwrap();
+    let (_d, missing) = marks_case("missing.json", |v| {
+        v["joints"].as_object_mut().unwrap().remove("left_knee");
+    });
+    assert_bad(
+        &["track", video, "--marks", &missing, "-o", "t.json"],
+        &[&missing, "left_knee", "missing"],
+    );
+    let (_d, outside) = marks_case("outside.json", |v| {
+        v["joints"]["right_wrist"] = serde_json::json!([2000.0, 10.0])
+    });
+    assert_bad(
+        &["track", video, "--marks", &outside, "-o", "t.json"],
+        &[&outside, "right_wrist", "outside"],
+    );
+    let (_d, version) = marks_case("v9.json", |v| v["version"] = serde_json::json!(9));
+    assert_bad(
+        &["track", video, "--marks", &version, "-o", "t.json"],
+        &[&version, "version 9"],
+    );
+    let (_d, unknown) = marks_case("unknown.json", |v| {
+        v["joints"]["nose"] = serde_json::json!([1.0, 1.0])
+    });
+    assert_bad(
+        &["track", video, "--marks", &unknown, "-o", "t.json"],
+        &[&unknown, "nose"],
+    );
+}
+
+#[test]
+fn malformed_json_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("broken.json");
+    std::fs::write(&p, "{\"format\": \"videomocap.tracks2d\", ").unwrap();
+    let ps = p.to_str().unwrap();
+    assert_bad(&["lift", ps, "-o", "s.json"], &[ps, "JSON"]);
+    assert_bad(&["export", ps, "--bvh", "m.bvh"], &[ps]);
+}
+
+#[test]
+fn valid_inputs_to_a_step_not_built_yet_say_so_with_code_2() {
+    let video = sample_dir().join("video.mp4");
+    let marks = sample_dir().join("marks.json");
+    let (code, stderr) = run(&[
+        "track",
+        video.to_str().unwrap(),
+        "--marks",
+        marks.to_str().unwrap(),
+        "-o",
+        "t.json",
+    ]);
+    assert_eq!(code, 2);
+    assert!(stderr.contains("not built yet"), "{stderr}");
+}
+
+#[test]
+fn info_prints_the_samples_portrait_size_and_json() {
+    let video = sample_dir().join("video.mp4");
+    let out = Command::cargo_bin("videomocap")
+        .unwrap()
+        .args(["info", video.to_str().unwrap(), "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        (
+            v["width"].as_u64(),
+            v["height"].as_u64(),
+            v["frame_count"].as_u64()
+        ),
+        (Some(1080), Some(1920), Some(100))
+    );
+    assert_eq!(v["fps"].as_f64(), Some(60.0));
+}
