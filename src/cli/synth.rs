@@ -49,7 +49,7 @@ pub fn params_from_args(a: &SynthArgs) -> Result<SynthParams, ExitError> {
             "focal length must be positive, got {focal_px}"
         )));
     }
-    if !a.png && (a.width % 2 != 0 || a.height % 2 != 0) {
+    if !a.png && (!a.width.is_multiple_of(2) || !a.height.is_multiple_of(2)) {
         return Err(ExitError::bad_input(anyhow!(
             "MP4 needs even sides, got {}×{} (use --png for odd sizes)",
             a.width,

@@ -65,10 +65,11 @@ impl Skeleton3d {
         check_header(path, SKELETON3D_FORMAT, raw.format.as_deref(), raw.version)?;
         let columns = joint_columns(path, &raw.joints)?;
         let cam = raw.camera;
-        if !(cam.focal_px.is_finite() && cam.focal_px > 0.0)
-            || !cam.cx.is_finite()
-            || !cam.cy.is_finite()
-        {
+        let camera_ok = cam.focal_px.is_finite()
+            && cam.focal_px > 0.0
+            && cam.cx.is_finite()
+            && cam.cy.is_finite();
+        if !camera_ok {
             return Err(FormatError::Invalid {
                 path: path.to_owned(),
                 problem: format!(

@@ -58,7 +58,12 @@ impl Mp4Writer {
         params: &EncodeParams,
     ) -> Result<Mp4Writer, VideoError> {
         super::ffmpeg::init();
-        if width % 2 != 0 || height % 2 != 0 || width == 0 || height == 0 || params.fps == 0 {
+        if !width.is_multiple_of(2)
+            || !height.is_multiple_of(2)
+            || width == 0
+            || height == 0
+            || params.fps == 0
+        {
             return Err(encode_error(
                 path,
                 format!(

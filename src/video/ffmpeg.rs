@@ -305,7 +305,11 @@ impl FfmpegSource {
         Ok(None)
     }
 
-    fn to_rgb(&mut self, frame: &ff::frame::Video, index: usize) -> Result<RgbImage, VideoError> {
+    fn convert_to_rgb(
+        &mut self,
+        frame: &ff::frame::Video,
+        index: usize,
+    ) -> Result<RgbImage, VideoError> {
         let (fmt, w, h) = (frame.format(), frame.width(), frame.height());
         let rebuild =
             !matches!(&self.scaler, Some((_, f, sw, sh)) if *f == fmt && *sw == w && *sh == h);
@@ -397,13 +401,13 @@ impl VideoSource for FfmpegSource {
             .last_decoded
             .is_some_and(|last| index > last && index - last <= DECODE_ON_LIMIT);
         if ahead && let Some(frame) = self.decode_forward_to(index)? {
-            return self.to_rgb(&frame, index);
+            return self.convert_to_rgb(&frame, index);
         }
         // Seek to the keyframe before; if that lands too late (inexact index), step back.
         let mut k = self.seek_to_keyframe_before(index)?;
         loop {
             if let Some(frame) = self.decode_forward_to(index)? {
-                return self.to_rgb(&frame, index);
+                return self.convert_to_rgb(&frame, index);
             }
             if k == 0 {
                 return Err(self.decode_error(
