@@ -92,6 +92,22 @@ fn joint_columns(path: &Path, names: &[String]) -> Result<[usize; JOINT_COUNT], 
     Ok(columns)
 }
 
+/// Checks that frame indexes strictly increase; `previous` carries the last index seen.
+fn check_frame_order(
+    path: &Path,
+    previous: &mut Option<usize>,
+    index: usize,
+) -> Result<(), FormatError> {
+    if previous.is_some_and(|p| index <= p) {
+        return Err(FormatError::Invalid {
+            path: path.to_owned(),
+            problem: format!("frame {index} is out of order or repeated"),
+        });
+    }
+    *previous = Some(index);
+    Ok(())
+}
+
 /// The 16 joint names in file order, as written in the `joints` field.
 fn joint_names() -> Vec<String> {
     Joint::ALL.iter().map(|j| j.name().to_owned()).collect()

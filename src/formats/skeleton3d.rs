@@ -2,8 +2,8 @@
 //! (metres, X right, Y down, Z forward), with the camera and the bone lengths used.
 
 use super::{
-    FORMAT_VERSION, FormatError, check_header, joint_columns, joint_names, parse_json, read_text,
-    save_json,
+    FORMAT_VERSION, FormatError, check_frame_order, check_header, joint_columns, joint_names,
+    parse_json, read_text, save_json,
 };
 use crate::camera::PinholeCamera;
 use crate::skeleton::{Bone, Joint, PerJoint};
@@ -104,13 +104,7 @@ impl Skeleton3d {
                     expected: raw.joints.len(),
                 });
             }
-            if previous.is_some_and(|p| f.index <= p) {
-                return Err(FormatError::Invalid {
-                    path: path.to_owned(),
-                    problem: format!("frame {} is out of order or repeated", f.index),
-                });
-            }
-            previous = Some(f.index);
+            check_frame_order(path, &mut previous, f.index)?;
             for joint in Joint::ALL {
                 if !f.points[columns[joint.index()]]
                     .iter()

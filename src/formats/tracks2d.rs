@@ -2,8 +2,8 @@
 //! reliability and whether it was interpolated.
 
 use super::{
-    FORMAT_VERSION, FormatError, check_header, joint_columns, joint_names, parse_json, read_text,
-    save_json,
+    FORMAT_VERSION, FormatError, check_frame_order, check_header, joint_columns, joint_names,
+    parse_json, read_text, save_json,
 };
 use crate::camera::point_in_frame;
 use crate::skeleton::{Joint, PerJoint};
@@ -126,13 +126,7 @@ impl Tracks2d {
                     });
                 }
             }
-            if previous.is_some_and(|p| f.index <= p) {
-                return Err(FormatError::Invalid {
-                    path: path.to_owned(),
-                    problem: format!("frame {} is out of order or repeated", f.index),
-                });
-            }
-            previous = Some(f.index);
+            check_frame_order(path, &mut previous, f.index)?;
             let mut points = Vec::with_capacity(n);
             for joint in Joint::ALL {
                 let col = columns[joint.index()];
