@@ -8,6 +8,7 @@
 
 pub mod bvh;
 pub mod camera;
+pub mod eval;
 pub mod formats;
 pub mod skeleton;
 pub mod synth;

@@ -155,15 +155,12 @@ fn malformed_json_is_named() {
 
 #[test]
 fn valid_inputs_to_a_step_not_built_yet_say_so_with_code_2() {
-    let video = sample_dir().join("video.mp4");
-    let marks = sample_dir().join("marks.json");
+    let dir = tempfile::tempdir().unwrap();
     let (code, stderr) = run(&[
-        "track",
-        video.to_str().unwrap(),
-        "--marks",
-        marks.to_str().unwrap(),
-        "-o",
-        "t.json",
+        "volume",
+        dir.path().to_str().unwrap(),
+        "--out-dir",
+        dir.path().join("out").to_str().unwrap(),
     ]);
     assert_eq!(code, 2);
     assert!(stderr.contains("not built yet"), "{stderr}");

@@ -79,9 +79,15 @@ pub struct TrackArgs {
     /// Where to write tracks2d.json.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Worker threads (default: all cores).
+    /// Worker threads (default: all cores; 1 = decode and track on one thread).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// A ground-truth gt.json to score the tracks against (prints PCK and mean error).
+    #[arg(long)]
+    pub reference: Option<PathBuf>,
+    /// Tracker settings as JSON (keys of the GUI's tracker panel; missing keys keep defaults).
+    #[arg(long)]
+    pub tracker_settings: Option<PathBuf>,
 }
 
 /// Camera and subject options shared by `lift` and `run`.
@@ -154,7 +160,7 @@ pub struct VolumeArgs {
 /// `synth`.
 #[derive(Debug, Args)]
 pub struct SynthArgs {
-    /// Motion: walk, wave, jumping-jacks, or a BVH file.
+    /// Motion: walk, wave, jumping-jacks, sit-down, bend, or a BVH file.
     #[arg(long, default_value = "walk")]
     pub motion: String,
     /// Start time in the BVH, seconds.
@@ -196,6 +202,10 @@ pub struct SynthArgs {
     /// Write a PNG sequence instead of an MP4.
     #[arg(long)]
     pub png: bool,
+    /// A photograph to use as background (scaled to fill the frame), e.g.
+    /// assets/backgrounds/pose2sim_room.jpg; default a procedural room.
+    #[arg(long)]
+    pub background: Option<PathBuf>,
     /// Output directory.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -204,10 +214,17 @@ pub struct SynthArgs {
 /// `bench`.
 #[derive(Debug, Args)]
 pub struct BenchArgs {
-    /// What to measure: all, decode, synth.
+    /// What to measure: all (decode and synth), decode, synth, or track (tracking accuracy on
+    /// the synthetic suite and the real sample, and tracking speed; takes a few minutes).
     #[arg(default_value = "all")]
     pub what: String,
-    /// Frames per measured clip.
+    /// Frames per measured clip (decode).
     #[arg(long, default_value_t = 300)]
     pub frames: usize,
+    /// Where the synthetic tracking suite is rendered (once) and kept.
+    #[arg(long, default_value = "out/bench-suite")]
+    pub suite_dir: PathBuf,
+    /// Tracker settings as JSON for `bench track`.
+    #[arg(long)]
+    pub tracker_settings: Option<PathBuf>,
 }

@@ -19,6 +19,9 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             "note: this is a debug build; run `cargo run --release -- bench` for real figures",
         );
     }
+    if a.what == "track" {
+        return super::bench_track::run(a, global);
+    }
     let dir = tempfile::tempdir().map_err(ExitError::failed)?;
     let mut rows: Vec<[String; 4]> = Vec::new();
     if matches!(a.what.as_str(), "all" | "decode") {
@@ -65,7 +68,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     }
     if rows.is_empty() {
         return Err(ExitError::bad_input(anyhow!(
-            "bench {}: expected all, decode or synth",
+            "bench {}: expected all, decode, synth or track",
             a.what
         )));
     }

@@ -3,9 +3,11 @@
 
 pub mod args;
 mod bench;
+mod bench_track;
 mod info;
 mod pending;
 mod synth;
+mod track;
 
 use args::{Command, GlobalArgs};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -48,7 +50,7 @@ pub fn run(command: Command, global: &GlobalArgs) -> Result<(), ExitError> {
         Command::Info { video } => info::run(&video, global),
         Command::Synth(a) => synth::run(&a, global),
         Command::Bench(a) => bench::run(&a, global),
-        Command::Track(a) => pending::track(&a),
+        Command::Track(a) => track::run(&a, global),
         Command::Lift(a) => pending::lift(&a),
         Command::Export(a) => pending::export(&a),
         Command::Run(a) => pending::run_all(&a),

@@ -2,7 +2,7 @@
 //! learns about a bad file now) and then exits with code 2 and a sentence naming what is missing.
 
 use super::ExitError;
-use super::args::{ExportArgs, LiftArgs, LiftOptions, RunArgs, TrackArgs, VolumeArgs};
+use super::args::{ExportArgs, LiftArgs, LiftOptions, RunArgs, VolumeArgs};
 use anyhow::anyhow;
 use std::path::Path;
 use videomocap::formats::{Marks, Skeleton3d, Tracks2d};
@@ -54,11 +54,6 @@ fn check_lift_options(o: &LiftOptions) -> Result<(), ExitError> {
         )));
     }
     Ok(())
-}
-
-pub fn track(a: &TrackArgs) -> Result<(), ExitError> {
-    check_video_and_marks(&a.video, &a.marks)?;
-    Err(not_built("2D tracking (track)"))
 }
 
 pub fn lift(a: &LiftArgs) -> Result<(), ExitError> {

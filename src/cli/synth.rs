@@ -23,7 +23,7 @@ pub fn params_from_args(a: &SynthArgs) -> Result<SynthParams, ExitError> {
             let path = PathBuf::from(&a.motion);
             if !path.is_file() {
                 return Err(ExitError::bad_input(anyhow!(
-                    "--motion {}: neither walk, wave, jumping-jacks nor an existing BVH file",
+                    "--motion {}: neither walk, wave, jumping-jacks, sit-down, bend nor an existing BVH file",
                     a.motion
                 )));
             }
@@ -71,6 +71,7 @@ pub fn params_from_args(a: &SynthArgs) -> Result<SynthParams, ExitError> {
             seed: a.seed,
         },
         background_seed: a.seed.wrapping_add(6),
+        background_image: a.background.clone(),
         output: if a.png {
             VideoOutput::PngSequence
         } else {

@@ -186,6 +186,12 @@ impl<T> PerJoint<T> {
     }
 }
 
+impl<T: Default> Default for PerJoint<T> {
+    fn default() -> Self {
+        PerJoint::from_fn(|_| T::default())
+    }
+}
+
 impl<T> Index<Joint> for PerJoint<T> {
     type Output = T;
     fn index(&self, joint: Joint) -> &T {

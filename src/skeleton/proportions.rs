@@ -156,6 +156,17 @@ impl Proportions {
         })
     }
 
+    /// Length of the bone joining two joints (in either order) as a fraction of stature; 0 when
+    /// no bone joins them.
+    pub fn fraction_between(&self, a: Joint, b: Joint) -> f64 {
+        Bone::ALL
+            .iter()
+            .position(|bone| {
+                (bone.parent == a && bone.child == b) || (bone.parent == b && bone.child == a)
+            })
+            .map_or(0.0, |i| self.bone_fraction[i])
+    }
+
     /// Breadth of a body part as a fraction of stature.
     pub fn breadth_fraction(&self, breadth: Breadth) -> f64 {
         let w = &self.breadths;

@@ -98,8 +98,11 @@ pub struct SynthParams {
     pub person_px: f64,
     /// Sensor noise and flicker.
     pub effects: SensorEffects,
-    /// Background texture seed.
+    /// Background texture seed (procedural background).
     pub background_seed: u64,
+    /// A photograph to use as background instead (scaled to the frame), e.g.
+    /// `assets/backgrounds/*.jpg`.
+    pub background_image: Option<PathBuf>,
     /// Output kind.
     pub output: VideoOutput,
 }
@@ -122,6 +125,7 @@ impl Default for SynthParams {
                 seed: 1,
             },
             background_seed: 7,
+            background_image: None,
             output: VideoOutput::Mp4,
         }
     }
@@ -141,6 +145,8 @@ pub enum SynthError {
         path: PathBuf,
         source: std::io::Error,
     },
+    #[error("{path}: cannot use as background: {message}")]
+    Background { path: PathBuf, message: String },
     #[error("bad parameters: {0}")]
     Params(String),
     #[error("cancelled")]
@@ -253,7 +259,20 @@ pub fn render_clip(
     let camera = PinholeCamera::centred(params.focal_px, params.width, params.height);
     let (camera_from_world, centre) = place_camera(&motion, params, &camera);
     let stature = stature_of(&motion);
-    let bg = background(params.width, params.height, params.background_seed);
+    let bg = match &params.background_image {
+        Some(path) => image::open(path)
+            .map_err(|e| SynthError::Background {
+                path: path.clone(),
+                message: e.to_string(),
+            })?
+            .resize_to_fill(
+                params.width,
+                params.height,
+                image::imageops::FilterType::Triangle,
+            )
+            .to_rgb8(),
+        None => background(params.width, params.height, params.background_seed),
+    };
 
     let video_path = match params.output {
         VideoOutput::Mp4 => out_dir.join("video.mp4"),

@@ -28,15 +28,21 @@ pub enum ProceduralMotion {
     Wave,
     /// Jumping jacks at one per second.
     JumpingJacks,
+    /// Sitting down on an (unseen) chair and standing up again, one cycle per 4 s.
+    SitDown,
+    /// Bending forward from the hips to touch the shins and back, one cycle per 3 s.
+    Bend,
 }
 
 impl ProceduralMotion {
-    /// Parses `walk`, `wave` or `jumping-jacks`.
+    /// Parses `walk`, `wave`, `jumping-jacks`, `sit-down` or `bend`.
     pub fn from_name(name: &str) -> Option<Self> {
         match name {
             "walk" => Some(Self::Walk),
             "wave" => Some(Self::Wave),
             "jumping-jacks" | "jumping_jacks" => Some(Self::JumpingJacks),
+            "sit-down" | "sit_down" | "sit" => Some(Self::SitDown),
+            "bend" => Some(Self::Bend),
             _ => None,
         }
     }
@@ -47,6 +53,8 @@ impl ProceduralMotion {
             Self::Walk => "walk",
             Self::Wave => "wave",
             Self::JumpingJacks => "jumping-jacks",
+            Self::SitDown => "sit-down",
+            Self::Bend => "bend",
         }
     }
 }
@@ -142,6 +150,40 @@ fn reflect_bend(upper: Vector3<f64>, lower: Vector3<f64>) -> Vector3<f64> {
     (along + across).normalize()
 }
 
+/// Turns everything above the pelvis forward about the pelvis by `pitch` radians (bending at the
+/// hips: the head moves towards +Z).
+fn pitch_upper_body(mut p: PerJoint<Point3<f64>>, pitch: f64) -> PerJoint<Point3<f64>> {
+    use Joint::*;
+    let r = Rotation3::from_axis_angle(&Vector3::x_axis(), pitch);
+    let pelvis = p[Pelvis];
+    for j in [
+        Chest,
+        Neck,
+        HeadTop,
+        LeftShoulder,
+        LeftElbow,
+        LeftWrist,
+        RightShoulder,
+        RightElbow,
+        RightWrist,
+    ] {
+        p[j] = pelvis + r * (p[j] - pelvis);
+    }
+    p
+}
+
+/// Moves a pose so its lower ankle is `ankle_height` above the floor (y = 0) and the ankles'
+/// mean is at x = z = 0 (the feet stay put while the body moves above them).
+fn on_ground(p: PerJoint<Point3<f64>>, ankle_height: f64) -> PerJoint<Point3<f64>> {
+    let (l, r) = (p[Joint::LeftAnkle], p[Joint::RightAnkle]);
+    let shift = Vector3::new(
+        -(l.x + r.x) / 2.0,
+        ankle_height - l.y.min(r.y),
+        -(l.z + r.z) / 2.0,
+    );
+    p.map(|_, q| q + shift)
+}
+
 /// Builds a procedural motion of `frames` frames at `fps`.
 pub fn procedural(
     kind: ProceduralMotion,
@@ -205,6 +247,38 @@ pub fn procedural(
                     }; 2];
                     let pelvis = Point3::new(0.03 * (0.5 * w).sin(), stand - 0.01, 0.0);
                     pose(subject, pelvis, arms, legs)
+                }
+                ProceduralMotion::SitDown => {
+                    // 0 standing … 1 seated, smooth, one cycle per 4 s
+                    let s = 0.5 - 0.5 * (w / 4.0).cos();
+                    let legs = [LimbAngles {
+                        abduction: 0.08,
+                        flexion: 1.45 * s,
+                        bend: 1.5 * s,
+                    }; 2];
+                    let arms = [LimbAngles {
+                        abduction: 0.15,
+                        flexion: 0.6 * s,
+                        bend: 0.4 + 0.6 * s,
+                    }; 2];
+                    let p = pose(subject, Point3::origin(), arms, legs);
+                    let p = pitch_upper_body(p, 0.35 * (PI * s).sin() + 0.1 * s);
+                    on_ground(p, ankle_height)
+                }
+                ProceduralMotion::Bend => {
+                    let pitch = 1.25 * (0.5 - 0.5 * (w / 3.0).cos());
+                    let legs = [LimbAngles {
+                        abduction: 0.06,
+                        flexion: -0.1 * pitch,
+                        bend: 0.15 * pitch,
+                    }; 2];
+                    let arms = [LimbAngles {
+                        abduction: 0.1,
+                        flexion: pitch,
+                        bend: 0.2,
+                    }; 2];
+                    let p = pose(subject, Point3::origin(), arms, legs);
+                    on_ground(pitch_upper_body(p, pitch), ankle_height)
                 }
                 ProceduralMotion::JumpingJacks => {
                     let phase = 0.5 - 0.5 * w.cos(); // 0 closed … 1 open

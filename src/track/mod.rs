@@ -1,5 +1,26 @@
 //! 2D tracking (VBA, Pan et al. "Feature tracking"): from the marks of one frame to the
-//! positions of all 16 joints in every frame. Not built yet: its issue (VBA 2D tracking)
-//! brings the block model, the morph-block similarity and the top-down tracker.
+//! positions of all 16 joints in every frame, with a reliability per joint and frame.
 //!
-//! Its input is [`crate::formats::Marks`], its output [`crate::formats::Tracks2d`].
+//! In: a [`crate::video::Video`] and [`crate::formats::Marks`] (plus any corrections as
+//! [`KeyFrames`]). Out: [`crate::formats::Tracks2d`] and a list of weak spans.
+//!
+//! - [`block`]: the morph-block `A = {(x, y), m, n, θ}` (Fig. 7)
+//! - [`similarity`]: the sub-pixel morph-block similarity (eqs. 3–5), the hot loop
+//! - [`head`]: image-difference head prediction (eqs. 1–5)
+//! - [`search`]: the spiral search path (Fig. 6) and the anchored angular search
+//! - [`body`]: the top-down tracker (head → trunk → limbs)
+//! - [`occlusion`]: interpolation over weak runs, the weak-span report
+//! - [`run`]: passes over a video, key frames, re-tracking
+
+pub mod block;
+pub mod body;
+pub mod head;
+pub mod occlusion;
+pub mod params;
+pub mod run;
+pub mod search;
+pub mod similarity;
+
+pub use occlusion::{SpanKind, WeakSpan};
+pub use params::TrackerParams;
+pub use run::{KeyFrames, TrackError, TrackJob, TrackOutput, TrackProgress, track_video};

@@ -1,0 +1,479 @@
+//! `videomocap bench track`: tracking accuracy and speed.
+//!
+//! Accuracy: a synthetic suite rendered by `synth` (real CMU motion capture from `tests/data`
+//! and procedural motions, several views, photographic and procedural backgrounds, sensor
+//! noise; persons 200–450 px tall at 640×480) plus the real sample, each tracked from the marks
+//! of frame 0 by the VBA tracker and by a fixed-template matcher per joint (the baseline written
+//! here: the marked patch of each joint searched around its last position, no prediction, no
+//! model update). Metrics from [`videomocap::eval`].
+//!
+//! Speed: frames per second of the tracker at 640×480 and 1080×1920, with frames already in
+//! memory (decoding excluded) and with decoding, on one thread and on all.
+
+use super::args::{BenchArgs, GlobalArgs};
+use super::{ExitError, say};
+use anyhow::anyhow;
+use nalgebra::Point2;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+use videomocap::eval::{Accuracy, ClipScore, score_positions, score_tracks};
+use videomocap::formats::Marks;
+use videomocap::skeleton::{Joint, PerJoint};
+use videomocap::synth::{
+    GroundTruth, MotionSource, ProceduralMotion, SynthParams, VideoOutput, View, render_clip,
+};
+use videomocap::track::similarity::FrameView;
+use videomocap::track::{KeyFrames, TrackJob, TrackerParams, track_video};
+use videomocap::video::{OpenOptions, Video};
+
+/// One clip of the synthetic suite.
+struct ClipSpec {
+    name: &'static str,
+    motion: Motion,
+    view: View,
+    person_px: f64,
+    /// Photograph under `assets/backgrounds/`, or a procedural background.
+    background: Option<&'static str>,
+}
+
+enum Motion {
+    Bvh(&'static str, f64),
+    Procedural(ProceduralMotion),
+}
+
+const SUITE: &[ClipSpec] = &[
+    ClipSpec {
+        name: "walk_across_side",
+        motion: Motion::Bvh("cmu_02_01_walk.bvh", 0.0),
+        view: View::Side,
+        person_px: 300.0,
+        background: Some("pose2sim_room.jpg"),
+    },
+    ClipSpec {
+        name: "walk_toward_frontal",
+        motion: Motion::Bvh("cmu_02_01_walk.bvh", 0.0),
+        view: View::Frontal,
+        person_px: 330.0,
+        background: Some("pose2sim_floor.jpg"),
+    },
+    ClipSpec {
+        name: "walk_oblique",
+        motion: Motion::Procedural(ProceduralMotion::Walk),
+        view: View::Oblique,
+        person_px: 260.0,
+        background: None,
+    },
+    ClipSpec {
+        name: "run_side",
+        motion: Motion::Bvh("cmu_02_03_run.bvh", 0.0),
+        view: View::Side,
+        person_px: 240.0,
+        background: Some("pose2sim_room.jpg"),
+    },
+    ClipSpec {
+        name: "dance_turns_frontal",
+        motion: Motion::Bvh("cmu_60_02_dance.bvh", 1.0),
+        view: View::Frontal,
+        person_px: 330.0,
+        background: Some("pose2sim_room.jpg"),
+    },
+    ClipSpec {
+        name: "dance_oblique",
+        motion: Motion::Bvh("cmu_61_05_dance.bvh", 0.5),
+        view: View::Oblique,
+        person_px: 380.0,
+        background: Some("pose2sim_floor.jpg"),
+    },
+    ClipSpec {
+        name: "dribble_oblique",
+        motion: Motion::Bvh("cmu_06_03_dribble.bvh", 0.0),
+        view: View::Oblique,
+        person_px: 300.0,
+        background: None,
+    },
+    ClipSpec {
+        name: "jumping_jacks_frontal",
+        motion: Motion::Procedural(ProceduralMotion::JumpingJacks),
+        view: View::Frontal,
+        person_px: 300.0,
+        background: Some("pose2sim_room.jpg"),
+    },
+    ClipSpec {
+        name: "wave_oblique",
+        motion: Motion::Procedural(ProceduralMotion::Wave),
+        view: View::Oblique,
+        person_px: 420.0,
+        background: Some("pose2sim_floor.jpg"),
+    },
+    ClipSpec {
+        name: "sit_down_frontal",
+        motion: Motion::Procedural(ProceduralMotion::SitDown),
+        view: View::Frontal,
+        person_px: 350.0,
+        background: Some("pose2sim_room.jpg"),
+    },
+    ClipSpec {
+        name: "bend_side",
+        motion: Motion::Procedural(ProceduralMotion::Bend),
+        view: View::Side,
+        person_px: 300.0,
+        background: None,
+    },
+    ClipSpec {
+        name: "walk_raised",
+        motion: Motion::Procedural(ProceduralMotion::Walk),
+        view: View::Raised,
+        person_px: 220.0,
+        background: Some("pose2sim_floor.jpg"),
+    },
+];
+
+/// Frames per suite clip.
+const SUITE_FRAMES: usize = 120;
+
+/// Renders the clips missing from `dir` and returns every clip's directory.
+pub fn ensure_suite(dir: &Path, global: &GlobalArgs) -> Result<Vec<(String, PathBuf)>, ExitError> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut out = Vec::new();
+    for (k, spec) in SUITE.iter().enumerate() {
+        let clip = dir.join(spec.name);
+        if !clip.join("gt.json").is_file() {
+            say(global, &format!("rendering suite clip {} …", spec.name));
+            let motion = match spec.motion {
+                Motion::Bvh(file, start_s) => MotionSource::Bvh {
+                    path: root.join("tests/data").join(file),
+                    start_s,
+                },
+                Motion::Procedural(p) => MotionSource::Procedural(p),
+            };
+            let mut params = SynthParams {
+                motion,
+                frames: SUITE_FRAMES,
+                view: spec.view,
+                person_px: spec.person_px,
+                background_seed: 11 + k as u64,
+                background_image: spec
+                    .background
+                    .map(|b| root.join("assets/backgrounds").join(b)),
+                output: VideoOutput::Mp4,
+                ..SynthParams::default()
+            };
+            params.effects.seed = 100 + k as u64;
+            render_clip(&params, &clip, &mut |_, _| {}, &AtomicBool::new(false))
+                .map_err(ExitError::failed)?;
+        }
+        out.push((spec.name.to_owned(), clip));
+    }
+    Ok(out)
+}
+
+/// The fixed-template baseline: each joint's marked square patch (side 8% of the marked
+/// stature) searched by the sum of absolute RGB differences within ±20% of the stature of its
+/// last position (every 2 px, then ±1 px around the best). No prediction, no model update.
+pub fn fixed_template_track(
+    video: &mut Video,
+    marks: &PerJoint<Point2<f64>>,
+    stature_px: f64,
+) -> Result<Vec<PerJoint<Point2<f64>>>, ExitError> {
+    let half = ((0.04 * stature_px).round() as i64).max(4);
+    let radius = ((0.2 * stature_px).round() as i64).max(8);
+    let first = video.frame(0).map_err(ExitError::failed)?.image;
+    let f0 = FrameView::new(&first);
+    let (w, h) = (first.width() as i64, first.height() as i64);
+    let clampi = |v: i64, hi: i64| v.clamp(0, hi - 1) as usize;
+    let templates: Vec<Vec<[f32; 3]>> = Joint::ALL
+        .iter()
+        .map(|&j| {
+            let (cx, cy) = (marks[j].x.round() as i64, marks[j].y.round() as i64);
+            let mut t = Vec::new();
+            for dy in -half..=half {
+                for dx in -half..=half {
+                    t.push(f0.pixel(clampi(cx + dx, w), clampi(cy + dy, h)));
+                }
+            }
+            t
+        })
+        .collect();
+    let mut pos: Vec<(i64, i64)> = Joint::ALL
+        .iter()
+        .map(|&j| (marks[j].x.round() as i64, marks[j].y.round() as i64))
+        .collect();
+    let mut out = vec![*marks];
+    for index in 1..video.info().frame_count {
+        let image = video.frame(index).map_err(ExitError::failed)?.image;
+        let f = FrameView::new(&image);
+        let sad = |t: &[[f32; 3]], cx: i64, cy: i64, bound: f32| -> f32 {
+            let mut s = 0.0;
+            let mut k = 0;
+            for dy in -half..=half {
+                for dx in -half..=half {
+                    let p = f.pixel(clampi(cx + dx, w), clampi(cy + dy, h));
+                    let q = t[k];
+                    s += (p[0] - q[0]).abs() + (p[1] - q[1]).abs() + (p[2] - q[2]).abs();
+                    k += 1;
+                }
+                if s > bound {
+                    return f32::INFINITY;
+                }
+            }
+            s
+        };
+        for (i, t) in templates.iter().enumerate() {
+            let (px, py) = pos[i];
+            let mut best = (f32::INFINITY, px, py);
+            for step_then in [(2i64, radius), (1, 2)] {
+                let (step, r) = step_then;
+                let (bx, by) = (best.1, best.2);
+                let mut dy = -r;
+                while dy <= r {
+                    let mut dx = -r;
+                    while dx <= r {
+                        let c = sad(t, bx + dx, by + dy, best.0);
+                        if c < best.0 {
+                            best = (c, bx + dx, by + dy);
+                        }
+                        dx += step;
+                    }
+                    dy += step;
+                }
+            }
+            pos[i] = (best.1, best.2);
+        }
+        out.push(PerJoint::from_fn(|j| {
+            let (x, y) = pos[j.index()];
+            Point2::new(x as f64, y as f64)
+        }));
+    }
+    Ok(out)
+}
+
+fn fmt_row(name: &str, a: &Accuracy) -> String {
+    format!(
+        "{:<24} {:>8.1} {:>8.3} {:>8.3} {:>8.3} {:>7.1}%",
+        name,
+        a.mean_px(),
+        a.mean_torso(),
+        a.pck01(),
+        a.pck02(),
+        100.0 * a.lost()
+    )
+}
+
+fn header(title: &str) -> String {
+    format!(
+        "{:<24} {:>8} {:>8} {:>8} {:>8} {:>8}",
+        title, "mean px", "err/torso", "PCK@0.1", "PCK@0.2", "lost"
+    )
+}
+
+struct Scored {
+    vba: ClipScore,
+    baseline: ClipScore,
+}
+
+fn score_clip(dir: &Path, threads: usize, params: TrackerParams) -> Result<Scored, ExitError> {
+    let gt = GroundTruth::load(&dir.join("gt.json")).map_err(ExitError::failed)?;
+    let marks = Marks::load(&dir.join("marks.json")).map_err(ExitError::failed)?;
+    let mut video =
+        Video::open(&dir.join("video.mp4"), &OpenOptions::default()).map_err(ExitError::failed)?;
+    let job = TrackJob {
+        keys: KeyFrames::from_marks(&marks),
+        params,
+        threads,
+        from: None,
+        previous: None,
+    };
+    let out = track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false))
+        .map_err(ExitError::failed)?;
+    let vba = score_tracks(&gt, &out.tracks).map_err(ExitError::failed)?;
+    let stature = videomocap::track::body::stature_px(
+        &marks.points,
+        &videomocap::skeleton::Proportions::default(),
+    );
+    let base = fixed_template_track(&mut video, &marks.points, stature)?;
+    let baseline = score_positions(&gt, base.into_iter().enumerate()).map_err(ExitError::failed)?;
+    Ok(Scored { vba, baseline })
+}
+
+/// Runs the accuracy and speed benchmark and prints its tables.
+pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+    let threads = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1);
+    let params = match &a.tracker_settings {
+        Some(p) => super::track::load_settings(p)?,
+        None => TrackerParams::default(),
+    };
+    let clips = ensure_suite(&a.suite_dir, global)?;
+    let mut total_vba = ClipScore::default();
+    let mut total_base = ClipScore::default();
+    let mut lines = vec![
+        "synthetic suite (VBA tracker | fixed-template baseline)".to_owned(),
+        format!("{}  | baseline PCK@0.2, mean px", header("clip")),
+    ];
+    let mut rows_json = Vec::new();
+    for (name, dir) in &clips {
+        let s = score_clip(dir, threads, params)?;
+        lines.push(format!(
+            "{}  | {:.3} {:6.1}",
+            fmt_row(name, &s.vba.overall),
+            s.baseline.overall.pck02(),
+            s.baseline.overall.mean_px()
+        ));
+        rows_json.push(serde_json::json!({
+            "clip": name,
+            "vba": {"mean_px": s.vba.overall.mean_px(), "pck02": s.vba.overall.pck02(), "lost": s.vba.overall.lost()},
+            "baseline": {"mean_px": s.baseline.overall.mean_px(), "pck02": s.baseline.overall.pck02(), "lost": s.baseline.overall.lost()},
+        }));
+        merge(&mut total_vba, &s.vba);
+        merge(&mut total_base, &s.baseline);
+    }
+    lines.push(String::new());
+    lines.push(header("suite overall"));
+    for (label, v) in [
+        ("VBA all", &total_vba.overall),
+        ("VBA visible", &total_vba.visible),
+        ("VBA occluded", &total_vba.occluded),
+        ("fixed-template all", &total_base.overall),
+        ("fixed-template visible", &total_base.visible),
+        ("fixed-template occluded", &total_base.occluded),
+    ] {
+        lines.push(fmt_row(label, v));
+    }
+    lines.push(String::new());
+    lines.push(header("suite per joint (VBA)"));
+    for (j, acc) in total_vba.per_joint.iter() {
+        lines.push(fmt_row(j.name(), acc));
+    }
+
+    // The real sample.
+    let real = Path::new(env!("CARGO_MANIFEST_DIR")).join("sample_videos/pose2sim_balancing_cam01");
+    let s = score_clip(&real, threads, params)?;
+    lines.push(String::new());
+    lines.push(header("real sample (no chest)"));
+    lines.push(fmt_row("VBA", &s.vba.overall));
+    lines.push(fmt_row("fixed-template", &s.baseline.overall));
+    for (j, acc) in s.vba.per_joint.iter() {
+        if acc.count > 0 {
+            lines.push(fmt_row(&format!("  {}", j.name()), acc));
+        }
+    }
+
+    // Speed.
+    lines.push(String::new());
+    lines.push(format!(
+        "{:<48} {:>12}",
+        "speed (all 16 joints)", "frames/s"
+    ));
+    let speed_clip = &clips[0].1;
+    for (label, dir) in [
+        ("640×480", speed_clip.as_path()),
+        ("1080×1920", real.as_path()),
+    ] {
+        let n = speed(dir, 1, false, params)?;
+        lines.push(format!(
+            "{:<48} {:>12.1}",
+            format!("track {label}, 1 thread, decoding excluded"),
+            n
+        ));
+        let n = speed(dir, threads, false, params)?;
+        lines.push(format!(
+            "{:<48} {:>12.1}",
+            format!("track {label}, {threads} threads, decoding excluded"),
+            n
+        ));
+        let n = speed(dir, 1, true, params)?;
+        lines.push(format!(
+            "{:<48} {:>12.1}",
+            format!("track {label}, 1 thread, with decoding"),
+            n
+        ));
+        let with = speed(dir, threads, true, params)?;
+        lines.push(format!(
+            "{:<48} {:>12.1}",
+            format!("track {label}, {threads} threads, with decoding"),
+            with
+        ));
+        let d = decode_speed(dir)?;
+        lines.push(format!(
+            "{:<48} {:>12.1}",
+            format!("decode only {label}"),
+            d
+        ));
+        lines.push(format!(
+            "{:<48} {:>12.2}",
+            format!("time ratio track+decode / decode {label}"),
+            d / with
+        ));
+    }
+    if global.json {
+        println!(
+            "{}",
+            serde_json::json!({"clips": rows_json, "table": lines})
+        );
+    } else {
+        for l in lines {
+            println!("{l}");
+        }
+    }
+    Ok(())
+}
+
+fn merge(total: &mut ClipScore, s: &ClipScore) {
+    total.overall.merge(&s.overall);
+    total.visible.merge(&s.visible);
+    total.occluded.merge(&s.occluded);
+    for j in Joint::ALL {
+        total.per_joint[j].merge(&s.per_joint[j]);
+    }
+}
+
+/// Frames per second of `track_video` on a clip; `decoding` false pre-loads every frame into
+/// the cache first.
+fn speed(
+    dir: &Path,
+    threads: usize,
+    decoding: bool,
+    params: TrackerParams,
+) -> Result<f64, ExitError> {
+    let marks = Marks::load(&dir.join("marks.json")).map_err(ExitError::failed)?;
+    let options = OpenOptions {
+        cache_bytes: 2 << 30,
+        ..OpenOptions::default()
+    };
+    let mut video = Video::open(&dir.join("video.mp4"), &options).map_err(ExitError::failed)?;
+    let n = video.info().frame_count;
+    if !decoding {
+        for i in 0..n {
+            let _: Arc<_> = video.frame(i).map_err(ExitError::failed)?.image;
+        }
+    }
+    let job = TrackJob {
+        keys: KeyFrames::from_marks(&marks),
+        params,
+        threads,
+        from: None,
+        previous: None,
+    };
+    let t0 = Instant::now();
+    track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false))
+        .map_err(ExitError::failed)?;
+    Ok(n as f64 / t0.elapsed().as_secs_f64())
+}
+
+fn decode_speed(dir: &Path) -> Result<f64, ExitError> {
+    let mut video =
+        Video::open(&dir.join("video.mp4"), &OpenOptions::default()).map_err(ExitError::failed)?;
+    let n = video.info().frame_count;
+    let t0 = Instant::now();
+    for i in 0..n {
+        video.frame(i).map_err(ExitError::failed)?;
+    }
+    let s = t0.elapsed().as_secs_f64();
+    if s <= 0.0 {
+        return Err(ExitError::failed(anyhow!("decoding took no time")));
+    }
+    Ok(n as f64 / s)
+}

@@ -1,0 +1,188 @@
+//! `videomocap track`: follow the 16 marked joints through the video and write tracks2d.json.
+
+use super::args::{GlobalArgs, TrackArgs};
+use super::{ExitError, progress_bar, say};
+use anyhow::anyhow;
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+use videomocap::eval::score_tracks;
+use videomocap::formats::Marks;
+use videomocap::synth::GroundTruth;
+use videomocap::track::{
+    KeyFrames, SpanKind, TrackError, TrackJob, TrackOutput, TrackerParams, track_video,
+};
+use videomocap::video::{OpenOptions, Video};
+
+/// Opens the video and marks and checks that they fit together.
+pub fn open_checked(video: &Path, marks: &Path) -> Result<(Video, Marks), ExitError> {
+    let v = Video::open(video, &OpenOptions::default()).map_err(ExitError::bad_input)?;
+    let m = Marks::load(marks).map_err(ExitError::bad_input)?;
+    let info = v.info();
+    if m.frame >= info.frame_count {
+        return Err(ExitError::bad_input(anyhow!(
+            "{}: marks are on frame {} but {} has {} frames",
+            marks.display(),
+            m.frame,
+            video.display(),
+            info.frame_count
+        )));
+    }
+    m.check_in_frame(marks, info.width, info.height)
+        .map_err(ExitError::bad_input)?;
+    Ok((v, m))
+}
+
+/// Runs the tracker with a progress bar; shared by `track` and `run`.
+pub fn track_with_progress(
+    video: &mut Video,
+    marks: &Marks,
+    threads: Option<usize>,
+    params: TrackerParams,
+    global: &GlobalArgs,
+) -> Result<TrackOutput, ExitError> {
+    let threads = threads.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    if threads == 0 {
+        return Err(ExitError::bad_input(anyhow!(
+            "--threads must be at least 1"
+        )));
+    }
+    let job = TrackJob {
+        keys: KeyFrames::from_marks(marks),
+        params,
+        threads,
+        from: None,
+        previous: None,
+    };
+    let bar = progress_bar(global, video.info().frame_count as u64, "tracking");
+    let cancel = AtomicBool::new(false);
+    let mut on_progress = |p: &videomocap::track::TrackProgress| {
+        bar.set_length(p.total as u64);
+        bar.set_position(p.done as u64);
+    };
+    let out = track_video(video, &job, &mut on_progress, &cancel).map_err(|e| match e {
+        TrackError::Video(_) | TrackError::Cancelled => ExitError::failed(e),
+        _ => ExitError::bad_input(e),
+    })?;
+    bar.finish_and_clear();
+    Ok(out)
+}
+
+/// Reads tracker settings from a JSON file.
+pub fn load_settings(path: &Path) -> Result<TrackerParams, ExitError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| ExitError::bad_input(anyhow!("{}: cannot read: {e}", path.display())))?;
+    serde_json::from_str(&text)
+        .map_err(|e| ExitError::bad_input(anyhow!("{}: bad tracker settings: {e}", path.display())))
+}
+
+/// Prints the weak spans (the tracking report).
+pub fn report(out: &TrackOutput, global: &GlobalArgs) {
+    let interpolated = out
+        .spans
+        .iter()
+        .filter(|s| s.kind == SpanKind::Interpolated)
+        .count();
+    let weak: Vec<_> = out
+        .spans
+        .iter()
+        .filter(|s| s.kind == SpanKind::Weak)
+        .collect();
+    say(
+        global,
+        &format!(
+            "{} frames tracked (working scale 1/{}); {} short weak runs interpolated, {} weak spans left for review",
+            out.tracks.frames.len(),
+            out.shrink,
+            interpolated,
+            weak.len()
+        ),
+    );
+    for s in weak.iter().take(20) {
+        say(
+            global,
+            &format!(
+                "  weak: {:<15} frames {}–{} (lowest reliability {:.2})",
+                s.joint, s.start, s.end, s.min_reliability
+            ),
+        );
+    }
+    if weak.len() > 20 {
+        say(global, &format!("  … and {} more", weak.len() - 20));
+    }
+}
+
+pub fn run(a: &TrackArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+    let (mut video, marks) = open_checked(&a.video, &a.marks)?;
+    let reference = match &a.reference {
+        Some(p) => Some(GroundTruth::load(p).map_err(ExitError::bad_input)?),
+        None => None,
+    };
+    let params = match &a.tracker_settings {
+        Some(p) => load_settings(p)?,
+        None => TrackerParams::default(),
+    };
+    let t0 = std::time::Instant::now();
+    let out = track_with_progress(&mut video, &marks, a.threads, params, global)?;
+    let seconds = t0.elapsed().as_secs_f64();
+    out.tracks.save(&a.output).map_err(ExitError::failed)?;
+    report(&out, global);
+    say(
+        global,
+        &format!(
+            "wrote {} ({:.1} frames/s including decoding)",
+            a.output.display(),
+            out.tracks.frames.len() as f64 / seconds
+        ),
+    );
+    let score = match &reference {
+        Some(gt) => Some(score_tracks(gt, &out.tracks).map_err(ExitError::bad_input)?),
+        None => None,
+    };
+    if let Some(s) = &score {
+        for (j, acc) in s.per_joint.iter() {
+            if acc.count > 0 {
+                say(
+                    global,
+                    &format!(
+                        "  {:<15} mean {:6.1} px  PCK@0.2 {:.3}  lost {:5.1}%",
+                        j.name(),
+                        acc.mean_px(),
+                        acc.pck02(),
+                        100.0 * acc.lost()
+                    ),
+                );
+            }
+        }
+        say(
+            global,
+            &format!(
+                "against the reference: mean {:.1} px, PCK@0.1 {:.3}, PCK@0.2 {:.3}, lost {:.1}%",
+                s.overall.mean_px(),
+                s.overall.pck01(),
+                s.overall.pck02(),
+                100.0 * s.overall.lost()
+            ),
+        );
+    }
+    if global.json {
+        let summary = serde_json::json!({
+            "output": a.output,
+            "frames": out.tracks.frames.len(),
+            "seconds": seconds,
+            "shrink": out.shrink,
+            "spans": out.spans,
+            "reference": score.map(|s| serde_json::json!({
+                "mean_px": s.overall.mean_px(),
+                "pck01": s.overall.pck01(),
+                "pck02": s.overall.pck02(),
+                "lost": s.overall.lost(),
+            })),
+        });
+        println!("{summary:#}");
+    }
+    Ok(())
+}

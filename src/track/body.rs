@@ -1,0 +1,426 @@
+//! The top-down body tracker (Pan et al., "Trunk and Limb"): head first (image-difference
+//! prediction + spiral search), then the trunk anchored at the tracked neck, then each limb
+//! chain shoulder→elbow→wrist and hip→knee→ankle, every child block anchored at its tracked
+//! parent joint and its search centred on a motion prediction (the bone's angular velocity
+//! relative to its parent). The four limb chains are independent and run in parallel.
+//!
+//! Works in one image scale (the caller converts to and from video pixels).
+
+use super::block::{MorphBlock, wrap_angle};
+use super::head::HeadPredictor;
+use super::params::TrackerParams;
+use super::search::{AngularParams, Found, Prior, SpiralParams, angular, spiral};
+use super::similarity::{Extent, FrameView, Template};
+use crate::skeleton::{BodyPart, Joint, PerJoint, Proportions};
+use image::RgbImage;
+use nalgebra::Point2;
+use std::sync::Arc;
+
+/// The four limb chains: root joint, middle joint, end joint.
+pub const CHAINS: [[Joint; 3]; 4] = [
+    [Joint::LeftShoulder, Joint::LeftElbow, Joint::LeftWrist],
+    [Joint::RightShoulder, Joint::RightElbow, Joint::RightWrist],
+    [Joint::LeftHip, Joint::LeftKnee, Joint::LeftAnkle],
+    [Joint::RightHip, Joint::RightKnee, Joint::RightAnkle],
+];
+
+/// Joints carried rigidly by the trunk block (in its block coordinates).
+const TRUNK_JOINTS: [Joint; 5] = [
+    Joint::Chest,
+    Joint::LeftShoulder,
+    Joint::RightShoulder,
+    Joint::LeftHip,
+    Joint::RightHip,
+];
+
+/// One joint's result in one frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointResult {
+    /// Position, pixels (tracker scale).
+    pub pos: Point2<f64>,
+    /// Reliability in [0, 1]: the block's similarity mapped by `c0 / (c0 + cost)`.
+    pub reliability: f32,
+}
+
+/// A tracked body part: its block, its angle one frame earlier and its colour model.
+#[derive(Debug, Clone)]
+struct Part {
+    block: MorphBlock,
+    /// θ of the previous frame (for the angular velocity).
+    prev_theta: f64,
+    /// The colour model.
+    template: Template,
+    reliability: f32,
+    /// Longest plausible image length of the bone, pixels (proportions × marked stature).
+    max_len: f64,
+}
+
+/// The sampled extent of each part along its bone (see [`Extent`]): the head block reaches a
+/// little above the calvaria, limb blocks past their far joint (into the forearm, the hand,
+/// the shank, the foot).
+fn extent(part: BodyPart) -> Extent {
+    let (start, end) = match part {
+        BodyPart::Head => (0.0, 1.0),
+        BodyPart::Trunk => (0.0, 1.1),
+        BodyPart::LeftUpperArm | BodyPart::RightUpperArm => (0.0, 1.15),
+        BodyPart::LeftForearm | BodyPart::RightForearm => (0.0, 1.3),
+        BodyPart::LeftThigh | BodyPart::RightThigh => (0.0, 1.15),
+        BodyPart::LeftShank | BodyPart::RightShank => (0.0, 1.2),
+    };
+    Extent { start, end }
+}
+
+/// Block widths in pixels, from the proportions scaled to the marked body.
+fn widths(
+    pose: &PerJoint<Point2<f64>>,
+    proportions: &Proportions,
+    scale: f64,
+) -> impl Fn(BodyPart) -> f64 {
+    let stature = stature_px(pose, proportions);
+    let shoulders = (pose[Joint::LeftShoulder] - pose[Joint::RightShoulder]).norm();
+    let hips = (pose[Joint::LeftHip] - pose[Joint::RightHip]).norm();
+    let p = proportions.clone();
+    move |part| {
+        let w = p.breadth_fraction(part.breadth()) * stature;
+        if part == BodyPart::Trunk {
+            // wide enough to carry the shoulders and hips
+            w.max(shoulders).max(hips)
+        } else {
+            (w * scale).max(3.0)
+        }
+    }
+}
+
+/// The subject's stature in pixels estimated from marked bones: the longest of the trunk chain
+/// and each limb divided by its fraction of the stature (foreshortening only shortens, so the
+/// longest estimate is the least foreshortened).
+pub fn stature_px(pose: &PerJoint<Point2<f64>>, proportions: &Proportions) -> f64 {
+    let chains: [&[Joint]; 5] = [
+        &[Joint::HeadTop, Joint::Neck, Joint::Chest, Joint::Pelvis],
+        &CHAINS[0],
+        &CHAINS[1],
+        &CHAINS[2],
+        &CHAINS[3],
+    ];
+    let mut best = 0.0f64;
+    for chain in chains {
+        let (mut px, mut frac) = (0.0, 0.0);
+        for w in chain.windows(2) {
+            px += (pose[w[1]] - pose[w[0]]).norm();
+            frac += proportions.fraction_between(w[0], w[1]);
+        }
+        if frac > 0.0 {
+            best = best.max(px / frac);
+        }
+    }
+    best.max(20.0)
+}
+
+/// Tracks the body frame by frame.
+#[derive(Debug, Clone)]
+pub struct BodyTracker {
+    params: TrackerParams,
+    head: Part,
+    trunk: Part,
+    /// Per chain: the upper and lower part.
+    limbs: [[Part; 2]; 4],
+    /// Chest, shoulders and hips in the trunk block's (u, v) coordinates.
+    trunk_points: [(f64, f64); 5],
+    predictor: HeadPredictor,
+    prev_image: Arc<RgbImage>,
+}
+
+fn reliability(cost: f32, c0: f32) -> f32 {
+    if cost.is_finite() {
+        c0 / (c0 + cost.max(0.0))
+    } else {
+        0.0
+    }
+}
+
+impl BodyTracker {
+    /// Starts from a pose on `image` (a key frame): blocks from the pose, widths from the
+    /// proportions scaled to it, colour models sampled from the image.
+    pub fn new(
+        image: Arc<RgbImage>,
+        pose: &PerJoint<Point2<f64>>,
+        proportions: &Proportions,
+        params: TrackerParams,
+    ) -> BodyTracker {
+        let width = widths(pose, proportions, params.block_width_scale);
+        let stature = stature_px(pose, proportions);
+        let frame = FrameView::new(&image);
+        let w = params.weights;
+        let part = |block: MorphBlock, kind: BodyPart| {
+            let (a, b) = kind.ends();
+            let fraction = if kind == BodyPart::Trunk {
+                proportions.fraction_between(Joint::Neck, Joint::Chest)
+                    + proportions.fraction_between(Joint::Chest, Joint::Pelvis)
+            } else {
+                proportions.fraction_between(a, b)
+            };
+            Part {
+                block,
+                prev_theta: block.theta,
+                template: Template::sample(frame, &block, extent(kind), w),
+                reliability: 1.0,
+                max_len: (1.2 * fraction * stature).max(block.m * 1.05),
+            }
+        };
+        // The head block runs from the calvaria down to the neck (its anchor is head_top).
+        let head = part(
+            MorphBlock::along(
+                pose[Joint::HeadTop],
+                pose[Joint::Neck],
+                width(BodyPart::Head),
+            ),
+            BodyPart::Head,
+        );
+        let trunk_block = MorphBlock::along(
+            pose[Joint::Neck],
+            pose[Joint::Pelvis],
+            width(BodyPart::Trunk),
+        );
+        let trunk = part(trunk_block, BodyPart::Trunk);
+        let trunk_points = TRUNK_JOINTS.map(|j| trunk_block.to_block(pose[j]));
+        let limb_parts = [
+            [BodyPart::LeftUpperArm, BodyPart::LeftForearm],
+            [BodyPart::RightUpperArm, BodyPart::RightForearm],
+            [BodyPart::LeftThigh, BodyPart::LeftShank],
+            [BodyPart::RightThigh, BodyPart::RightShank],
+        ];
+        let limbs = std::array::from_fn(|c| {
+            let [a, b, e] = CHAINS[c];
+            [
+                part(
+                    MorphBlock::along(pose[a], pose[b], width(limb_parts[c][0])),
+                    limb_parts[c][0],
+                ),
+                part(
+                    MorphBlock::along(pose[b], pose[e], width(limb_parts[c][1])),
+                    limb_parts[c][1],
+                ),
+            ]
+        });
+        BodyTracker {
+            params,
+            head,
+            trunk,
+            limbs,
+            trunk_points,
+            predictor: HeadPredictor::default(),
+            prev_image: image,
+        }
+    }
+
+    /// The current pose (after the last step, or the starting pose).
+    pub fn pose(&self) -> PerJoint<JointResult> {
+        let mut out = PerJoint::from_fn(|_| JointResult {
+            pos: Point2::origin(),
+            reliability: 0.0,
+        });
+        let set = |out: &mut PerJoint<JointResult>, j: Joint, pos: Point2<f64>, r: f32| {
+            out[j] = JointResult {
+                pos,
+                reliability: r,
+            }
+        };
+        set(
+            &mut out,
+            Joint::HeadTop,
+            self.head.block.origin,
+            self.head.reliability,
+        );
+        set(
+            &mut out,
+            Joint::Neck,
+            self.head.block.end(),
+            self.head.reliability,
+        );
+        set(
+            &mut out,
+            Joint::Pelvis,
+            self.trunk.block.end(),
+            self.trunk.reliability,
+        );
+        for (k, j) in TRUNK_JOINTS.iter().enumerate() {
+            let (u, v) = self.trunk_points[k];
+            set(
+                &mut out,
+                *j,
+                self.trunk.block.to_image(u, v),
+                self.trunk.reliability,
+            );
+        }
+        for (c, chain) in CHAINS.iter().enumerate() {
+            let [upper, lower] = &self.limbs[c];
+            set(&mut out, chain[1], upper.block.end(), upper.reliability);
+            set(&mut out, chain[2], lower.block.end(), lower.reliability);
+        }
+        out
+    }
+
+    /// Tracks the body into the next frame and returns its pose.
+    pub fn step(&mut self, image: Arc<RgbImage>) -> PerJoint<JointResult> {
+        let p = self.params;
+        let frame = FrameView::new(&image);
+        let prev = FrameView::new(&self.prev_image);
+
+        // Head: image-difference prediction, then the spiral search path.
+        let motion =
+            self.predictor
+                .predict(prev, frame, self.head.block.origin, self.head.block.end());
+        let predicted = MorphBlock {
+            origin: self.head.block.origin + motion.displacement,
+            ..self.head.block
+        };
+        let found = spiral(
+            &self.head.template,
+            frame,
+            &predicted,
+            &SpiralParams {
+                step_px: p.head_step_px,
+                d_theta: p.head_d_theta_deg.to_radians(),
+                d_m: p.head_d_m,
+                max_rings: p.head_max_rings,
+            },
+        );
+        self.predictor.adapt(
+            motion.displacement,
+            found.block.origin - self.head.block.origin,
+        );
+        accept(&mut self.head, found, frame, &p);
+
+        // Trunk, anchored at the neck.
+        let neck = self.head.block.end();
+        let trunk_before = (self.trunk.block.theta, self.trunk.prev_theta);
+        let trunk_pred = predict_anchored(&self.trunk, neck, None, p.velocity_damping);
+        let found = angular(
+            &self.trunk.template,
+            frame,
+            &trunk_pred,
+            &AngularParams {
+                range_theta: p.trunk_range_deg.to_radians(),
+                step_theta: p.coarse_step_deg.to_radians(),
+                range_m: p.trunk_range_m,
+                m_count: 5,
+                scale_width: false,
+            },
+            &prior(&self.trunk, &trunk_pred, &p),
+        );
+        accept(&mut self.trunk, found, frame, &p);
+        let pose_now = self.pose();
+
+        // Limbs, each chain from its root joint on the trunk; chains in parallel.
+        let trunk_angles = [self.trunk.block.theta, trunk_before.0, trunk_before.1];
+        let roots = CHAINS.map(|c| pose_now[c[0]].pos);
+        let [a, b, c, d] = &mut self.limbs;
+        let track_chain = |parts: &mut [Part; 2], root: Point2<f64>| {
+            track_limb(parts, root, trunk_angles, frame, &p);
+        };
+        if p.parallel {
+            rayon::join(
+                || rayon::join(|| track_chain(a, roots[0]), || track_chain(b, roots[1])),
+                || rayon::join(|| track_chain(c, roots[2]), || track_chain(d, roots[3])),
+            );
+        } else {
+            track_chain(a, roots[0]);
+            track_chain(b, roots[1]);
+            track_chain(c, roots[2]);
+            track_chain(d, roots[3]);
+        }
+        self.prev_image = image;
+        self.pose()
+    }
+}
+
+/// The predicted block of a part anchored at `anchor`. Without a parent (the trunk) its angle
+/// advances by its own angular velocity; with one (`[θ now, θ one frame ago, θ two frames ago]`
+/// of the parent) its angle relative to the parent advances by its relative angular velocity,
+/// so a forearm follows its upper arm. Velocities are damped by `damping`; the length is kept.
+fn predict_anchored(
+    part: &Part,
+    anchor: Point2<f64>,
+    parent: Option<[f64; 3]>,
+    damping: f64,
+) -> MorphBlock {
+    let theta = match parent {
+        None => part.block.theta + damping * wrap_angle(part.block.theta - part.prev_theta),
+        Some([now, before, older]) => {
+            let rel = wrap_angle(part.block.theta - before);
+            let rel_prev = wrap_angle(part.prev_theta - older);
+            now + rel + damping * wrap_angle(rel - rel_prev)
+        }
+    };
+    MorphBlock {
+        origin: anchor,
+        theta,
+        ..part.block
+    }
+}
+
+/// The motion prior of an anchored part around its prediction.
+fn prior(part: &Part, pred: &MorphBlock, p: &TrackerParams) -> Prior {
+    Prior {
+        theta: pred.theta,
+        m: pred.m,
+        per_degree: p.angle_penalty,
+        per_log_length: p.length_penalty,
+        m_min: 0.2 * part.max_len,
+        m_max: part.max_len,
+    }
+}
+
+/// Takes a search result: the block moves, the angle history shifts, the reliability is the
+/// mapped similarity, and the adaptive colour model learns the new appearance when reliable.
+fn accept(part: &mut Part, found: Found, frame: FrameView, p: &TrackerParams) {
+    part.prev_theta = part.block.theta;
+    part.block = found.block;
+    // The reliability comes from the appearance alone, without the prior's penalty.
+    let cost = part.template.cost(frame, &part.block, false, f32::INFINITY);
+    part.reliability = reliability(cost, p.reliability_c0);
+    if part.reliability >= p.weak_reliability {
+        part.template.update(frame, &part.block, p.update_rate);
+    }
+}
+
+/// One limb chain: the upper block anchored at the root, the lower at the found middle joint.
+/// A weak result from the narrow search around the prediction is searched again over the wide
+/// range (fast limbs).
+fn track_limb(
+    parts: &mut [Part; 2],
+    root: Point2<f64>,
+    trunk_angles: [f64; 3],
+    frame: FrameView,
+    p: &TrackerParams,
+) {
+    let mut parent = trunk_angles;
+    let mut anchor = root;
+    for part in parts.iter_mut() {
+        let before = (part.block.theta, part.prev_theta);
+        let pred = predict_anchored(part, anchor, Some(parent), p.velocity_damping);
+        let narrow = AngularParams {
+            range_theta: p.limb_range_deg.to_radians(),
+            step_theta: p.coarse_step_deg.to_radians(),
+            range_m: p.limb_range_m,
+            m_count: 5,
+            scale_width: false,
+        };
+        let prior = prior(part, &pred, p);
+        let mut found = angular(&part.template, frame, &pred, &narrow, &prior);
+        if reliability(found.cost, p.reliability_c0) < p.weak_reliability {
+            let wide = AngularParams {
+                range_theta: p.wide_range_deg.to_radians(),
+                step_theta: 2.0 * p.coarse_step_deg.to_radians(),
+                ..narrow
+            };
+            let again = angular(&part.template, frame, &pred, &wide, &prior);
+            if again.cost < found.cost {
+                found = again;
+            }
+        }
+        accept(part, found, frame, p);
+        parent = [part.block.theta, before.0, before.1];
+        anchor = part.block.end();
+    }
+}

@@ -1,0 +1,157 @@
+//! Occlusion handling (Pan et al., end of "Trunk and Limb"): a run of low-reliability frames
+//! between reliable ones is filled by linear interpolation of the joint; longer runs, and runs
+//! with no reliable frame on one side, are reported as weak spans and never silently filled.
+//! Key frames (hand-placed joints) always count as reliable anchors.
+
+use crate::formats::{FrameTracks, PointSource};
+use crate::skeleton::{Joint, PerJoint};
+use serde::Serialize;
+
+/// What happened to a run of weak frames of one joint.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SpanKind {
+    /// Filled by linear interpolation between the reliable frames around it.
+    Interpolated,
+    /// Left as tracked and reported: too long to interpolate, or not bounded by reliable frames.
+    Weak,
+}
+
+/// A run of consecutive weak frames of one joint.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct WeakSpan {
+    /// The joint's name.
+    pub joint: &'static str,
+    /// First frame of the run.
+    pub start: usize,
+    /// Last frame of the run (inclusive).
+    pub end: usize,
+    /// Interpolated or left weak.
+    pub kind: SpanKind,
+    /// Lowest reliability in the run.
+    pub min_reliability: f32,
+}
+
+/// Fills short weak runs by interpolation and lists every weak run. `frames` must hold
+/// consecutive frame indices; `is_key(frame position, joint)` marks hand-placed joints.
+pub fn fill_weak_runs(
+    frames: &mut [FrameTracks],
+    weak: f32,
+    max_gap: usize,
+    is_key: &dyn Fn(usize, Joint) -> bool,
+) -> Vec<WeakSpan> {
+    let mut spans = Vec::new();
+    let n = frames.len();
+    for joint in crate::skeleton::Joint::ALL {
+        let reliable = |frames: &[FrameTracks], i: usize| {
+            is_key(i, joint) || frames[i].points[joint].confidence >= weak
+        };
+        let mut i = 0;
+        while i < n {
+            if reliable(frames, i) {
+                i += 1;
+                continue;
+            }
+            let start = i;
+            while i < n && !reliable(frames, i) {
+                i += 1;
+            }
+            let end = i - 1;
+            let min_reliability = frames[start..=end]
+                .iter()
+                .map(|f| f.points[joint].confidence)
+                .fold(f32::INFINITY, f32::min);
+            let bounded = start > 0 && end + 1 < n;
+            let len = end - start + 1;
+            let kind = if bounded && len <= max_gap {
+                let a = frames[start - 1].points[joint].pos;
+                let b = frames[end + 1].points[joint].pos;
+                for (k, f) in frames[start..=end].iter_mut().enumerate() {
+                    let t = (k + 1) as f64 / (len + 1) as f64;
+                    let p = &mut f.points[joint];
+                    p.pos = a + (b - a) * t;
+                    p.source = PointSource::Interpolated;
+                }
+                SpanKind::Interpolated
+            } else {
+                SpanKind::Weak
+            };
+            spans.push(WeakSpan {
+                joint: joint.name(),
+                start: frames[start].index,
+                end: frames[end].index,
+                kind,
+                min_reliability,
+            });
+        }
+    }
+    spans.sort_by_key(|s| (s.start, s.joint));
+    spans
+}
+
+/// Counts frames per joint that ended interpolated (for summaries).
+pub fn interpolated_counts(frames: &[FrameTracks]) -> PerJoint<usize> {
+    PerJoint::from_fn(|j| {
+        frames
+            .iter()
+            .filter(|f| f.points[j].source == PointSource::Interpolated)
+            .count()
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::formats::TrackedPoint;
+    use nalgebra::Point2;
+
+    fn frames(conf: &[f32]) -> Vec<FrameTracks> {
+        conf.iter()
+            .enumerate()
+            .map(|(i, &c)| FrameTracks {
+                index: i,
+                points: PerJoint::from_fn(|_| TrackedPoint {
+                    pos: Point2::new(i as f64 * 10.0 + if c < 0.5 { 100.0 } else { 0.0 }, 0.0),
+                    confidence: c,
+                    source: PointSource::Tracked,
+                }),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_short_bounded_run_is_interpolated_and_a_long_one_reported() {
+        let mut f = frames(&[0.9, 0.9, 0.1, 0.2, 0.9, 0.1, 0.1, 0.1, 0.1, 0.9]);
+        let spans = fill_weak_runs(&mut f, 0.5, 3, &|_, _| false);
+        let head: Vec<_> = spans.iter().filter(|s| s.joint == "head_top").collect();
+        assert_eq!(head.len(), 2);
+        assert_eq!(
+            (head[0].start, head[0].end, head[0].kind),
+            (2, 3, SpanKind::Interpolated)
+        );
+        assert_eq!(
+            (head[1].start, head[1].end, head[1].kind),
+            (5, 8, SpanKind::Weak)
+        );
+        // Interpolated on the line between frames 1 and 4 (x = 10 … 40).
+        assert!((f[2].points[Joint::HeadTop].pos.x - 20.0).abs() < 1e-9);
+        assert!((f[3].points[Joint::HeadTop].pos.x - 30.0).abs() < 1e-9);
+        assert_eq!(f[3].points[Joint::Neck].source, PointSource::Interpolated);
+        // The long run keeps its tracked (wrong) positions and stays flagged tracked.
+        assert_eq!(f[6].points[Joint::HeadTop].source, PointSource::Tracked);
+    }
+
+    #[test]
+    fn runs_at_the_ends_are_never_filled_and_key_frames_anchor() {
+        let mut f = frames(&[0.1, 0.9, 0.9, 0.1]);
+        let spans = fill_weak_runs(&mut f, 0.5, 10, &|_, _| false);
+        assert!(spans.iter().all(|s| s.kind == SpanKind::Weak));
+        let mut f = frames(&[0.9, 0.1, 0.1]);
+        let spans = fill_weak_runs(&mut f, 0.5, 10, &|i, _| i == 2);
+        assert!(
+            spans
+                .iter()
+                .all(|s| s.kind == SpanKind::Interpolated && s.end == 1)
+        );
+    }
+}

@@ -1,0 +1,90 @@
+//! The tracker's settings, each with its default and what it does (the GUI shows these as
+//! tooltips).
+
+use super::similarity::SimilarityWeights;
+use serde::{Deserialize, Serialize};
+
+/// Settings of the VBA tracker. Serialised as JSON (`--tracker-settings`); missing keys take
+/// their defaults.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TrackerParams {
+    /// Weights of the morph-block similarity (eqs. 3–5) and of the key-frame model.
+    pub weights: SimilarityWeights,
+    /// Spacing of the head's spiral search path, tracker pixels. Default 2.
+    pub head_step_px: f64,
+    /// Δθ of the head search, degrees. Default 6.
+    pub head_d_theta_deg: f64,
+    /// Δm of the head search, fraction of m. Default 0.06.
+    pub head_d_m: f64,
+    /// Most rings of the spiral path. Default 12.
+    pub head_max_rings: usize,
+    /// Half-range of the trunk's angle search around its prediction, degrees. Default 20.
+    pub trunk_range_deg: f64,
+    /// Half-range of the trunk's length search, fraction. Default 0.15.
+    pub trunk_range_m: f64,
+    /// Half-range of a limb's angle search around its prediction, degrees. Default 30.
+    pub limb_range_deg: f64,
+    /// Half-range of a limb's length search, fraction (foreshortening). Default 0.3.
+    pub limb_range_m: f64,
+    /// Half-range of the second, wide search when the narrow one finds only a weak match
+    /// (fast limbs), degrees. Default 100.
+    pub wide_range_deg: f64,
+    /// Angle step of the coarse scans, degrees. Default 3.
+    pub coarse_step_deg: f64,
+    /// Motion prior: cost (8-bit levels) added per degree an anchored block turns away from its
+    /// prediction. Default 0.1.
+    pub angle_penalty: f32,
+    /// Motion prior: cost added per unit of |ln(length / predicted length)|. Default 8.
+    pub length_penalty: f32,
+    /// How much of the last frame's angular velocity the prediction keeps. Default 0.7.
+    pub velocity_damping: f64,
+    /// Linear weight of the adaptive colour model's update per frame. Default 0.15.
+    pub update_rate: f32,
+    /// `c0` of the reliability `c0 / (c0 + cost)`: the cost (mean difference, 8-bit levels)
+    /// that maps to reliability 0.5. Default 20.
+    pub reliability_c0: f32,
+    /// Reliability below which a joint is weak: not learnt from, and filled by interpolation
+    /// when reliable frames surround it. Default 0.45.
+    pub weak_reliability: f32,
+    /// Longest run of weak frames filled by interpolation, seconds; longer runs are reported
+    /// and left as tracked. Default 0.5.
+    pub max_gap_s: f64,
+    /// The tracker works on frames shrunk by an integer factor so that the marked person is at
+    /// most this tall, pixels (speed on large videos; the sampling grids are capped anyway).
+    /// Default 480.
+    pub working_stature_px: f64,
+    /// Limb and head blocks are this many times the body part's breadth from the proportions,
+    /// so their margins (eq. 5's b2) hold the part's outline against the background. Default 1.5.
+    pub block_width_scale: f64,
+    /// Track the four limb chains in parallel.
+    pub parallel: bool,
+}
+
+impl Default for TrackerParams {
+    fn default() -> Self {
+        TrackerParams {
+            weights: SimilarityWeights::default(),
+            head_step_px: 2.0,
+            head_d_theta_deg: 6.0,
+            head_d_m: 0.06,
+            head_max_rings: 12,
+            trunk_range_deg: 20.0,
+            trunk_range_m: 0.15,
+            limb_range_deg: 30.0,
+            limb_range_m: 0.3,
+            wide_range_deg: 100.0,
+            coarse_step_deg: 3.0,
+            angle_penalty: 0.1,
+            length_penalty: 8.0,
+            velocity_damping: 0.7,
+            update_rate: 0.15,
+            reliability_c0: 20.0,
+            weak_reliability: 0.45,
+            max_gap_s: 0.5,
+            working_stature_px: 480.0,
+            block_width_scale: 1.5,
+            parallel: true,
+        }
+    }
+}

@@ -1,0 +1,541 @@
+//! Tracking a whole video: the passes over the frames, key frames, and the result.
+//!
+//! From the first key frame (the marks) a forward pass runs to the end and a backward pass to
+//! the start. Each later key frame (a frame where the user corrected joints) restarts the
+//! forward pass there with the corrected pose and fresh key-frame colour models, and a backward
+//! pass from it fills the weak frames before it, keeping for each joint and frame whichever pass
+//! is more reliable. Short weak runs are then interpolated with key frames as anchors
+//! ([`super::occlusion`]). Frames are decoded (and shrunk to the working scale) on a separate
+//! thread while the tracker works, unless one thread is asked for.
+
+use super::body::{BodyTracker, JointResult, stature_px};
+use super::occlusion::{WeakSpan, fill_weak_runs};
+use super::params::TrackerParams;
+use crate::formats::{FrameTracks, PointSource, SourceInfo, TrackedPoint, Tracks2d};
+use crate::skeleton::{JOINT_COUNT, Joint, PerJoint, Proportions};
+use crate::video::{Video, VideoError};
+use image::RgbImage;
+use nalgebra::Point2;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Hand-placed joints per frame: the marks, and every correction made since.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct KeyFrames {
+    /// Per frame index, the joints placed by hand there.
+    pub frames: BTreeMap<usize, PerJoint<Option<Point2<f64>>>>,
+}
+
+impl KeyFrames {
+    /// Key frames from marks (all 16 joints on one frame).
+    pub fn from_marks(marks: &crate::formats::Marks) -> KeyFrames {
+        let mut frames = BTreeMap::new();
+        frames.insert(marks.frame, marks.points.map(|_, p| Some(*p)));
+        KeyFrames { frames }
+    }
+
+    /// Places one joint by hand on a frame (that frame becomes a key frame for the joint).
+    pub fn set(&mut self, frame: usize, joint: Joint, pos: Point2<f64>) {
+        self.frames
+            .entry(frame)
+            .or_insert_with(|| PerJoint([None; JOINT_COUNT]))[joint] = Some(pos);
+    }
+
+    /// Whether a joint was placed by hand on a frame.
+    pub fn is_key(&self, frame: usize, joint: Joint) -> bool {
+        self.frames
+            .get(&frame)
+            .is_some_and(|joints| joints[joint].is_some())
+    }
+}
+
+/// Tracking could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum TrackError {
+    #[error(transparent)]
+    Video(#[from] VideoError),
+    #[error("{path}: has {frames} frame(s); tracking needs at least 2")]
+    TooShort { path: PathBuf, frames: usize },
+    #[error("no key frame with all 16 joints placed (mark the first frame fully)")]
+    NoFullKeyFrame,
+    #[error("key frame {frame} is past the end of {path} ({frames} frames)")]
+    KeyFrameOutOfRange {
+        path: PathBuf,
+        frame: usize,
+        frames: usize,
+    },
+    #[error("{path}: frame {frame} is {got_w}×{got_h} but the video is {width}×{height}")]
+    FrameSize {
+        path: PathBuf,
+        frame: usize,
+        got_w: u32,
+        got_h: u32,
+        width: u32,
+        height: u32,
+    },
+    #[error("re-tracking from frame {frame} needs an earlier result that covers it")]
+    NoEarlierResult { frame: usize },
+    #[error("cancelled")]
+    Cancelled,
+}
+
+/// What to track.
+#[derive(Debug, Clone)]
+pub struct TrackJob {
+    /// The marks and corrections.
+    pub keys: KeyFrames,
+    /// Settings.
+    pub params: TrackerParams,
+    /// Worker threads (1 = decode and track on the calling thread, limbs in sequence).
+    pub threads: usize,
+    /// Re-track from this frame on, keeping an earlier result before it (`None` = everything).
+    pub from: Option<usize>,
+    /// The earlier result (needed with `from`).
+    pub previous: Option<Tracks2d>,
+}
+
+/// Progress of a tracking run.
+#[derive(Debug, Clone)]
+pub struct TrackProgress {
+    /// Frames processed so far (over all passes).
+    pub done: usize,
+    /// Frames to process in all (an estimate: backward gap passes are added as found).
+    pub total: usize,
+    /// The frame just tracked (for drawing results as they arrive).
+    pub frame: Option<FrameTracks>,
+}
+
+/// The result: tracks and the report of weak spans.
+#[derive(Debug, Clone)]
+pub struct TrackOutput {
+    /// Tracks of every frame.
+    pub tracks: Tracks2d,
+    /// Every run of weak frames per joint, interpolated or left weak.
+    pub spans: Vec<WeakSpan>,
+    /// The integer shrink factor of the working scale.
+    pub shrink: u32,
+}
+
+/// Converts between video pixels and the working scale (pixel centres at integers).
+#[derive(Debug, Clone, Copy)]
+struct Scale {
+    sx: f64,
+    sy: f64,
+    width: u32,
+    height: u32,
+}
+
+impl Scale {
+    fn to_work(self, p: Point2<f64>) -> Point2<f64> {
+        Point2::new((p.x + 0.5) / self.sx - 0.5, (p.y + 0.5) / self.sy - 0.5)
+    }
+    fn to_video(self, p: Point2<f64>) -> Point2<f64> {
+        Point2::new((p.x + 0.5) * self.sx - 0.5, (p.y + 0.5) * self.sy - 0.5)
+    }
+    fn shrink(&self, image: Arc<RgbImage>) -> Arc<RgbImage> {
+        if self.width == image.width() && self.height == image.height() {
+            image
+        } else {
+            Arc::new(image::imageops::thumbnail(&*image, self.width, self.height))
+        }
+    }
+}
+
+/// Tracks the video from its key frames.
+pub fn track_video(
+    video: &mut Video,
+    job: &TrackJob,
+    progress: &mut (dyn FnMut(&TrackProgress) + Send),
+    cancel: &AtomicBool,
+) -> Result<TrackOutput, TrackError> {
+    let info = video.info().clone();
+    let n = info.frame_count;
+    if n < 2 {
+        return Err(TrackError::TooShort {
+            path: info.path.clone(),
+            frames: n,
+        });
+    }
+    if let Some((&frame, _)) = job.keys.frames.range(n..).next() {
+        return Err(TrackError::KeyFrameOutOfRange {
+            path: info.path.clone(),
+            frame,
+            frames: n,
+        });
+    }
+    let (first_key, first_pose) = job
+        .keys
+        .frames
+        .iter()
+        .find_map(|(f, joints)| {
+            let all: Option<Vec<Point2<f64>>> = joints.0.iter().copied().collect();
+            all.map(|v| (*f, PerJoint::from_fn(|j| v[j.index()])))
+        })
+        .ok_or(TrackError::NoFullKeyFrame)?;
+    let proportions = Proportions::default();
+    let stature = stature_px(&first_pose, &proportions);
+    let shrink = (stature / job.params.working_stature_px).ceil().max(1.0) as u32;
+    let (ww, wh) = ((info.width / shrink).max(2), (info.height / shrink).max(2));
+    let scale = Scale {
+        sx: f64::from(info.width) / f64::from(ww),
+        sy: f64::from(info.height) / f64::from(wh),
+        width: ww,
+        height: wh,
+    };
+    let mut params = job.params;
+    params.parallel = params.parallel && job.threads > 1;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(job.threads.max(1))
+        .build()
+        .ok();
+
+    // Per frame, the raw result in video pixels (None = not tracked yet).
+    let mut raw: Vec<Option<PerJoint<JointResult>>> = vec![None; n];
+    let start = match job.from {
+        Some(from) => {
+            let prev = job
+                .previous
+                .as_ref()
+                .filter(|p| p.frames.len() == n && from < n)
+                .ok_or(TrackError::NoEarlierResult { frame: from })?;
+            for f in &prev.frames[..from] {
+                raw[f.index] = Some(f.points.map(|_, p| JointResult {
+                    pos: p.pos,
+                    reliability: p.confidence,
+                }));
+            }
+            from
+        }
+        None => first_key,
+    };
+    let mut ctx = PassContext {
+        video,
+        scale,
+        params,
+        keys: &job.keys,
+        path: info.path.clone(),
+        width: info.width,
+        height: info.height,
+        threads: job.threads,
+        done: 0,
+        total: (n - start) + if job.from.is_none() { first_key } else { 0 },
+        progress,
+        cancel,
+    };
+    let start_pose = |raw: &[Option<PerJoint<JointResult>>], f: usize| -> PerJoint<Point2<f64>> {
+        let base = raw[f].map(|r| r.map(|_, j| j.pos)).unwrap_or(first_pose);
+        keyed(&base, &job.keys, f)
+    };
+    let run = |ctx: &mut PassContext, raw: &mut Vec<Option<PerJoint<JointResult>>>| {
+        // Forward from the start to the end, re-keyed at every key frame on the way.
+        let pose = if job.from.is_some() {
+            start_pose(raw, start)
+        } else {
+            first_pose
+        };
+        let forward: Vec<usize> = (start..n).collect();
+        let results = ctx.pass(&forward, &pose, true)?;
+        for (f, r) in forward.iter().zip(results) {
+            raw[*f] = Some(r);
+        }
+        // Backward from the first key frame to the start.
+        if job.from.is_none() && first_key > 0 {
+            let backward: Vec<usize> = (0..=first_key).rev().collect();
+            let results = ctx.pass(&backward, &first_pose, false)?;
+            for (f, r) in backward.iter().zip(results).skip(1) {
+                raw[*f] = Some(r);
+            }
+        }
+        // Backward gap passes from each later key frame over the weak frames before it.
+        let keys: Vec<usize> = job.keys.frames.keys().copied().collect();
+        for w in keys.windows(2) {
+            let (lo, hi) = (w[0], w[1]);
+            if hi <= start.max(lo) {
+                continue;
+            }
+            let weak_first = (lo + 1..hi).find(|&f| {
+                raw[f].is_some_and(|r| {
+                    r.0.iter()
+                        .any(|j| j.reliability < ctx.params.weak_reliability)
+                })
+            });
+            let Some(from) = weak_first else { continue };
+            let backward: Vec<usize> = (from..=hi).rev().collect();
+            ctx.total += backward.len();
+            let pose = start_pose(raw, hi);
+            let results = ctx.pass(&backward, &pose, false)?;
+            for (f, r) in backward.iter().zip(results).skip(1) {
+                if let Some(old) = raw[*f].as_mut() {
+                    for j in Joint::ALL {
+                        if r[j].reliability > old[j].reliability {
+                            old[j] = r[j];
+                        }
+                    }
+                }
+            }
+        }
+        Ok::<(), TrackError>(())
+    };
+    match &pool {
+        Some(pool) => pool.install(|| run(&mut ctx, &mut raw))?,
+        None => run(&mut ctx, &mut raw)?,
+    }
+
+    let mut frames: Vec<FrameTracks> = raw
+        .into_iter()
+        .enumerate()
+        .map(|(index, r)| FrameTracks {
+            index,
+            points: r
+                .unwrap_or_else(|| {
+                    first_pose.map(|_, p| JointResult {
+                        pos: *p,
+                        reliability: 0.0,
+                    })
+                })
+                .map(|j, r| TrackedPoint {
+                    pos: job
+                        .keys
+                        .frames
+                        .get(&index)
+                        .and_then(|k| k[j])
+                        .unwrap_or(r.pos),
+                    confidence: if job.keys.is_key(index, j) {
+                        1.0
+                    } else {
+                        r.reliability
+                    },
+                    source: PointSource::Tracked,
+                }),
+        })
+        .collect();
+    let max_gap = (job.params.max_gap_s * info.fps).round().max(1.0) as usize;
+    let spans = fill_weak_runs(
+        &mut frames,
+        job.params.weak_reliability,
+        max_gap,
+        &|i, j| job.keys.is_key(i, j),
+    );
+    Ok(TrackOutput {
+        tracks: Tracks2d {
+            source: SourceInfo {
+                path: info.path.clone(),
+                width: info.width,
+                height: info.height,
+                fps: info.fps,
+                frame_count: n,
+            },
+            frames,
+        },
+        spans,
+        shrink,
+    })
+}
+
+/// A pose with the joints placed by hand on frame `f` put in.
+fn keyed(base: &PerJoint<Point2<f64>>, keys: &KeyFrames, f: usize) -> PerJoint<Point2<f64>> {
+    match keys.frames.get(&f) {
+        Some(k) => base.map(|j, p| k[j].unwrap_or(*p)),
+        None => *base,
+    }
+}
+
+struct PassContext<'a, 'p> {
+    video: &'a mut Video,
+    scale: Scale,
+    params: TrackerParams,
+    keys: &'a KeyFrames,
+    path: PathBuf,
+    width: u32,
+    height: u32,
+    threads: usize,
+    done: usize,
+    total: usize,
+    progress: &'p mut (dyn FnMut(&TrackProgress) + Send),
+    cancel: &'a AtomicBool,
+}
+
+impl PassContext<'_, '_> {
+    /// Tracks over `order` (consecutive frames, forwards or backwards), starting from `pose` on
+    /// its first frame; returns the results in video pixels, one per frame of `order` (the
+    /// first is the starting pose). Forward passes re-key at key frames on the way.
+    fn pass(
+        &mut self,
+        order: &[usize],
+        pose: &PerJoint<Point2<f64>>,
+        rekey: bool,
+    ) -> Result<Vec<PerJoint<JointResult>>, TrackError> {
+        let scale = self.scale;
+        let params = self.params;
+        let keys = self.keys;
+        let cancel = self.cancel;
+        let (path, width, height) = (self.path.clone(), self.width, self.height);
+        let to_video = |r: PerJoint<JointResult>| {
+            r.map(|_, j| JointResult {
+                pos: scale.to_video(j.pos),
+                reliability: j.reliability,
+            })
+        };
+        let mut out = Vec::with_capacity(order.len());
+        let mut tracker: Option<BodyTracker> = None;
+        let proportions = Proportions::default();
+        let check = |index: usize, image: &RgbImage| {
+            if image.width() != width || image.height() != height {
+                Err(TrackError::FrameSize {
+                    path: path.clone(),
+                    frame: index,
+                    got_w: image.width(),
+                    got_h: image.height(),
+                    width,
+                    height,
+                })
+            } else {
+                Ok(())
+            }
+        };
+        let mut handle = |ctx_done: &mut usize,
+                          index: usize,
+                          image: Arc<RgbImage>|
+         -> Result<PerJoint<JointResult>, TrackError> {
+            if cancel.load(Ordering::Relaxed) {
+                return Err(TrackError::Cancelled);
+            }
+            let result = match tracker.as_mut() {
+                None => {
+                    let work = pose.map(|_, p| scale.to_work(*p));
+                    let t = BodyTracker::new(image, &work, &proportions, params);
+                    let mut r = t.pose();
+                    for j in Joint::ALL {
+                        r[j].reliability = 1.0;
+                    }
+                    tracker = Some(t);
+                    r
+                }
+                Some(t) => {
+                    let mut r = t.step(Arc::clone(&image));
+                    if rekey && keys.frames.contains_key(&index) {
+                        let tracked = r.map(|_, j| j.pos);
+                        let work_keys = keys.frames[&index].map(|_, k| k.map(|p| scale.to_work(p)));
+                        let fixed = tracked.map(|j, p| work_keys[j].unwrap_or(*p));
+                        *t = BodyTracker::new(image, &fixed, &proportions, params);
+                        for j in Joint::ALL {
+                            if work_keys[j].is_some() {
+                                r[j] = JointResult {
+                                    pos: fixed[j],
+                                    reliability: 1.0,
+                                };
+                            }
+                        }
+                    }
+                    r
+                }
+            };
+            *ctx_done += 1;
+            Ok(to_video(result))
+        };
+        let mut done = self.done;
+        let total = self.total;
+        let progress = &mut *self.progress;
+        let mut emit = |done: usize, index: usize, r: &PerJoint<JointResult>| {
+            progress(&TrackProgress {
+                done,
+                total,
+                frame: Some(FrameTracks {
+                    index,
+                    points: r.map(|_, j| TrackedPoint {
+                        pos: j.pos,
+                        confidence: j.reliability,
+                        source: PointSource::Tracked,
+                    }),
+                }),
+            });
+        };
+        if self.threads <= 1 {
+            for &index in order {
+                let frame = self.video.frame(index)?;
+                check(index, &frame.image)?;
+                let r = handle(&mut done, index, scale.shrink(frame.image))?;
+                emit(done, index, &r);
+                out.push(r);
+            }
+        } else {
+            // Decode (and shrink) ahead on another thread.
+            let video = &mut *self.video;
+            let order_owned = order.to_vec();
+            let stop_flag = AtomicBool::new(false);
+            let stop = &stop_flag;
+            std::thread::scope(|s| -> Result<(), TrackError> {
+                let (tx, rx) =
+                    std::sync::mpsc::sync_channel::<Result<(usize, Arc<RgbImage>), TrackError>>(6);
+                s.spawn(move || {
+                    for chunk in decode_order(&order_owned) {
+                        let mut images = Vec::with_capacity(chunk.decode.len());
+                        for &index in &chunk.decode {
+                            if stop.load(Ordering::Relaxed) {
+                                return;
+                            }
+                            let item =
+                                video
+                                    .frame(index)
+                                    .map_err(TrackError::from)
+                                    .and_then(|frame| {
+                                        check(index, &frame.image)?;
+                                        Ok((index, scale.shrink(frame.image)))
+                                    });
+                            images.push(item);
+                        }
+                        if chunk.reverse {
+                            images.reverse();
+                        }
+                        for item in images {
+                            if tx.send(item).is_err() {
+                                return;
+                            }
+                        }
+                    }
+                });
+                let result = (|| {
+                    for _ in 0..order.len() {
+                        let (index, image) = rx.recv().map_err(|_| TrackError::Cancelled)??;
+                        let r = handle(&mut done, index, image)?;
+                        emit(done, index, &r);
+                        out.push(r);
+                    }
+                    Ok(())
+                })();
+                stop.store(true, Ordering::Relaxed);
+                drop(rx);
+                result
+            })?;
+        }
+        self.done = done;
+        Ok(out)
+    }
+}
+
+/// A run of frames the decoder reads forwards, sent in reverse for backward passes.
+struct DecodeChunk {
+    decode: Vec<usize>,
+    reverse: bool,
+}
+
+/// Splits a pass's frame order into decoder-friendly chunks (backward passes decode 32 frames
+/// forwards at a time and hand them over in reverse).
+fn decode_order(order: &[usize]) -> Vec<DecodeChunk> {
+    let backward = order.len() > 1 && order[1] < order[0];
+    if !backward {
+        return vec![DecodeChunk {
+            decode: order.to_vec(),
+            reverse: false,
+        }];
+    }
+    order
+        .chunks(32)
+        .map(|c| DecodeChunk {
+            decode: c.iter().rev().copied().collect(),
+            reverse: true,
+        })
+        .collect()
+}

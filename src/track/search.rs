@@ -1,0 +1,420 @@
+//! Where to look for a block in the next frame: the spiral search path of the head (Pan et al.,
+//! Fig. 6) and the angular search of blocks anchored at a tracked parent joint (trunk, limbs).
+//! Both end with a local refinement that halves its steps down to sub-pixel size.
+
+use super::block::{MorphBlock, wrap_angle};
+use super::similarity::{FrameView, Template};
+use nalgebra::Vector2;
+
+/// The best block found and its cost.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Found {
+    /// The block.
+    pub block: MorphBlock,
+    /// Its cost: the appearance cost (mean weighted difference, 8-bit levels) plus the prior's
+    /// penalty.
+    pub cost: f32,
+}
+
+/// A soft motion prior on anchored blocks (beyond the paper): a penalty, in the cost's units,
+/// for turning away from the predicted angle and for changing length, and hard bounds on the
+/// length from the body's proportions. Without it a uniformly coloured limb slides or shrinks
+/// along flat stretches of the cost surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Prior {
+    /// Predicted angle, radians.
+    pub theta: f64,
+    /// Predicted length, pixels.
+    pub m: f64,
+    /// Penalty per degree away from the predicted angle.
+    pub per_degree: f32,
+    /// Penalty per unit of |ln(m / predicted m)|.
+    pub per_log_length: f32,
+    /// Shortest allowed length, pixels.
+    pub m_min: f64,
+    /// Longest allowed length, pixels.
+    pub m_max: f64,
+}
+
+impl Prior {
+    /// No prior.
+    pub const NONE: Prior = Prior {
+        theta: 0.0,
+        m: 1.0,
+        per_degree: 0.0,
+        per_log_length: 0.0,
+        m_min: 0.0,
+        m_max: f64::INFINITY,
+    };
+
+    /// The penalty of a candidate (infinite outside the length bounds).
+    pub fn penalty(&self, b: &MorphBlock) -> f32 {
+        if b.m < self.m_min || b.m > self.m_max {
+            return f32::INFINITY;
+        }
+        let mut p = 0.0f32;
+        if self.per_degree > 0.0 {
+            p += self.per_degree * wrap_angle(b.theta - self.theta).abs().to_degrees() as f32;
+        }
+        if self.per_log_length > 0.0 && self.m > 0.0 {
+            p += self.per_log_length * (b.m / self.m).ln().abs() as f32;
+        }
+        p
+    }
+}
+
+/// Appearance cost plus prior, with early exit against `bound`.
+fn total_cost(
+    template: &Template,
+    frame: FrameView,
+    b: &MorphBlock,
+    prior: &Prior,
+    coarse: bool,
+    bound: f32,
+) -> f32 {
+    let pen = prior.penalty(b);
+    if pen >= bound {
+        return f32::INFINITY;
+    }
+    template.cost(frame, b, coarse, bound - pen) + pen
+}
+
+/// Ranges of the spiral search (the paper's Δθ and Δm).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpiralParams {
+    /// Distance between neighbouring points of the path, pixels.
+    pub step_px: f64,
+    /// Δθ: each point is tried at θ − Δθ, θ and θ + Δθ, radians.
+    pub d_theta: f64,
+    /// Δm as a fraction of m: each point is tried at m − Δm, m and m + Δm (n in proportion).
+    pub d_m: f64,
+    /// Most rings walked (a bound on the time spent on a lost head).
+    pub max_rings: usize,
+}
+
+/// The morph variants tried at each point of the spiral: {θ−Δθ, θ, θ+Δθ} × {m−Δm, m, m+Δm},
+/// n scaled with m (the head zooms as a whole).
+fn variants(b: &MorphBlock, p: &SpiralParams) -> [MorphBlock; 9] {
+    let mut out = [*b; 9];
+    let mut k = 0;
+    for dt in [0.0, -p.d_theta, p.d_theta] {
+        for dm in [0.0, -p.d_m, p.d_m] {
+            let s = 1.0 + dm;
+            out[k] = MorphBlock {
+                m: b.m * s,
+                n: b.n * s,
+                theta: b.theta + dt,
+                ..*b
+            };
+            k += 1;
+        }
+    }
+    out
+}
+
+/// The spiral search of Fig. 6 around `predicted` (origin, m, n, θ): ring by ring outwards,
+/// stopping after the first ring that finds nothing better than the best so far; then a local
+/// refinement of position, angle and size down to a quarter of a pixel.
+pub fn spiral(
+    template: &Template,
+    frame: FrameView,
+    predicted: &MorphBlock,
+    p: &SpiralParams,
+) -> Found {
+    let mut best = Found {
+        block: *predicted,
+        cost: f32::INFINITY,
+    };
+    let try_point = |origin: nalgebra::Point2<f64>, base: &MorphBlock, best: &mut Found| {
+        let at = MorphBlock { origin, ..*base };
+        let mut improved = false;
+        for v in variants(&at, p) {
+            let c = template.cost(frame, &v, false, best.cost);
+            if c < best.cost {
+                *best = Found { block: v, cost: c };
+                improved = true;
+            }
+        }
+        improved
+    };
+    try_point(predicted.origin, predicted, &mut best);
+    for ring in 1..=p.max_rings {
+        let r = ring as i64;
+        let mut improved = false;
+        // The square ring at Chebyshev distance r, walked clockwise from its top-left corner.
+        for k in 0..(8 * r) {
+            let side = k / (2 * r);
+            let t = k % (2 * r);
+            let (dx, dy) = match side {
+                0 => (-r + t, -r),
+                1 => (r, -r + t),
+                2 => (r - t, r),
+                _ => (-r, r - t),
+            };
+            let o = predicted.origin + Vector2::new(dx as f64, dy as f64) * p.step_px;
+            improved |= try_point(o, predicted, &mut best);
+        }
+        if !improved {
+            break;
+        }
+    }
+    refine(
+        template,
+        frame,
+        best,
+        &Steps {
+            position: p.step_px / 2.0,
+            theta: p.d_theta / 2.0,
+            scale: p.d_m / 2.0,
+            scale_width: true,
+            move_origin: true,
+            levels: 3,
+        },
+        &Prior::NONE,
+    )
+}
+
+/// Step sizes of a local refinement.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Steps {
+    /// First position step, pixels.
+    pub position: f64,
+    /// First angle step, radians.
+    pub theta: f64,
+    /// First relative length step.
+    pub scale: f64,
+    /// Whether the width scales with the length (head) or stays (limbs: foreshortening shortens
+    /// a limb's image, not its width).
+    pub scale_width: bool,
+    /// Whether the origin may move (free blocks) or is a fixed parent joint (anchored blocks).
+    pub move_origin: bool,
+    /// How many times the steps are halved.
+    pub levels: usize,
+}
+
+/// Coordinate descent from `start`: tries ± each step on each free parameter until nothing
+/// improves, then halves the steps.
+pub fn refine(
+    template: &Template,
+    frame: FrameView,
+    start: Found,
+    s: &Steps,
+    prior: &Prior,
+) -> Found {
+    let mut best = start;
+    let (mut dp, mut dt, mut ds) = (s.position, s.theta, s.scale);
+    for _ in 0..s.levels {
+        for _ in 0..8 {
+            let b = best.block;
+            let mut cands: [Option<MorphBlock>; 8] = [None; 8];
+            cands[0] = Some(MorphBlock {
+                theta: b.theta + dt,
+                ..b
+            });
+            cands[1] = Some(MorphBlock {
+                theta: b.theta - dt,
+                ..b
+            });
+            for (k, f) in [(2, 1.0 + ds), (3, 1.0 / (1.0 + ds))] {
+                cands[k] = Some(MorphBlock {
+                    m: b.m * f,
+                    n: if s.scale_width { b.n * f } else { b.n },
+                    ..b
+                });
+            }
+            if s.move_origin {
+                for (k, d) in [
+                    (4, (dp, 0.0)),
+                    (5, (-dp, 0.0)),
+                    (6, (0.0, dp)),
+                    (7, (0.0, -dp)),
+                ] {
+                    cands[k] = Some(MorphBlock {
+                        origin: b.origin + Vector2::new(d.0, d.1),
+                        ..b
+                    });
+                }
+            }
+            let mut improved = false;
+            for c in cands.into_iter().flatten() {
+                let cost = total_cost(template, frame, &c, prior, false, best.cost);
+                if cost < best.cost {
+                    best = Found { block: c, cost };
+                    improved = true;
+                }
+            }
+            if !improved {
+                break;
+            }
+        }
+        dp /= 2.0;
+        dt /= 2.0;
+        ds /= 2.0;
+    }
+    best
+}
+
+/// Ranges of the search of an anchored block.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AngularParams {
+    /// Half-width of the angle range around the predicted angle, radians.
+    pub range_theta: f64,
+    /// Angle step of the coarse scan, radians.
+    pub step_theta: f64,
+    /// Half-width of the relative length range around the predicted length.
+    pub range_m: f64,
+    /// Number of lengths scanned across that range (odd).
+    pub m_count: usize,
+    /// Whether the width scales with the length.
+    pub scale_width: bool,
+}
+
+/// Searches a block anchored at a fixed joint: a coarse scan of angle × length on the coarse
+/// grid, then a refinement of the three best on the full grid.
+pub fn angular(
+    template: &Template,
+    frame: FrameView,
+    predicted: &MorphBlock,
+    p: &AngularParams,
+    prior: &Prior,
+) -> Found {
+    const KEEP: usize = 3;
+    let mut top: [Found; KEEP] = [Found {
+        block: *predicted,
+        cost: f32::INFINITY,
+    }; KEEP];
+    let steps = (p.range_theta / p.step_theta).ceil().max(0.0) as i64;
+    let half_m = (p.m_count / 2) as i64;
+    for k in -steps..=steps {
+        let theta = predicted.theta + k as f64 * p.step_theta;
+        for mi in -half_m..=half_m {
+            let f = if half_m == 0 {
+                1.0
+            } else {
+                1.0 + p.range_m * mi as f64 / half_m as f64
+            };
+            let b = MorphBlock {
+                theta,
+                m: predicted.m * f,
+                n: if p.scale_width {
+                    predicted.n * f
+                } else {
+                    predicted.n
+                },
+                ..*predicted
+            };
+            let worst = top[KEEP - 1].cost;
+            let c = total_cost(template, frame, &b, prior, true, worst);
+            if c < worst {
+                top[KEEP - 1] = Found { block: b, cost: c };
+                top.sort_by(|a, b| a.cost.total_cmp(&b.cost));
+            }
+        }
+    }
+    let steps = Steps {
+        position: 0.0,
+        theta: p.step_theta / 2.0,
+        scale: (p.range_m / half_m.max(1) as f64 / 2.0).max(0.01),
+        scale_width: p.scale_width,
+        move_origin: false,
+        levels: 4,
+    };
+    let mut best = Found {
+        block: *predicted,
+        cost: f32::INFINITY,
+    };
+    for t in top.iter().filter(|t| t.cost.is_finite()) {
+        let start = Found {
+            block: t.block,
+            cost: total_cost(template, frame, &t.block, prior, false, f32::INFINITY),
+        };
+        let r = refine(template, frame, start, &steps, prior);
+        if r.cost < best.cost {
+            best = r;
+        }
+    }
+    if !best.cost.is_finite() {
+        best.cost = total_cost(template, frame, predicted, prior, false, f32::INFINITY);
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::track::similarity::{Extent, SimilarityWeights};
+    use image::{Rgb, RgbImage};
+    use nalgebra::Point2;
+
+    /// A textured bar from `a` to `b` over a differently textured background.
+    fn bar(a: Point2<f64>, b: Point2<f64>, width: f64) -> RgbImage {
+        let block = MorphBlock::along(a, b, width);
+        RgbImage::from_fn(160, 160, |x, y| {
+            let p = Point2::new(f64::from(x), f64::from(y));
+            let (u, v) = block.to_block(p);
+            if (0.0..=1.0).contains(&u) && v.abs() <= 0.5 {
+                let s = ((u * 6.0).floor() as i64 + (v * 4.0 + 2.0).floor() as i64) & 1;
+                Rgb([180 + 40 * s as u8, 60, 60 + 80 * s as u8])
+            } else {
+                let s = ((x / 7 + y / 5) & 1) as u8;
+                Rgb([70 + 30 * s, 110, 90 + 20 * s])
+            }
+        })
+    }
+
+    #[test]
+    fn the_angular_search_finds_a_turned_and_shortened_limb() {
+        let shoulder = Point2::new(80.0, 40.0);
+        let a = bar(shoulder, Point2::new(80.0, 110.0), 16.0);
+        let truth = Point2::new(80.0 + 50.0 * 0.5f64.sin(), 40.0 + 50.0 * 0.5f64.cos()); // 29° turn, shortened
+        let b = bar(shoulder, truth, 16.0);
+        let block = MorphBlock::along(shoulder, Point2::new(80.0, 110.0), 16.0);
+        let t = Template::sample(
+            FrameView::new(&a),
+            &block,
+            Extent::BLOCK,
+            SimilarityWeights::default(),
+        );
+        let found = angular(
+            &t,
+            FrameView::new(&b),
+            &block,
+            &AngularParams {
+                range_theta: 0.7,
+                step_theta: 0.05,
+                range_m: 0.35,
+                m_count: 5,
+                scale_width: false,
+            },
+            &Prior::NONE,
+        );
+        let err = (found.block.end() - truth).norm();
+        assert!(err < 2.0, "elbow off by {err} px");
+    }
+
+    #[test]
+    fn the_spiral_search_follows_a_moved_block() {
+        let a = bar(Point2::new(60.0, 50.0), Point2::new(70.0, 100.0), 20.0);
+        let b = bar(Point2::new(66.0, 46.0), Point2::new(76.0, 96.0), 20.0);
+        let block = MorphBlock::along(Point2::new(60.0, 50.0), Point2::new(70.0, 100.0), 20.0);
+        let t = Template::sample(
+            FrameView::new(&a),
+            &block,
+            Extent::BLOCK,
+            SimilarityWeights::default(),
+        );
+        let found = spiral(
+            &t,
+            FrameView::new(&b),
+            &block,
+            &SpiralParams {
+                step_px: 2.0,
+                d_theta: 0.05,
+                d_m: 0.05,
+                max_rings: 10,
+            },
+        );
+        let err = (found.block.origin - Point2::new(66.0, 46.0)).norm();
+        assert!(err < 1.0, "origin off by {err} px");
+    }
+}

@@ -1,0 +1,492 @@
+//! Sub-pixel morph-block similarity (Pan et al., "Morph-block match", eqs. 3–5 of the
+//! feature-tracking section) — the tracker's hot loop.
+//!
+//! A [`Template`] is the colour model of a block: `rows × cols` sub-pixels laid along θ and
+//! θ + 90°, each the bilinear interpolation of the image at that point. A candidate block of any
+//! size and angle is sampled on the same grid (the paper's "row = m, column = n of the smaller
+//! block"; the grid is capped at [`MAX_ROWS`] × [`MAX_COLS`] so the cost per candidate does not
+//! grow with the image size) and compared cell by cell:
+//!
+//! - eq. 3: `diff_ij = W_R·|ΔR| + W_G·|ΔG| + W_B·|ΔB|`
+//! - eq. 5: cells with `m/4 ≤ i ≤ 3m/4` and `n/4 ≤ j ≤ 3n/4` form the centre region b1, the
+//!   rest the margin b2
+//! - eq. 4: `S = 1 / (W1·Σ_b1 diff + W2·Σ_b2 diff)`.
+//!
+//! We return the *cost* `C = (W1·Σ_b1 diff + W2·Σ_b2 diff) / (W1·|b1| + W2·|b2|)`, the mean
+//! weighted difference in 8-bit levels: `S = 1 / (C · const)`, so the ranking is the paper's, but
+//! the number means the same for every block size. Beyond the paper, each cell is compared with
+//! two colour models at once — the key frame's appearance (drift control) and the adaptive model
+//! updated with a linear weight (Akita 1984) — mixed by [`SimilarityWeights::key`].
+
+use super::block::MorphBlock;
+use image::RgbImage;
+
+/// Most rows in a block's sampling grid.
+pub const MAX_ROWS: usize = 24;
+/// Most columns in a block's sampling grid.
+pub const MAX_COLS: usize = 10;
+
+/// The weights of eqs. 3–5 and of the colour-model mix.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SimilarityWeights {
+    /// `W_R, W_G, W_B` of eq. 3. Default equal thirds: clothes and skin differ as much in hue as
+    /// in brightness, so no channel is favoured.
+    pub rgb: [f32; 3],
+    /// `W1`, the centre region's weight (eq. 4). Default 1.0.
+    pub centre: f32,
+    /// `W2`, the margin region's weight (eq. 4); `W1 > W2` as in the paper because the margin
+    /// mixes in background that changes as the body moves. Default 0.5.
+    pub margin: f32,
+    /// Weight of the key-frame model against the adaptive one (0 = adaptive only, 1 = key only).
+    /// Default 0.5.
+    pub key: f32,
+}
+
+impl Default for SimilarityWeights {
+    fn default() -> Self {
+        SimilarityWeights {
+            rgb: [1.0 / 3.0; 3],
+            centre: 1.0,
+            margin: 0.5,
+            key: 0.5,
+        }
+    }
+}
+
+/// A read-only view of an RGB8 frame for bilinear sampling.
+#[derive(Clone, Copy)]
+pub struct FrameView<'a> {
+    data: &'a [u8],
+    width: usize,
+    height: usize,
+}
+
+impl<'a> FrameView<'a> {
+    /// Wraps an image.
+    pub fn new(image: &'a RgbImage) -> FrameView<'a> {
+        FrameView {
+            data: image.as_raw(),
+            width: image.width() as usize,
+            height: image.height() as usize,
+        }
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// The colour at a sub-pixel position by bilinear interpolation; points off the image take
+    /// the nearest edge pixel's colour.
+    #[inline]
+    pub fn bilinear(&self, x: f32, y: f32) -> [f32; 3] {
+        let xmax = (self.width - 1) as f32;
+        let ymax = (self.height - 1) as f32;
+        let x = x.clamp(0.0, xmax);
+        let y = y.clamp(0.0, ymax);
+        let x0 = x as usize; // x ≥ 0, so truncation is floor
+        let y0 = y as usize;
+        let fx = x - x0 as f32;
+        let fy = y - y0 as f32;
+        let x1 = (x0 + 1).min(self.width - 1);
+        let y1 = (y0 + 1).min(self.height - 1);
+        let row0 = y0 * self.width;
+        let row1 = y1 * self.width;
+        let d = self.data;
+        let (a, b, c, e) = (
+            (row0 + x0) * 3,
+            (row0 + x1) * 3,
+            (row1 + x0) * 3,
+            (row1 + x1) * 3,
+        );
+        let mut out = [0.0f32; 3];
+        for (k, o) in out.iter_mut().enumerate() {
+            let top = f32::from(d[a + k]) + fx * (f32::from(d[b + k]) - f32::from(d[a + k]));
+            let bottom = f32::from(d[c + k]) + fx * (f32::from(d[e + k]) - f32::from(d[c + k]));
+            *o = top + fy * (bottom - top);
+        }
+        out
+    }
+
+    /// Colour at an integer pixel, as floats (caller keeps `x < width`, `y < height`).
+    #[inline]
+    pub fn pixel(&self, x: usize, y: usize) -> [f32; 3] {
+        let i = (y * self.width + x) * 3;
+        [
+            f32::from(self.data[i]),
+            f32::from(self.data[i + 1]),
+            f32::from(self.data[i + 2]),
+        ]
+    }
+}
+
+/// Where the grid's cells sit for one candidate block: cell `(i, j)` is at
+/// `start + i·du + j·dv`.
+#[derive(Clone, Copy)]
+struct GridGeometry {
+    start: [f32; 2],
+    du: [f32; 2],
+    dv: [f32; 2],
+}
+
+impl GridGeometry {
+    fn new(block: &MorphBlock, extent: Extent, rows: usize, cols: usize) -> GridGeometry {
+        let span = extent.end - extent.start;
+        let d = block.direction() * (block.m * span / rows as f64);
+        let a = block.across() * (block.n / cols as f64);
+        // Cell centres: u = start + (i + ½)·span/rows, v = (j + ½)/cols − ½.
+        let s = block.origin
+            + block.direction() * (block.m * extent.start)
+            + d * 0.5
+            + a * (0.5 - cols as f64 / 2.0);
+        GridGeometry {
+            start: [s.x as f32, s.y as f32],
+            du: [d.x as f32, d.y as f32],
+            dv: [a.x as f32, a.y as f32],
+        }
+    }
+}
+
+/// How far along the middle line the sampled area runs, in units of `m`: from `start` (0 = the
+/// anchor joint) to `end` (1 = the other joint). Beyond the paper, limb blocks reach a little
+/// past their far joint so the boundary there (hand, shoe, background) pins the joint down; a
+/// block that stops exactly at a joint of a uniformly coloured limb can shrink along it at no
+/// cost.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Extent {
+    /// Start, units of m.
+    pub start: f64,
+    /// End, units of m.
+    pub end: f64,
+}
+
+impl Extent {
+    /// Exactly the block (the paper's).
+    pub const BLOCK: Extent = Extent {
+        start: 0.0,
+        end: 1.0,
+    };
+}
+
+/// The colour model of one block: `rows × cols` cells, each with its key-frame colour, its
+/// adaptive colour and its region weight (eq. 5).
+#[derive(Debug, Clone)]
+pub struct Template {
+    rows: usize,
+    cols: usize,
+    /// Per cell: key R, G, B, adaptive R, G, B.
+    cells: Vec<[f32; 6]>,
+    /// Per cell: `W1` in the centre region, `W2` in the margin (eq. 5).
+    region: Vec<f32>,
+    /// Sum of the region weights over all cells, and over the even rows and columns only (the
+    /// coarse level).
+    total: [f32; 2],
+    weights: SimilarityWeights,
+    extent: Extent,
+}
+
+/// Grid size for a block of `m × n` pixels: one cell per pixel, capped.
+pub fn grid_size(m: f64, n: f64) -> (usize, usize) {
+    let rows = (m.round() as usize).clamp(4, MAX_ROWS);
+    let cols = (n.round() as usize).clamp(3, MAX_COLS);
+    (rows, cols)
+}
+
+impl Template {
+    /// Samples a block of `frame` as both the key and the adaptive model.
+    pub fn sample(
+        frame: FrameView,
+        block: &MorphBlock,
+        extent: Extent,
+        weights: SimilarityWeights,
+    ) -> Template {
+        let (rows, cols) = grid_size(block.m * (extent.end - extent.start), block.n);
+        let mut region = Vec::with_capacity(rows * cols);
+        let (mut all, mut coarse) = (0.0f32, 0.0f32);
+        for i in 0..rows {
+            for j in 0..cols {
+                // eq. 5, in cell units: centre when m/4 ≤ i ≤ 3m/4 and n/4 ≤ j ≤ 3n/4.
+                let (fi, fj) = (i as f32 + 0.5, j as f32 + 0.5);
+                let centre = fi >= rows as f32 / 4.0
+                    && fi <= 0.75 * rows as f32
+                    && fj >= cols as f32 / 4.0
+                    && fj <= 0.75 * cols as f32;
+                let w = if centre {
+                    weights.centre
+                } else {
+                    weights.margin
+                };
+                region.push(w);
+                all += w;
+                if i % 2 == 0 && j % 2 == 0 {
+                    coarse += w;
+                }
+            }
+        }
+        let mut t = Template {
+            rows,
+            cols,
+            cells: vec![[0.0; 6]; rows * cols],
+            region,
+            total: [all, coarse],
+            weights,
+            extent,
+        };
+        let g = GridGeometry::new(block, extent, rows, cols);
+        for i in 0..rows {
+            for j in 0..cols {
+                let c = sample_cell(frame, &g, i, j);
+                t.cells[i * cols + j] = [c[0], c[1], c[2], c[0], c[1], c[2]];
+            }
+        }
+        t
+    }
+
+    /// Rows of the grid.
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Columns of the grid.
+    pub fn cols(&self) -> usize {
+        self.cols
+    }
+
+    /// The key-frame colour of cell `(i, j)`.
+    pub fn key_colour(&self, i: usize, j: usize) -> [f32; 3] {
+        let c = self.cells[i * self.cols + j];
+        [c[0], c[1], c[2]]
+    }
+
+    /// The adaptive colour of cell `(i, j)`.
+    pub fn adaptive_colour(&self, i: usize, j: usize) -> [f32; 3] {
+        let c = self.cells[i * self.cols + j];
+        [c[3], c[4], c[5]]
+    }
+
+    /// The region weight (W1 or W2) of cell `(i, j)`.
+    pub fn region_weight(&self, i: usize, j: usize) -> f32 {
+        self.region[i * self.cols + j]
+    }
+
+    /// The sampled extent along the middle line.
+    pub fn extent(&self) -> Extent {
+        self.extent
+    }
+
+    /// The weights in use.
+    pub fn weights(&self) -> SimilarityWeights {
+        self.weights
+    }
+
+    /// Updates the adaptive model with the block found in a new frame by a linear weight:
+    /// `model ← (1 − rate)·model + rate·observed` (the paper's self-adapting colour model).
+    pub fn update(&mut self, frame: FrameView, block: &MorphBlock, rate: f32) {
+        let g = GridGeometry::new(block, self.extent, self.rows, self.cols);
+        for i in 0..self.rows {
+            for j in 0..self.cols {
+                let c = sample_cell(frame, &g, i, j);
+                let cell = &mut self.cells[i * self.cols + j];
+                for k in 0..3 {
+                    cell[3 + k] += rate * (c[k] - cell[3 + k]);
+                }
+            }
+        }
+    }
+
+    /// The cost (mean weighted difference, 8-bit levels; similarity `S ∝ 1 / cost`) of a
+    /// candidate block in `frame`. `coarse` compares only every other row and column (4× fewer
+    /// samples, for the wide first search). Returns `f32::INFINITY` as soon as the partial sum
+    /// proves the cost exceeds `bound` (early exit: the candidate already loses).
+    pub fn cost(&self, frame: FrameView, block: &MorphBlock, coarse: bool, bound: f32) -> f32 {
+        let step = if coarse { 2 } else { 1 };
+        let total = self.total[usize::from(coarse)];
+        let limit = if bound.is_finite() {
+            bound * total
+        } else {
+            f32::INFINITY
+        };
+        let g = GridGeometry::new(block, self.extent, self.rows, self.cols);
+        let [wr, wg, wb] = self.weights.rgb;
+        let wk = self.weights.key;
+        let wa = 1.0 - wk;
+        let mut sum = 0.0f32;
+        let mut i = 0;
+        while i < self.rows {
+            let fi = i as f32;
+            let row_x = g.start[0] + fi * g.du[0];
+            let row_y = g.start[1] + fi * g.du[1];
+            let base = i * self.cols;
+            let mut j = 0;
+            while j < self.cols {
+                let fj = j as f32;
+                let x = frame.bilinear(row_x + fj * g.dv[0], row_y + fj * g.dv[1]);
+                let c = &self.cells[base + j];
+                let key =
+                    wr * (x[0] - c[0]).abs() + wg * (x[1] - c[1]).abs() + wb * (x[2] - c[2]).abs();
+                let ada =
+                    wr * (x[0] - c[3]).abs() + wg * (x[1] - c[4]).abs() + wb * (x[2] - c[5]).abs();
+                sum += self.region[base + j] * (wk * key + wa * ada);
+                j += step;
+            }
+            if sum > limit {
+                return f32::INFINITY;
+            }
+            i += step;
+        }
+        sum / total
+    }
+}
+
+#[inline]
+fn sample_cell(frame: FrameView, g: &GridGeometry, i: usize, j: usize) -> [f32; 3] {
+    let (fi, fj) = (i as f32, j as f32);
+    frame.bilinear(
+        g.start[0] + fi * g.du[0] + fj * g.dv[0],
+        g.start[1] + fi * g.du[1] + fj * g.dv[1],
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Point2;
+    use proptest::prelude::*;
+
+    fn textured(w: u32, h: u32, seed: u32) -> RgbImage {
+        RgbImage::from_fn(w, h, |x, y| {
+            let v = |k: u32| {
+                let s = (x.wrapping_mul(73) ^ y.wrapping_mul(151) ^ (seed + k).wrapping_mul(977))
+                    .wrapping_mul(2_654_435_761);
+                ((s >> 24) as u8) / 2 + ((x * 3 + y * 5 + k * 40) % 128) as u8
+            };
+            image::Rgb([v(0), v(1), v(2)])
+        })
+    }
+
+    /// Bilinear interpolation written out from its definition, in f64.
+    fn slow_bilinear(img: &RgbImage, x: f64, y: f64) -> [f64; 3] {
+        let x = x.clamp(0.0, f64::from(img.width() - 1));
+        let y = y.clamp(0.0, f64::from(img.height() - 1));
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let px = |xx: f64, yy: f64| {
+            let xx = (xx as u32).min(img.width() - 1);
+            let yy = (yy as u32).min(img.height() - 1);
+            img.get_pixel(xx, yy).0.map(f64::from)
+        };
+        let mut out = [0.0; 3];
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = (1.0 - fx) * (1.0 - fy) * px(x0, y0)[k]
+                + fx * (1.0 - fy) * px(x0 + 1.0, y0)[k]
+                + (1.0 - fx) * fy * px(x0, y0 + 1.0)[k]
+                + fx * fy * px(x0 + 1.0, y0 + 1.0)[k];
+        }
+        out
+    }
+
+    /// Eq. 3–5 written out directly: every cell's centre from the block's (u, v) coordinates,
+    /// the two regions summed separately, both models compared.
+    fn slow_cost(t: &Template, img: &RgbImage, block: &MorphBlock) -> f64 {
+        let w = t.weights();
+        let e = t.extent();
+        let (rows, cols) = (t.rows(), t.cols());
+        let (mut b1, mut b2, mut n1, mut n2) = (0.0, 0.0, 0.0, 0.0);
+        for i in 0..rows {
+            for j in 0..cols {
+                let u = e.start + (e.end - e.start) * (i as f64 + 0.5) / rows as f64;
+                let v = (j as f64 + 0.5) / cols as f64 - 0.5;
+                let p = block.to_image(u, v);
+                let x = slow_bilinear(img, p.x, p.y);
+                let diff = |m: [f32; 3]| -> f64 {
+                    (0..3)
+                        .map(|k| f64::from(w.rgb[k]) * (x[k] - f64::from(m[k])).abs())
+                        .sum()
+                };
+                let d = f64::from(w.key) * diff(t.key_colour(i, j))
+                    + f64::from(1.0 - w.key) * diff(t.adaptive_colour(i, j));
+                let (fi, fj) = (i as f64 + 0.5, j as f64 + 0.5);
+                let centre = fi >= rows as f64 / 4.0
+                    && fi <= 0.75 * rows as f64
+                    && fj >= cols as f64 / 4.0
+                    && fj <= 0.75 * cols as f64;
+                if centre {
+                    b1 += d;
+                    n1 += 1.0;
+                } else {
+                    b2 += d;
+                    n2 += 1.0;
+                }
+            }
+        }
+        let (w1, w2) = (f64::from(w.centre), f64::from(w.margin));
+        (w1 * b1 + w2 * b2) / (w1 * n1 + w2 * n2)
+    }
+
+    proptest! {
+        #[test]
+        fn fast_cost_matches_the_reference(
+            x in -10.0f64..110.0, y in -10.0f64..90.0, m in 3.0f64..60.0, n in 2.0f64..25.0,
+            theta in -3.2f64..3.2, dx in -6.0f64..6.0, dy in -6.0f64..6.0, dm in 0.7f64..1.3,
+            dt in -0.4f64..0.4,
+        ) {
+            let a = textured(100, 80, 1);
+            let b = textured(100, 80, 2);
+            let block = MorphBlock { origin: Point2::new(x, y), m, n, theta };
+            let extent = Extent { start: -0.1, end: 1.2 };
+            let mut t = Template::sample(FrameView::new(&a), &block, extent, SimilarityWeights::default());
+            t.update(FrameView::new(&b), &block, 0.3);
+            let cand = MorphBlock {
+                origin: Point2::new(x + dx, y + dy), m: m * dm, n: n * dm, theta: theta + dt,
+            };
+            let fast = f64::from(t.cost(FrameView::new(&b), &cand, false, f32::INFINITY));
+            let slow = slow_cost(&t, &b, &cand);
+            prop_assert!((fast - slow).abs() < 1e-3 * (1.0 + slow), "fast {fast} slow {slow}");
+            // Early exit never changes a winner: below the bound the value is exact, above it
+            // the answer is infinity.
+            let bounded = t.cost(FrameView::new(&b), &cand, false, (slow * 0.5) as f32);
+            prop_assert!(slow < 1e-6 || bounded.is_infinite());
+            let loose = f64::from(t.cost(FrameView::new(&b), &cand, false, (slow * 2.0 + 1.0) as f32));
+            prop_assert!((loose - slow).abs() < 1e-3 * (1.0 + slow));
+        }
+    }
+
+    #[test]
+    fn a_block_matches_itself_exactly_and_a_shifted_one_worse() {
+        let img = textured(120, 100, 3);
+        let f = FrameView::new(&img);
+        let block = MorphBlock::along(Point2::new(40.0, 20.0), Point2::new(60.0, 70.0), 14.0);
+        let t = Template::sample(f, &block, Extent::BLOCK, SimilarityWeights::default());
+        assert!(t.cost(f, &block, false, f32::INFINITY) < 1e-4);
+        let moved = MorphBlock {
+            origin: block.origin + nalgebra::Vector2::new(3.0, 0.0),
+            ..block
+        };
+        assert!(t.cost(f, &moved, false, f32::INFINITY) > 5.0);
+    }
+
+    #[test]
+    fn bilinear_matches_the_definition_at_edges_and_inside() {
+        let img = textured(20, 10, 4);
+        let f = FrameView::new(&img);
+        for &(x, y) in &[
+            (0.0, 0.0),
+            (19.0, 9.0),
+            (3.25, 4.75),
+            (-2.0, 5.5),
+            (25.0, 12.0),
+        ] {
+            let fast = f.bilinear(x as f32, y as f32);
+            let slow = slow_bilinear(&img, x, y);
+            for k in 0..3 {
+                assert!((f64::from(fast[k]) - slow[k]).abs() < 1e-3);
+            }
+        }
+    }
+}

@@ -1,0 +1,188 @@
+//! Tracking on rendered clips with known joints: accuracy floors, the CLI's output file, and
+//! bad input (too short a video, marks off the image).
+
+use assert_cmd::Command;
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+use videomocap::eval::score_tracks;
+use videomocap::formats::{Marks, PointSource, Tracks2d};
+use videomocap::skeleton::Joint;
+use videomocap::synth::{
+    GroundTruth, MotionSource, ProceduralMotion, SynthParams, VideoOutput, View, render_clip,
+};
+use videomocap::track::{KeyFrames, TrackError, TrackJob, TrackerParams, track_video};
+use videomocap::video::{OpenOptions, Video};
+
+fn render(dir: &Path, motion: ProceduralMotion, frames: usize, view: View) {
+    let params = SynthParams {
+        motion: MotionSource::Procedural(motion),
+        frames,
+        view,
+        width: 320,
+        height: 240,
+        focal_px: 300.0,
+        person_px: 200.0,
+        output: VideoOutput::PngSequence,
+        ..SynthParams::default()
+    };
+    render_clip(&params, dir, &mut |_, _| {}, &AtomicBool::new(false)).unwrap();
+}
+
+fn job(marks: &Marks, threads: usize) -> TrackJob {
+    TrackJob {
+        keys: KeyFrames::from_marks(marks),
+        params: TrackerParams::default(),
+        threads,
+        from: None,
+        previous: None,
+    }
+}
+
+#[test]
+fn a_waving_person_is_tracked_within_a_fifth_of_the_torso() {
+    let dir = tempfile::tempdir().unwrap();
+    render(dir.path(), ProceduralMotion::Wave, 30, View::Frontal);
+    let gt = GroundTruth::load(&dir.path().join("gt.json")).unwrap();
+    let marks = Marks::load(&dir.path().join("marks.json")).unwrap();
+    let mut video = Video::open(&dir.path().join("frames"), &OpenOptions::default()).unwrap();
+    let mut seen = 0;
+    let out = track_video(
+        &mut video,
+        &job(&marks, 2),
+        &mut |p| {
+            assert!(p.done <= p.total);
+            seen += 1;
+        },
+        &AtomicBool::new(false),
+    )
+    .unwrap();
+    assert_eq!(out.tracks.frames.len(), 30);
+    assert!(seen >= 30, "progress reported {seen} times");
+    let s = score_tracks(&gt, &out.tracks).unwrap();
+    assert!(
+        s.overall.pck02() >= 0.9,
+        "PCK@0.2 {:.3}, mean {:.1} px",
+        s.overall.pck02(),
+        s.overall.mean_px()
+    );
+    // The marked frame is returned exactly, with full confidence.
+    for j in Joint::ALL {
+        let p = out.tracks.frames[0].points[j];
+        assert!((p.pos - marks.points[j]).norm() < 1e-9);
+        assert_eq!(p.confidence, 1.0);
+        assert_eq!(p.source, PointSource::Tracked);
+    }
+    // Every confidence is a reliability in [0, 1].
+    assert!(out.tracks.frames.iter().all(|f| {
+        f.points
+            .0
+            .iter()
+            .all(|p| (0.0..=1.0).contains(&p.confidence))
+    }));
+}
+
+#[test]
+fn one_thread_and_two_threads_give_the_same_tracks() {
+    let dir = tempfile::tempdir().unwrap();
+    render(
+        dir.path(),
+        ProceduralMotion::JumpingJacks,
+        12,
+        View::Frontal,
+    );
+    let marks = Marks::load(&dir.path().join("marks.json")).unwrap();
+    let mut a = Video::open(&dir.path().join("frames"), &OpenOptions::default()).unwrap();
+    let one = track_video(
+        &mut a,
+        &job(&marks, 1),
+        &mut |_| {},
+        &AtomicBool::new(false),
+    )
+    .unwrap();
+    let two = track_video(
+        &mut a,
+        &job(&marks, 2),
+        &mut |_| {},
+        &AtomicBool::new(false),
+    )
+    .unwrap();
+    assert_eq!(one.tracks, two.tracks);
+}
+
+#[test]
+fn a_correction_on_a_later_frame_is_kept_and_anchors_the_track() {
+    let dir = tempfile::tempdir().unwrap();
+    render(dir.path(), ProceduralMotion::Walk, 20, View::Side);
+    let gt = GroundTruth::load(&dir.path().join("gt.json")).unwrap();
+    let marks = Marks::load(&dir.path().join("marks.json")).unwrap();
+    let mut video = Video::open(&dir.path().join("frames"), &OpenOptions::default()).unwrap();
+    let first = track_video(
+        &mut video,
+        &job(&marks, 2),
+        &mut |_| {},
+        &AtomicBool::new(false),
+    )
+    .unwrap();
+    // The user drags the left ankle on frame 10 to its true place and re-tracks from there.
+    let truth = gt.frames[10].points2d()[Joint::LeftAnkle];
+    let mut j = job(&marks, 2);
+    j.keys.set(10, Joint::LeftAnkle, truth);
+    j.from = Some(10);
+    j.previous = Some(first.tracks.clone());
+    let again = track_video(&mut video, &j, &mut |_| {}, &AtomicBool::new(false)).unwrap();
+    let p = again.tracks.frames[10].points[Joint::LeftAnkle];
+    assert!((p.pos - truth).norm() < 1e-9);
+    assert_eq!(p.confidence, 1.0);
+    // Frames before the correction keep the earlier result (except where the new key frame
+    // re-interpolates a weak run before it).
+    for f in 0..5 {
+        assert_eq!(
+            again.tracks.frames[f].points[Joint::HeadTop],
+            first.tracks.frames[f].points[Joint::HeadTop]
+        );
+    }
+}
+
+#[test]
+fn a_one_frame_video_is_refused_with_its_name() {
+    let dir = tempfile::tempdir().unwrap();
+    render(dir.path(), ProceduralMotion::Wave, 1, View::Frontal);
+    let marks = Marks::load(&dir.path().join("marks.json")).unwrap();
+    let mut video = Video::open(&dir.path().join("frames"), &OpenOptions::default()).unwrap();
+    let err = track_video(
+        &mut video,
+        &job(&marks, 1),
+        &mut |_| {},
+        &AtomicBool::new(false),
+    )
+    .unwrap_err();
+    assert!(matches!(err, TrackError::TooShort { frames: 1, .. }));
+    assert!(err.to_string().contains("frames"), "{err}");
+}
+
+#[test]
+fn the_track_command_writes_tracks_that_load() {
+    let dir = tempfile::tempdir().unwrap();
+    render(dir.path(), ProceduralMotion::Wave, 8, View::Oblique);
+    let out = dir.path().join("tracks2d.json");
+    let status = Command::cargo_bin("videomocap")
+        .unwrap()
+        .args(["--quiet", "track"])
+        .arg(dir.path().join("frames"))
+        .arg("--marks")
+        .arg(dir.path().join("marks.json"))
+        .arg("-o")
+        .arg(&out)
+        .arg("--threads")
+        .arg("1")
+        .output()
+        .unwrap();
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let t = Tracks2d::load(&out).unwrap();
+    assert_eq!(t.frames.len(), 8);
+    assert_eq!((t.source.width, t.source.height), (320, 240));
+}
