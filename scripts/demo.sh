@@ -22,10 +22,10 @@ set +e
 "$bin" run "$sample/video.mp4" --marks "$sample/marks.json" --out-dir "$out"
 code=$?
 set -e
-if [ "$code" -eq 2 ] && [ ! -f "$out/motion.bvh" ]; then
+if [ "$code" -eq 2 ] && [ -f "$out/tracks2d.json" ] && [ ! -f "$out/motion.bvh" ]; then
   echo
-  echo "The sample and its marks are valid; tracking, 3D and BVH export are not built yet in this"
-  echo "version, so the pipeline stops after checking its inputs. Written so far: $out/info.json"
+  echo "Tracked the sample: $out/tracks2d.json. 3D reconstruction and BVH export are not built"
+  echo "yet in this version, so the pipeline stops after tracking. Also written: $out/info.json"
   exit 0
 fi
 if [ "$code" -ne 0 ]; then exit "$code"; fi

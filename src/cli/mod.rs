@@ -53,7 +53,7 @@ pub fn run(command: Command, global: &GlobalArgs) -> Result<(), ExitError> {
         Command::Track(a) => track::run(&a, global),
         Command::Lift(a) => pending::lift(&a),
         Command::Export(a) => pending::export(&a),
-        Command::Run(a) => pending::run_all(&a),
+        Command::Run(a) => pending::run_all(&a, global),
         Command::Volume(a) => pending::volume(&a),
         Command::Gui { .. } => Err(ExitError::bad_input(anyhow::anyhow!(
             "the desktop app is opened by main, not by the CLI"

@@ -4,31 +4,12 @@
 use super::ExitError;
 use super::args::{ExportArgs, LiftArgs, LiftOptions, RunArgs, VolumeArgs};
 use anyhow::anyhow;
-use std::path::Path;
-use videomocap::formats::{Marks, Skeleton3d, Tracks2d};
-use videomocap::video::{OpenOptions, Video};
+use videomocap::formats::{Skeleton3d, Tracks2d};
 
 fn not_built(capability: &str) -> ExitError {
     ExitError::bad_input(anyhow!(
         "{capability} is not built yet in this version of videomocap; the inputs were checked and are valid"
     ))
-}
-
-fn check_video_and_marks(video: &Path, marks: &Path) -> Result<(), ExitError> {
-    let v = Video::open(video, &OpenOptions::default()).map_err(ExitError::bad_input)?;
-    let m = Marks::load(marks).map_err(ExitError::bad_input)?;
-    let info = v.info();
-    if m.frame >= info.frame_count {
-        return Err(ExitError::bad_input(anyhow!(
-            "{}: marks are on frame {} but {} has {} frames",
-            marks.display(),
-            m.frame,
-            video.display(),
-            info.frame_count
-        )));
-    }
-    m.check_in_frame(marks, info.width, info.height)
-        .map_err(ExitError::bad_input)
 }
 
 fn check_lift_options(o: &LiftOptions) -> Result<(), ExitError> {
@@ -67,11 +48,26 @@ pub fn export(a: &ExportArgs) -> Result<(), ExitError> {
     Err(not_built("BVH and CSV export (export)"))
 }
 
-pub fn run_all(a: &RunArgs) -> Result<(), ExitError> {
+/// `run`: the track step runs (tracks2d.json in the output directory); the steps after it are
+/// not built yet.
+pub fn run_all(a: &RunArgs, global: &super::args::GlobalArgs) -> Result<(), ExitError> {
     check_lift_options(&a.options)?;
-    check_video_and_marks(&a.video, &a.marks)?;
+    let (mut video, marks) = super::track::open_checked(&a.video, &a.marks)?;
+    std::fs::create_dir_all(&a.out_dir)
+        .map_err(|e| ExitError::failed(anyhow!("{}: cannot create: {e}", a.out_dir.display())))?;
+    let out = super::track::track_with_progress(
+        &mut video,
+        &marks,
+        None,
+        videomocap::track::TrackerParams::default(),
+        global,
+    )?;
+    let path = a.out_dir.join("tracks2d.json");
+    out.tracks.save(&path).map_err(ExitError::failed)?;
+    super::track::report(&out, global);
+    super::say(global, &format!("wrote {}", path.display()));
     Err(not_built(
-        "the full pipeline (run: tracking, 3D reconstruction, export)",
+        "3D reconstruction and export (the lift and export steps of run)",
     ))
 }
 

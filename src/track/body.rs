@@ -127,6 +127,8 @@ pub struct BodyTracker {
     /// Chest, shoulders and hips in the trunk block's (u, v) coordinates.
     trunk_points: [(f64, f64); 5],
     predictor: HeadPredictor,
+    /// The head's displacement over the last frame, pixels.
+    head_velocity: nalgebra::Vector2<f64>,
     prev_image: Arc<RgbImage>,
 }
 
@@ -209,6 +211,7 @@ impl BodyTracker {
             limbs,
             trunk_points,
             predictor: HeadPredictor::default(),
+            head_velocity: nalgebra::Vector2::zeros(),
             prev_image: image,
         }
     }
@@ -266,29 +269,46 @@ impl BodyTracker {
         let frame = FrameView::new(&image);
         let prev = FrameView::new(&self.prev_image);
 
-        // Head: image-difference prediction, then the spiral search path.
+        // Head: image-difference prediction (eqs. 1–5), then the spiral search path (Fig. 6).
+        // Beyond the paper, the spiral also starts from the constant-velocity prediction and
+        // from the unmoved head, and the best of the three ends wins: the difference image
+        // is fooled when arms move inside Ω, and the spiral stops at the first ring without
+        // improvement, so one wrong start would lose the head.
         let motion =
             self.predictor
                 .predict(prev, frame, self.head.block.origin, self.head.block.end());
-        let predicted = MorphBlock {
-            origin: self.head.block.origin + motion.displacement,
-            ..self.head.block
+        let spiral_params = SpiralParams {
+            step_px: p.head_step_px,
+            d_theta: p.head_d_theta_deg.to_radians(),
+            d_m: p.head_d_m,
+            max_rings: p.head_max_rings,
         };
-        let found = spiral(
-            &self.head.template,
-            frame,
-            &predicted,
-            &SpiralParams {
-                step_px: p.head_step_px,
-                d_theta: p.head_d_theta_deg.to_radians(),
-                d_m: p.head_d_m,
-                max_rings: p.head_max_rings,
-            },
-        );
-        self.predictor.adapt(
+        let starts = [
             motion.displacement,
-            found.block.origin - self.head.block.origin,
-        );
+            self.head_velocity * p.velocity_damping,
+            nalgebra::Vector2::zeros(),
+        ];
+        let mut found: Option<Found> = None;
+        for (k, d) in starts.iter().enumerate() {
+            if k > 0 && starts[..k].iter().any(|e| (e - d).norm() < p.head_step_px) {
+                continue;
+            }
+            let predicted = MorphBlock {
+                origin: self.head.block.origin + d,
+                ..self.head.block
+            };
+            let f = spiral(&self.head.template, frame, &predicted, &spiral_params);
+            if found.is_none_or(|b| f.cost < b.cost) {
+                found = Some(f);
+            }
+        }
+        let found = found.unwrap_or(Found {
+            block: self.head.block,
+            cost: f32::INFINITY,
+        });
+        let moved = found.block.origin - self.head.block.origin;
+        self.predictor.adapt(motion.displacement, moved);
+        self.head_velocity = moved;
         accept(&mut self.head, found, frame, &p);
 
         // Trunk, anchored at the neck.

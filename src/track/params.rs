@@ -55,7 +55,7 @@ pub struct TrackerParams {
     /// Default 480.
     pub working_stature_px: f64,
     /// Limb and head blocks are this many times the body part's breadth from the proportions,
-    /// so their margins (eq. 5's b2) hold the part's outline against the background. Default 1.5.
+    /// so their margins (eq. 5's b2) hold the part's outline against the background. Default 1.0.
     pub block_width_scale: f64,
     /// Track the four limb chains in parallel.
     pub parallel: bool,
@@ -83,7 +83,7 @@ impl Default for TrackerParams {
             weak_reliability: 0.45,
             max_gap_s: 0.5,
             working_stature_px: 480.0,
-            block_width_scale: 1.5,
+            block_width_scale: 1.0,
             parallel: true,
         }
     }
