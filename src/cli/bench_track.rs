@@ -372,30 +372,26 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         ("640×480", speed_clip.as_path()),
         ("1080×1920", real.as_path()),
     ] {
-        let n = speed(dir, 1, false, params)?;
-        lines.push(format!(
-            "{:<48} {:>12.1}",
-            format!("track {label}, 1 thread, decoding excluded"),
-            n
-        ));
-        let n = speed(dir, threads, false, params)?;
-        lines.push(format!(
-            "{:<48} {:>12.1}",
-            format!("track {label}, {threads} threads, decoding excluded"),
-            n
-        ));
-        let n = speed(dir, 1, true, params)?;
-        lines.push(format!(
-            "{:<48} {:>12.1}",
-            format!("track {label}, 1 thread, with decoding"),
-            n
-        ));
-        let with = speed(dir, threads, true, params)?;
-        lines.push(format!(
-            "{:<48} {:>12.1}",
-            format!("track {label}, {threads} threads, with decoding"),
-            with
-        ));
+        let mut with = f64::NAN;
+        for decoding in [false, true] {
+            for t in [1, threads] {
+                let n = speed(dir, t, decoding, params)?;
+                let what = if decoding {
+                    "with decoding"
+                } else {
+                    "decoding excluded"
+                };
+                let plural = if t == 1 { "thread" } else { "threads" };
+                lines.push(format!(
+                    "{:<48} {:>12.1}",
+                    format!("track {label}, {t} {plural}, {what}"),
+                    n
+                ));
+                if decoding && t == threads {
+                    with = n;
+                }
+            }
+        }
         let d = decode_speed(dir)?;
         lines.push(format!(
             "{:<48} {:>12.1}",

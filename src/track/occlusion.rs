@@ -4,7 +4,7 @@
 //! Key frames (hand-placed joints) always count as reliable anchors.
 
 use crate::formats::{FrameTracks, PointSource};
-use crate::skeleton::{Joint, PerJoint};
+use crate::skeleton::Joint;
 use serde::Serialize;
 
 /// What happened to a run of weak frames of one joint.
@@ -42,7 +42,7 @@ pub fn fill_weak_runs(
 ) -> Vec<WeakSpan> {
     let mut spans = Vec::new();
     let n = frames.len();
-    for joint in crate::skeleton::Joint::ALL {
+    for joint in Joint::ALL {
         let reliable = |frames: &[FrameTracks], i: usize| {
             is_key(i, joint) || frames[i].points[joint].confidence >= weak
         };
@@ -89,20 +89,11 @@ pub fn fill_weak_runs(
     spans
 }
 
-/// Counts frames per joint that ended interpolated (for summaries).
-pub fn interpolated_counts(frames: &[FrameTracks]) -> PerJoint<usize> {
-    PerJoint::from_fn(|j| {
-        frames
-            .iter()
-            .filter(|f| f.points[j].source == PointSource::Interpolated)
-            .count()
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::formats::TrackedPoint;
+    use crate::skeleton::PerJoint;
     use nalgebra::Point2;
 
     fn frames(conf: &[f32]) -> Vec<FrameTracks> {
