@@ -1,5 +1,27 @@
-//! 3D reconstruction (VBA, Pan et al. "Reconstruction of 3D human motion skeleton"): from
-//! 2D tracks to a metric skeleton per frame. Not built yet: its issue brings the key-triangle
-//! calibration (eqs. 6–9) and the frame-to-frame propagation (eqs. 10–11).
+//! 3D reconstruction (VBA, Pan et al., "Reconstruction of 3D human motion skeleton"): from
+//! 2D tracks to a metric skeleton per frame in the camera's space.
 //!
+//! The key triangle (both shoulders and the chest) calibrates the camera on the best frame
+//! ([`calibrate`], eqs. 6–9) and is carried to the other frames by its constant side lengths
+//! ([`propagate`], eqs. 10–11); every other joint is placed on its viewing ray at its bone's
+//! length from its parent ([`backproject`]); the two roots of each bone are chosen over the
+//! whole sequence ([`ambiguity`]); a global least-squares pass ([`refine`]) then adjusts all
+//! frames and the bone lengths together. [`focal`] estimates an unknown focal length.
 //! Its input is [`crate::formats::Tracks2d`], its output [`crate::formats::Skeleton3d`].
+
+pub mod ambiguity;
+pub mod backproject;
+pub mod calibrate;
+mod error;
+pub mod focal;
+mod newton;
+pub mod propagate;
+pub mod refine;
+mod solve;
+
+pub use ambiguity::{AmbiguityWeights, DepthOverrides};
+pub use backproject::Root;
+pub use error::LiftError;
+pub use solve::{
+    FrameFlag, FrameReport, LiftJob, LiftOutput, LiftParams, LiftProgress, lift, lift_per_frame,
+};

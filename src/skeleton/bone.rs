@@ -3,7 +3,7 @@
 use super::joint::Joint;
 
 /// A bone: the segment from a joint's parent to the joint.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Bone {
     /// The end nearer the pelvis.
     pub parent: Joint,
@@ -62,7 +62,7 @@ impl Bone {
 }
 
 /// A body part tracked as one morph-block (Pan et al., Fig. 2b): its middle line is a bone.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum BodyPart {
     Head,
     Trunk,
@@ -77,7 +77,7 @@ pub enum BodyPart {
 }
 
 /// Which breadth of the proportions table sizes a body part.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Breadth {
     Head,
     Trunk,

@@ -1,0 +1,430 @@
+//! The forward/backward depth ambiguity of every bone, resolved over the whole sequence.
+//!
+//! Each bone solved from its parent has two roots ([`super::backproject`]). Bones are taken in
+//! groups (the head and neck, the spine, the two hips, each arm, each leg); for each group every
+//! combination of its bones' roots is a candidate, scored per frame by a prior (the neck and
+//! spine lie along the key triangle's up direction, the hips are collinear with the pelvis and
+//! parallel to the shoulders, knees bend backwards and hanging elbows forwards), and the
+//! candidates are chained over the frames by dynamic programming (Viterbi over pairs of
+//! consecutive choices) that minimises the joints' 3D acceleration relative to the group's root
+//! plus the priors. Groups are solved centre outwards, each on the trajectory chosen for its
+//! root. A user's choice for a bone on a frame ([`DepthOverrides`]) is a hard constraint.
+
+use super::backproject::{Root, bone_roots};
+use crate::skeleton::{BONE_COUNT, Bone, Joint, PerJoint, SubjectModel};
+use nalgebra::{Point3, Vector3};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// How strongly each prior counts against the acceleration term (both in squared metres).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct AmbiguityWeights {
+    /// Neck, head and spine along the key triangle's up direction.
+    pub trunk_up: f64,
+    /// Hips collinear with the pelvis.
+    pub hips_collinear: f64,
+    /// Hip line parallel to the shoulder line.
+    pub hips_parallel: f64,
+    /// Knees bend backwards.
+    pub knee: f64,
+    /// Elbows of hanging arms bend forwards.
+    pub elbow: f64,
+}
+
+impl Default for AmbiguityWeights {
+    fn default() -> Self {
+        AmbiguityWeights {
+            trunk_up: 0.3,
+            hips_collinear: 10.0,
+            hips_parallel: 1.0,
+            knee: 2.0,
+            elbow: 0.5,
+        }
+    }
+}
+
+/// Forced root choices: `(frame index, bone) → root`, set by a user flipping a limb.
+pub type DepthOverrides = BTreeMap<(usize, Bone), Root>;
+
+/// Which prior scores a group.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Prior {
+    Head,
+    Spine,
+    Hips,
+    Arm,
+    Leg,
+}
+
+/// Bones whose roots are chosen together.
+struct Group {
+    bones: &'static [Bone],
+    prior: Prior,
+}
+
+use Joint::*;
+
+/// Centre outwards: every group's first parent is known when it is solved.
+const GROUPS: [Group; 7] = [
+    Group {
+        bones: &[Bone::new(Chest, Neck), Bone::new(Neck, HeadTop)],
+        prior: Prior::Head,
+    },
+    Group {
+        bones: &[Bone::new(Chest, Pelvis)],
+        prior: Prior::Spine,
+    },
+    Group {
+        bones: &[Bone::new(Pelvis, LeftHip), Bone::new(Pelvis, RightHip)],
+        prior: Prior::Hips,
+    },
+    Group {
+        bones: &[
+            Bone::new(LeftShoulder, LeftElbow),
+            Bone::new(LeftElbow, LeftWrist),
+        ],
+        prior: Prior::Arm,
+    },
+    Group {
+        bones: &[
+            Bone::new(RightShoulder, RightElbow),
+            Bone::new(RightElbow, RightWrist),
+        ],
+        prior: Prior::Arm,
+    },
+    Group {
+        bones: &[Bone::new(LeftHip, LeftKnee), Bone::new(LeftKnee, LeftAnkle)],
+        prior: Prior::Leg,
+    },
+    Group {
+        bones: &[
+            Bone::new(RightHip, RightKnee),
+            Bone::new(RightKnee, RightAnkle),
+        ],
+        prior: Prior::Leg,
+    },
+];
+
+/// Length of a bone of the lifting order (which runs chest-outwards, so the spine is
+/// `chest → pelvis` although the model's tree is rooted at the pelvis).
+fn length(subject: &SubjectModel, bone: Bone) -> f64 {
+    let modelled = if bone.parent == Chest && bone.child == Pelvis {
+        Bone::new(Pelvis, Chest)
+    } else {
+        bone
+    };
+    subject.bone_length(modelled)
+}
+
+/// The model's bone that a lifting-order bone stands for.
+pub fn model_bone(bone: Bone) -> Bone {
+    if bone.parent == Chest && bone.child == Pelvis {
+        Bone::new(Pelvis, Chest)
+    } else {
+        bone
+    }
+}
+
+/// The skeleton of a sequence with every root chosen.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Resolved {
+    /// Joint positions per frame.
+    pub points: Vec<PerJoint<Point3<f64>>>,
+    /// The root taken by each bone (indexed like [`Bone::ALL`]) per frame.
+    pub choices: Vec<[Root; BONE_COUNT]>,
+    /// Whether each bone was too long for its 2D image (flagged, placed off its ray).
+    pub too_long: Vec<[bool; BONE_COUNT]>,
+}
+
+/// The key triangle's directions in one frame: left, up, forward (unit vectors).
+struct TrunkFrame {
+    left: Vector3<f64>,
+    up: Vector3<f64>,
+    forward: Vector3<f64>,
+}
+
+impl TrunkFrame {
+    fn of(points: &PerJoint<Point3<f64>>) -> TrunkFrame {
+        let left = (points[LeftShoulder] - points[RightShoulder]).normalize();
+        let mid = nalgebra::center(&points[LeftShoulder], &points[RightShoulder]);
+        let down = points[Chest] - mid;
+        let up = -(down - left * left.dot(&down)).normalize();
+        // Subject's left × up = forward (right-handed camera space, Y down).
+        TrunkFrame {
+            left,
+            up,
+            forward: left.cross(&up),
+        }
+    }
+}
+
+/// A group's prior for one candidate (squared metres, weighted).
+fn prior_cost(
+    group: &Group,
+    p: &PerJoint<Point3<f64>>,
+    trunk: &TrunkFrame,
+    subject: &SubjectModel,
+    w: &AmbiguityWeights,
+) -> f64 {
+    let along_up = |from: Joint, to: Joint, sign: f64| {
+        let len = length(subject, Bone::new(from, to));
+        (p[to] - (p[from] + trunk.up * (sign * len))).norm_squared()
+    };
+    match group.prior {
+        Prior::Head => {
+            w.trunk_up * (along_up(Chest, Neck, 1.0) + 0.5 * along_up(Neck, HeadTop, 1.0))
+        }
+        Prior::Spine => w.trunk_up * along_up(Chest, Pelvis, -1.0),
+        Prior::Hips => {
+            let off_line =
+                (p[LeftHip].coords + p[RightHip].coords - p[Pelvis].coords * 2.0).norm_squared();
+            let across = p[LeftHip] - p[RightHip];
+            let half = across.norm() / 2.0;
+            let parallel = if half > 0.0 {
+                (across / (2.0 * half) - trunk.left).norm_squared() * half * half
+            } else {
+                0.0
+            };
+            w.hips_collinear * off_line + w.hips_parallel * parallel
+        }
+        Prior::Arm | Prior::Leg => {
+            let root = group.bones[0].parent;
+            let middle = group.bones[0].child;
+            let end = group.bones[1].child;
+            let upper = (p[middle] - p[root]).normalize();
+            let lower = p[end] - p[middle];
+            // How the lower bone leaves the upper bone's line.
+            let bend = lower - upper * upper.dot(&lower);
+            if group.prior == Prior::Leg {
+                // A knee bends backwards: its bend must not point forwards.
+                w.knee * bend.dot(&trunk.forward).max(0.0).powi(2)
+            } else {
+                // An elbow of an arm hanging down bends forwards; the weight fades as the arm
+                // rises (a raised arm can bend its elbow any way by turning the upper arm).
+                let hanging = ((-upper.dot(&trunk.up) - 0.3) / 0.7).clamp(0.0, 1.0);
+                w.elbow * hanging * (-bend.dot(&trunk.forward)).max(0.0).powi(2)
+            }
+        }
+    }
+}
+
+/// One candidate of a group on one frame.
+#[derive(Clone)]
+struct Candidate {
+    /// Positions of the group's child joints relative to the group's root joint.
+    relative: [Vector3<f64>; 2],
+    /// Absolute positions of the group's child joints.
+    absolute: [Point3<f64>; 2],
+    too_long: [bool; 2],
+    unary: f64,
+}
+
+/// Resolves every bone's root over the sequence.
+///
+/// `key[t]` holds the key joints (shoulders and chest) of frame `t`; `rays[t]` the unit viewing
+/// ray of every joint; `frame_index[t]` the video frame (for overrides).
+pub fn resolve(
+    key: &[[Point3<f64>; 3]],
+    rays: &[PerJoint<Vector3<f64>>],
+    frame_index: &[usize],
+    subject: &SubjectModel,
+    weights: &AmbiguityWeights,
+    overrides: &DepthOverrides,
+) -> Resolved {
+    let n = key.len();
+    let mut points: Vec<PerJoint<Point3<f64>>> = key
+        .iter()
+        .map(|k| {
+            let mut p = PerJoint::from_fn(|_| Point3::origin());
+            p.0[LeftShoulder.index()] = k[0];
+            p.0[RightShoulder.index()] = k[1];
+            p.0[Chest.index()] = k[2];
+            p
+        })
+        .collect();
+    let trunks: Vec<TrunkFrame> = points.iter().map(TrunkFrame::of).collect();
+    let mut choices = vec![[Root::Near; BONE_COUNT]; n];
+    let mut too_long = vec![[false; BONE_COUNT]; n];
+    for group in &GROUPS {
+        let combos = 1usize << group.bones.len();
+        let candidates: Vec<Vec<Candidate>> = (0..n)
+            .map(|t| {
+                (0..combos)
+                    .map(|combo| {
+                        let mut p = points[t];
+                        let mut c = Candidate {
+                            relative: [Vector3::zeros(); 2],
+                            absolute: [Point3::origin(); 2],
+                            too_long: [false; 2],
+                            unary: 0.0,
+                        };
+                        for (k, bone) in group.bones.iter().enumerate() {
+                            let roots = bone_roots(
+                                &p[bone.parent],
+                                &rays[t][bone.child],
+                                length(subject, *bone),
+                            );
+                            let root = if combo >> k & 1 == 0 {
+                                Root::Near
+                            } else {
+                                Root::Far
+                            };
+                            if overrides
+                                .get(&(frame_index[t], model_bone(*bone)))
+                                .is_some_and(|o| *o != root)
+                            {
+                                c.unary = f64::INFINITY;
+                            }
+                            p.0[bone.child.index()] = roots.get(root);
+                            c.absolute[k] = roots.get(root);
+                            c.relative[k] = roots.get(root) - p[group.bones[0].parent];
+                            c.too_long[k] = roots.too_long;
+                        }
+                        if c.unary.is_finite() {
+                            c.unary = prior_cost(group, &p, &trunks[t], subject, weights);
+                        }
+                        c
+                    })
+                    .collect()
+            })
+            .collect();
+        let path = viterbi(&candidates);
+        for (t, &combo) in path.iter().enumerate() {
+            let c = &candidates[t][combo];
+            for (k, bone) in group.bones.iter().enumerate() {
+                points[t].0[bone.child.index()] = c.absolute[k];
+                let b = model_bone(*bone).index();
+                choices[t][b] = if combo >> k & 1 == 0 {
+                    Root::Near
+                } else {
+                    Root::Far
+                };
+                too_long[t][b] = c.too_long[k];
+            }
+        }
+    }
+    Resolved {
+        points,
+        choices,
+        too_long,
+    }
+}
+
+/// Squared second difference of the candidates' relative positions at three frames.
+fn acceleration(a: &Candidate, b: &Candidate, c: &Candidate) -> f64 {
+    (0..2)
+        .map(|k| (c.relative[k] - b.relative[k] * 2.0 + a.relative[k]).norm_squared())
+        .sum()
+}
+
+/// Weight of the squared velocity between the first two frames (only matters for two-frame
+/// clips, where there is no acceleration).
+const VELOCITY_WEIGHT: f64 = 0.01;
+
+/// The sequence of candidate indices minimising priors plus squared accelerations.
+fn viterbi(candidates: &[Vec<Candidate>]) -> Vec<usize> {
+    let n = candidates.len();
+    let best_single = |t: usize| {
+        (0..candidates[t].len())
+            .min_by(|&a, &b| candidates[t][a].unary.total_cmp(&candidates[t][b].unary))
+            .unwrap_or(0)
+    };
+    if n < 2 {
+        return (0..n).map(best_single).collect();
+    }
+    let k = candidates[0].len();
+    // cost[a * k + b]: best total with frame t−1 at a and frame t at b.
+    let mut cost = vec![f64::INFINITY; k * k];
+    for a in 0..k {
+        for b in 0..k {
+            let (ca, cb) = (&candidates[0][a], &candidates[1][b]);
+            let v: f64 = (0..2)
+                .map(|i| (cb.relative[i] - ca.relative[i]).norm_squared())
+                .sum();
+            cost[a * k + b] = ca.unary + cb.unary + VELOCITY_WEIGHT * v;
+        }
+    }
+    let mut back: Vec<Vec<usize>> = Vec::with_capacity(n);
+    for t in 2..n {
+        let mut next = vec![f64::INFINITY; k * k];
+        let mut from = vec![0usize; k * k];
+        for b in 0..k {
+            for c in 0..k {
+                let cc = &candidates[t][c];
+                for a in 0..k {
+                    let prev = cost[a * k + b];
+                    if !prev.is_finite() {
+                        continue;
+                    }
+                    let total = prev
+                        + cc.unary
+                        + acceleration(&candidates[t - 2][a], &candidates[t - 1][b], cc);
+                    if total < next[b * k + c] {
+                        next[b * k + c] = total;
+                        from[b * k + c] = a;
+                    }
+                }
+            }
+        }
+        cost = next;
+        back.push(from);
+    }
+    let end = (0..k * k)
+        .min_by(|&x, &y| cost[x].total_cmp(&cost[y]))
+        .unwrap_or(0);
+    let mut path = vec![0usize; n];
+    path[n - 2] = end / k;
+    path[n - 1] = end % k;
+    for t in (2..n).rev() {
+        path[t - 2] = back[t - 2][path[t - 1] * k + path[t]];
+    }
+    path
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cand(x: f64, unary: f64) -> Candidate {
+        Candidate {
+            relative: [Vector3::new(x, 0.0, 0.0), Vector3::zeros()],
+            absolute: [Point3::origin(); 2],
+            too_long: [false; 2],
+            unary,
+        }
+    }
+
+    #[test]
+    fn viterbi_prefers_a_smooth_crossing_to_a_bounce() {
+        // Two roots that meet at t = 3 and part again: the true path goes straight through
+        // (0.3, 0.2, 0.1, 0, −0.1 …); the other root mirrors it.
+        let xs = [0.3, 0.2, 0.1, 0.0, -0.1, -0.2, -0.3];
+        let frames: Vec<Vec<Candidate>> = xs
+            .iter()
+            .map(|&x: &f64| vec![cand(x.abs(), 0.0), cand(-x.abs(), 0.0)])
+            .collect();
+        // Start pinned to the positive root by a small prior.
+        let mut frames = frames;
+        frames[0][1].unary = 0.001;
+        let path = viterbi(&frames);
+        let chosen: Vec<f64> = path
+            .iter()
+            .enumerate()
+            .map(|(t, &c)| frames[t][c].relative[0].x)
+            .collect();
+        for (c, x) in chosen.iter().zip(xs) {
+            assert!((c - x).abs() < 1e-12, "{chosen:?}");
+        }
+    }
+
+    #[test]
+    fn an_infinite_unary_is_never_taken() {
+        let mut frames: Vec<Vec<Candidate>> = (0..5)
+            .map(|_| vec![cand(0.0, 0.0), cand(0.0, 1.0)])
+            .collect();
+        frames[2][0].unary = f64::INFINITY;
+        assert_eq!(viterbi(&frames)[2], 1);
+        assert_eq!(viterbi(&frames[..1])[0], 0);
+    }
+}

@@ -1,0 +1,32 @@
+//! Why a lift could not run.
+
+use crate::skeleton::{Joint, ProportionsError};
+
+/// Errors of the 3D reconstruction. Frames that are merely hard (Newton not converging, a bone
+/// too long for its 2D image) are not errors: they are flagged in [`super::FrameReport`].
+#[derive(Debug, thiserror::Error)]
+pub enum LiftError {
+    #[error("the tracks have no frames")]
+    NoFrames,
+    #[error("frame {frame}: joint {joint} has a position that is not a finite number")]
+    NonFinite { frame: usize, joint: Joint },
+    #[error("focal length must be a positive finite number of pixels, got {0}")]
+    BadFocal(f64),
+    #[error(
+        "the key triangle (both shoulders and the chest) is degenerate in every frame: the shoulders lie on top of each other or on the chest, so the camera cannot be calibrated"
+    )]
+    DegenerateKeyTriangle,
+    #[error(
+        "the subject's proportions give no key triangle: the chest–shoulder bones ({chest_shoulder_m:.3} m) must be longer than half the shoulder width ({shoulder_width_m:.3} m)"
+    )]
+    BadKeyTriangle {
+        chest_shoulder_m: f64,
+        shoulder_width_m: f64,
+    },
+    #[error("camera calibration on the key triangle did not converge on frame {frame}")]
+    CalibrationFailed { frame: usize },
+    #[error(transparent)]
+    Subject(#[from] ProportionsError),
+    #[error("cancelled")]
+    Cancelled,
+}

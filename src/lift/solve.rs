@@ -1,0 +1,403 @@
+//! The lift of a whole sequence: checks, calibration on the best frame, propagation to the
+//! others, root choices, the optional global refinement, and the per-frame report.
+
+use super::ambiguity::{AmbiguityWeights, DepthOverrides, Resolved, resolve};
+use super::backproject::Root;
+use super::calibrate::{KEY_JOINTS, KeyTriangle, calibrate_all, shape};
+use super::error::LiftError;
+use super::propagate::key_depths;
+use super::refine::{RefineParams, RefineSummary, refine};
+use crate::camera::PinholeCamera;
+use crate::formats::{Frame3d, Skeleton3d, Tracks2d};
+use crate::skeleton::{BONE_COUNT, Bone, Joint, PerJoint, SubjectModel};
+use nalgebra::{Point2, Point3};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Settings of the lift; every field has a documented default and can be given as JSON.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LiftParams {
+    /// Run the global refinement after the per-frame solve (default true).
+    pub refine: bool,
+    /// A key-triangle calibration fits when its residual is below this RMS, pixels (default 1).
+    pub calibration_tolerance_px: f64,
+    /// A frame's key triangle is re-calibrated when eq. 11 leaves more than this RMS residual,
+    /// metres (default 0.005).
+    pub propagation_tolerance_m: f64,
+    /// Weights of the depth-ambiguity priors.
+    pub ambiguity: AmbiguityWeights,
+    /// Weights of the global refinement.
+    pub refinement: RefineParams,
+}
+
+impl Default for LiftParams {
+    fn default() -> Self {
+        LiftParams {
+            refine: true,
+            calibration_tolerance_px: 1.0,
+            propagation_tolerance_m: 0.005,
+            ambiguity: AmbiguityWeights::default(),
+            refinement: RefineParams::default(),
+        }
+    }
+}
+
+/// What to lift and how.
+#[derive(Debug, Clone)]
+pub struct LiftJob<'a> {
+    /// The 2D tracks.
+    pub tracks: &'a Tracks2d,
+    /// The camera (focal length given or estimated by [`super::focal`]).
+    pub camera: PinholeCamera,
+    /// The subject's bone lengths and shoulder width.
+    pub subject: SubjectModel,
+    /// Settings.
+    pub params: LiftParams,
+    /// Root choices forced by the user.
+    pub overrides: DepthOverrides,
+}
+
+/// Something worth knowing about one frame of the result.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrameFlag {
+    /// Eq. 11 did not hold from the previous frame; the key triangle was calibrated afresh.
+    KeyTriangleRecalibrated,
+    /// Neither propagation nor calibration fitted the key triangle; the closest fit is kept.
+    KeyTriangleNotConverged,
+    /// The bone's 2D image is longer than its 3D length allows: the joint is off its ray.
+    TooLong(Bone),
+}
+
+impl fmt::Display for FrameFlag {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            FrameFlag::KeyTriangleRecalibrated => f.write_str("key_triangle_recalibrated"),
+            FrameFlag::KeyTriangleNotConverged => f.write_str("key_triangle_not_converged"),
+            FrameFlag::TooLong(b) => write!(f, "too_long:{}", b.key()),
+        }
+    }
+}
+
+/// The per-frame report.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameReport {
+    /// Video frame index.
+    pub index: usize,
+    /// RMS residual of eq. 11 for the key triangle, metres.
+    pub key_rms_m: f64,
+    /// Flags.
+    pub flags: Vec<FrameFlag>,
+}
+
+/// The per-frame solve before refinement.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PerFrame {
+    /// Joints and root choices.
+    pub resolved: Resolved,
+    /// One report per frame.
+    pub reports: Vec<FrameReport>,
+    /// The frame the camera was calibrated on.
+    pub calibration_frame: usize,
+}
+
+/// Where the lift is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LiftProgress {
+    /// What is being done.
+    pub stage: &'static str,
+    /// Steps done.
+    pub done: usize,
+    /// Steps in this stage.
+    pub total: usize,
+}
+
+/// The result of a lift.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LiftOutput {
+    /// The final skeleton (refined when refinement ran).
+    pub skeleton: Skeleton3d,
+    /// The per-frame skeleton (eqs. 6–11 and the root choices), before refinement.
+    pub per_frame: Skeleton3d,
+    /// The root taken by each bone (indexed like [`Bone::ALL`]) per frame, for flipping.
+    pub choices: Vec<[Root; BONE_COUNT]>,
+    /// One report per frame.
+    pub reports: Vec<FrameReport>,
+    /// The frame the camera was calibrated on.
+    pub calibration_frame: usize,
+    /// What the refinement did, if it ran.
+    pub refinement: Option<RefineSummary>,
+}
+
+/// Checks the job's inputs.
+fn check(job: &LiftJob<'_>) -> Result<(), LiftError> {
+    let f = job.camera.focal_px;
+    if !(f.is_finite() && f > 0.0) {
+        return Err(LiftError::BadFocal(f));
+    }
+    if job.tracks.frames.is_empty() {
+        return Err(LiftError::NoFrames);
+    }
+    for frame in &job.tracks.frames {
+        for (joint, p) in frame.points.iter() {
+            if !(p.pos.x.is_finite() && p.pos.y.is_finite()) {
+                return Err(LiftError::NonFinite {
+                    frame: frame.index,
+                    joint,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+fn key_image(tracks: &Tracks2d, t: usize) -> [Point2<f64>; 3] {
+    KEY_JOINTS.map(|j| tracks.frames[t].points[j].pos)
+}
+
+/// Shoulders on top of each other or on the chest (closer than one pixel).
+fn degenerate(image: &[Point2<f64>; 3]) -> bool {
+    (image[0] - image[1]).norm() < 1.0
+        || (image[0] - image[2]).norm() < 1.0
+        || (image[1] - image[2]).norm() < 1.0
+}
+
+/// Distance in metres between where each joint is and where its track says it is, at its
+/// depth: how badly a skeleton misses its 2D points.
+pub(crate) fn miss_m(
+    cam: &PinholeCamera,
+    points: &PerJoint<Point3<f64>>,
+    image: &PerJoint<Point2<f64>>,
+) -> f64 {
+    Joint::ALL
+        .iter()
+        .map(|&j| {
+            cam.project(&points[j])
+                .map_or(1.0, |p| (p - image[j]).norm() / cam.focal_px * points[j].z)
+        })
+        .sum()
+}
+
+/// Eqs. 6–11 and the root choices for every frame.
+pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
+    check(job)?;
+    let cam = &job.camera;
+    let tracks = job.tracks;
+    let n = tracks.frames.len();
+    let triangle = KeyTriangle::from_subject(&job.subject)?;
+    let sides = super::calibrate::KEY_LINES.map(|(i, j)| triangle.side(i, j));
+    let images: Vec<PerJoint<Point2<f64>>> = tracks
+        .frames
+        .iter()
+        .map(|f| f.points.map(|_, p| p.pos))
+        .collect();
+    let rays: Vec<_> = images.iter().map(|im| im.map(|_, p| cam.ray(p))).collect();
+    let frame_index: Vec<usize> = tracks.frames.iter().map(|f| f.index).collect();
+
+    // The calibration frame: the best-shaped key triangle, weighted by the trust in its points.
+    let calibration_frame = (0..n)
+        .filter(|&t| !degenerate(&key_image(tracks, t)))
+        .max_by(|&a, &b| {
+            let score = |t: usize| {
+                let trust = KEY_JOINTS
+                    .iter()
+                    .map(|&j| f64::from(tracks.frames[t].points[j].confidence))
+                    .fold(1.0, f64::min)
+                    .max(0.05);
+                shape(&key_image(tracks, t)) * trust
+            };
+            score(a).total_cmp(&score(b))
+        })
+        .ok_or(LiftError::DegenerateKeyTriangle)?;
+    let calibrations = calibrate_all(
+        cam,
+        &triangle,
+        &key_image(tracks, calibration_frame),
+        job.params.calibration_tolerance_px,
+    );
+    // Several poses fit three points. Build the whole body on each and keep the one that best
+    // explains every joint's track (bones too long for their image give themselves away), the
+    // most upright trunk breaking near-ties (people are filmed standing more often than not).
+    let one = [calibration_frame];
+    let key_of = |pose: &super::calibrate::Pose| triangle.points.map(|p| pose.apply(&p));
+    let best = calibrations
+        .iter()
+        .map(|c| {
+            let key = key_of(&c.pose);
+            let r = resolve(
+                &[key],
+                &rays[calibration_frame..=calibration_frame],
+                &one,
+                &job.subject,
+                &job.params.ambiguity,
+                &job.overrides,
+            );
+            let up = nalgebra::center(&key[0], &key[1]) - key[2];
+            let upright = -up.normalize().y;
+            let score =
+                miss_m(cam, &r.points[0], &images[calibration_frame]) + 0.1 * (1.0 - upright);
+            (score, key)
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, key)| key)
+        .ok_or(LiftError::CalibrationFailed {
+            frame: frame_index[calibration_frame],
+        })?;
+
+    // Eqs. 10–11 outwards from the calibration frame, in both directions.
+    let mut key = vec![best; n];
+    let mut reports: Vec<FrameReport> = frame_index
+        .iter()
+        .map(|&index| FrameReport {
+            index,
+            key_rms_m: 0.0,
+            flags: Vec::new(),
+        })
+        .collect();
+    let order: Vec<(usize, usize)> = (calibration_frame + 1..n)
+        .map(|t| (t, t - 1))
+        .chain((0..calibration_frame).rev().map(|t| (t, t + 1)))
+        .collect();
+    for (t, from) in order {
+        let image = key_image(tracks, t);
+        let previous = key[from];
+        let mut found = key_depths(cam, &image, &sides, previous.map(|p| p.z));
+        if found.rms_m > job.params.propagation_tolerance_m {
+            let nearest =
+                calibrate_all(cam, &triangle, &image, job.params.calibration_tolerance_px)
+                    .iter()
+                    .map(|c| key_of(&c.pose))
+                    .min_by(|a, b| {
+                        let d = |k: &[Point3<f64>; 3]| {
+                            (0..3).map(|i| (k[i] - previous[i]).norm()).sum::<f64>()
+                        };
+                        d(a).total_cmp(&d(b))
+                    });
+            if let Some(k) = nearest {
+                let again = key_depths(cam, &image, &sides, k.map(|p| p.z));
+                if again.rms_m < found.rms_m {
+                    found = again;
+                }
+            }
+            reports[t]
+                .flags
+                .push(if found.rms_m > job.params.propagation_tolerance_m {
+                    super::solve::FrameFlag::KeyTriangleNotConverged
+                } else {
+                    FrameFlag::KeyTriangleRecalibrated
+                });
+        }
+        key[t] = found.points;
+        reports[t].key_rms_m = found.rms_m;
+    }
+    let resolved = resolve(
+        &key,
+        &rays,
+        &frame_index,
+        &job.subject,
+        &job.params.ambiguity,
+        &job.overrides,
+    );
+    for (t, report) in reports.iter_mut().enumerate() {
+        for (b, bone) in Bone::ALL.iter().enumerate() {
+            if resolved.too_long[t][b] {
+                report.flags.push(FrameFlag::TooLong(*bone));
+            }
+        }
+    }
+    Ok(PerFrame {
+        resolved,
+        reports,
+        calibration_frame,
+    })
+}
+
+/// A skeleton3d from per-frame joints.
+fn skeleton(
+    job: &LiftJob<'_>,
+    points: &[PerJoint<Point3<f64>>],
+    bone_lengths: &[f64; BONE_COUNT],
+) -> Skeleton3d {
+    Skeleton3d {
+        camera: job.camera,
+        bone_lengths_m: Bone::ALL
+            .iter()
+            .zip(bone_lengths)
+            .map(|(b, l)| (b.key(), *l))
+            .collect(),
+        frames: job
+            .tracks
+            .frames
+            .iter()
+            .zip(points)
+            .map(|(f, p)| Frame3d {
+                index: f.index,
+                points: *p,
+            })
+            .collect(),
+    }
+}
+
+/// The whole lift: per frame, then (if enabled) the global refinement.
+pub fn lift(
+    job: &LiftJob<'_>,
+    progress: &mut dyn FnMut(&LiftProgress),
+    cancel: &AtomicBool,
+) -> Result<LiftOutput, LiftError> {
+    progress(&LiftProgress {
+        stage: "per-frame solve",
+        done: 0,
+        total: 1,
+    });
+    let per = lift_per_frame(job)?;
+    if cancel.load(Ordering::Relaxed) {
+        return Err(LiftError::Cancelled);
+    }
+    let per_frame = skeleton(job, &per.resolved.points, &job.subject.bone_length_m);
+    let (final_skeleton, refinement) = if job.params.refine {
+        let weights: Vec<PerJoint<f64>> = job
+            .tracks
+            .frames
+            .iter()
+            .map(|f| f.points.map(|_, p| super::refine::track_weight(p)))
+            .collect();
+        let images: Vec<PerJoint<Point2<f64>>> = job
+            .tracks
+            .frames
+            .iter()
+            .map(|f| f.points.map(|_, p| p.pos))
+            .collect();
+        let refined = refine(
+            &job.camera,
+            &images,
+            &weights,
+            &per.resolved.points,
+            &job.subject,
+            job.tracks.source.fps,
+            &job.params.refinement,
+            &mut |done, total| {
+                progress(&LiftProgress {
+                    stage: "global refinement",
+                    done,
+                    total,
+                })
+            },
+            cancel,
+        )?;
+        (
+            skeleton(job, &refined.points, &refined.bone_lengths),
+            Some(refined.summary),
+        )
+    } else {
+        (per_frame.clone(), None)
+    };
+    Ok(LiftOutput {
+        skeleton: final_skeleton,
+        per_frame,
+        choices: per.resolved.choices,
+        reports: per.reports,
+        calibration_frame: per.calibration_frame,
+        refinement,
+    })
+}
