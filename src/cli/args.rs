@@ -99,9 +99,12 @@ pub struct LiftOptions {
     /// Horizontal field of view in degrees (instead of --focal-px).
     #[arg(long)]
     pub fov_deg: Option<f64>,
-    /// The subject's height in metres (scales the bone lengths).
+    /// The subject's height in metres (scales the bone lengths; default 1.70).
     #[arg(long)]
     pub height_m: Option<f64>,
+    /// Lift settings as JSON (see docs/formats.md; every field optional, defaults documented).
+    #[arg(long)]
+    pub lift_settings: Option<PathBuf>,
 }
 
 /// `lift`.
@@ -214,8 +217,9 @@ pub struct SynthArgs {
 /// `bench`.
 #[derive(Debug, Args)]
 pub struct BenchArgs {
-    /// What to measure: all (decode and synth), decode, synth, or track (tracking accuracy on
-    /// the synthetic suite and the real sample, and tracking speed; takes a few minutes).
+    /// What to measure: all (decode and synth), decode, synth, track (tracking accuracy on
+    /// the synthetic suite and the real sample, and tracking speed; takes a few minutes), or
+    /// lift (3D accuracy from true, noisy and tracked 2D, focal estimate, speed).
     #[arg(default_value = "all")]
     pub what: String,
     /// Frames per measured clip (decode).
@@ -227,4 +231,7 @@ pub struct BenchArgs {
     /// Tracker settings as JSON for `bench track`.
     #[arg(long)]
     pub tracker_settings: Option<PathBuf>,
+    /// Lift settings as JSON for `bench lift`.
+    #[arg(long)]
+    pub lift_settings: Option<PathBuf>,
 }

@@ -268,6 +268,25 @@ fn header(title: &str) -> String {
     )
 }
 
+/// Tracks an opened suite clip from its marks with the VBA tracker.
+pub fn track_opened(
+    video: &mut Video,
+    marks: &Marks,
+    threads: usize,
+    params: TrackerParams,
+) -> Result<videomocap::formats::Tracks2d, ExitError> {
+    let job = TrackJob {
+        keys: KeyFrames::from_marks(marks),
+        params,
+        threads,
+        from: None,
+        previous: None,
+    };
+    let out = track_video(video, &job, &mut |_| {}, &AtomicBool::new(false))
+        .map_err(ExitError::failed)?;
+    Ok(out.tracks)
+}
+
 struct Scored {
     vba: ClipScore,
     baseline: ClipScore,
@@ -278,16 +297,8 @@ fn score_clip(dir: &Path, threads: usize, params: TrackerParams) -> Result<Score
     let marks = Marks::load(&dir.join("marks.json")).map_err(ExitError::failed)?;
     let mut video =
         Video::open(&dir.join("video.mp4"), &OpenOptions::default()).map_err(ExitError::failed)?;
-    let job = TrackJob {
-        keys: KeyFrames::from_marks(&marks),
-        params,
-        threads,
-        from: None,
-        previous: None,
-    };
-    let out = track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false))
-        .map_err(ExitError::failed)?;
-    let vba = score_tracks(&gt, &out.tracks).map_err(ExitError::failed)?;
+    let tracks = track_opened(&mut video, &marks, threads, params)?;
+    let vba = score_tracks(&gt, &tracks).map_err(ExitError::failed)?;
     let stature = videomocap::track::body::stature_px(
         &marks.points,
         &videomocap::skeleton::Proportions::default(),

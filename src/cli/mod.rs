@@ -3,8 +3,10 @@
 
 pub mod args;
 mod bench;
+mod bench_lift;
 mod bench_track;
 mod info;
+mod lift;
 mod pending;
 mod synth;
 mod track;
@@ -51,7 +53,7 @@ pub fn run(command: Command, global: &GlobalArgs) -> Result<(), ExitError> {
         Command::Synth(a) => synth::run(&a, global),
         Command::Bench(a) => bench::run(&a, global),
         Command::Track(a) => track::run(&a, global),
-        Command::Lift(a) => pending::lift(&a),
+        Command::Lift(a) => lift::run(&a, global),
         Command::Export(a) => pending::export(&a),
         Command::Run(a) => pending::run_all(&a, global),
         Command::Volume(a) => pending::volume(&a),

@@ -2,9 +2,9 @@
 //! learns about a bad file now) and then exits with code 2 and a sentence naming what is missing.
 
 use super::ExitError;
-use super::args::{ExportArgs, LiftArgs, LiftOptions, RunArgs, VolumeArgs};
+use super::args::{ExportArgs, RunArgs, VolumeArgs};
 use anyhow::anyhow;
-use videomocap::formats::{Skeleton3d, Tracks2d};
+use videomocap::formats::Skeleton3d;
 
 fn not_built(capability: &str) -> ExitError {
     ExitError::bad_input(anyhow!(
@@ -12,46 +12,15 @@ fn not_built(capability: &str) -> ExitError {
     ))
 }
 
-fn check_lift_options(o: &LiftOptions) -> Result<(), ExitError> {
-    if let Some(f) = o.focal_px
-        && !(f.is_finite() && f > 0.0)
-    {
-        return Err(ExitError::bad_input(anyhow!(
-            "--focal-px must be positive, got {f}"
-        )));
-    }
-    if let Some(d) = o.fov_deg
-        && !(d.is_finite() && d > 0.0 && d < 180.0)
-    {
-        return Err(ExitError::bad_input(anyhow!(
-            "--fov-deg must be between 0 and 180, got {d}"
-        )));
-    }
-    if let Some(h) = o.height_m
-        && !(h.is_finite() && h > 0.3 && h < 3.0)
-    {
-        return Err(ExitError::bad_input(anyhow!(
-            "--height-m must be a person's height in metres (0.3 to 3), got {h}"
-        )));
-    }
-    Ok(())
-}
-
-pub fn lift(a: &LiftArgs) -> Result<(), ExitError> {
-    check_lift_options(&a.options)?;
-    Tracks2d::load(&a.tracks).map_err(ExitError::bad_input)?;
-    Err(not_built("3D reconstruction (lift)"))
-}
-
 pub fn export(a: &ExportArgs) -> Result<(), ExitError> {
     Skeleton3d::load(&a.skeleton).map_err(ExitError::bad_input)?;
     Err(not_built("BVH and CSV export (export)"))
 }
 
-/// `run`: the track step runs (tracks2d.json in the output directory); the steps after it are
-/// not built yet.
+/// `run`: the track and lift steps run (tracks2d.json and skeleton3d.json in the output
+/// directory); the export after them is not built yet.
 pub fn run_all(a: &RunArgs, global: &super::args::GlobalArgs) -> Result<(), ExitError> {
-    check_lift_options(&a.options)?;
+    super::lift::check_options(&a.options)?;
     let (mut video, marks) = super::track::open_checked(&a.video, &a.marks)?;
     std::fs::create_dir_all(&a.out_dir)
         .map_err(|e| ExitError::failed(anyhow!("{}: cannot create: {e}", a.out_dir.display())))?;
@@ -66,9 +35,12 @@ pub fn run_all(a: &RunArgs, global: &super::args::GlobalArgs) -> Result<(), Exit
     out.tracks.save(&path).map_err(ExitError::failed)?;
     super::track::report(&out, global);
     super::say(global, &format!("wrote {}", path.display()));
-    Err(not_built(
-        "3D reconstruction and export (the lift and export steps of run)",
-    ))
+    let lifted = super::lift::lift_with_progress(&out.tracks, &a.options, global)?;
+    let path = a.out_dir.join("skeleton3d.json");
+    lifted.skeleton.save(&path).map_err(ExitError::failed)?;
+    super::lift::report(&lifted, global);
+    super::say(global, &format!("wrote {}", path.display()));
+    Err(not_built("BVH export (the export step of run)"))
 }
 
 pub fn volume(a: &VolumeArgs) -> Result<(), ExitError> {

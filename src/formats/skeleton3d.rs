@@ -22,6 +22,9 @@ pub struct Frame3d {
     pub index: usize,
     /// Joint positions in camera space, metres.
     pub points: PerJoint<Point3<f64>>,
+    /// What the reconstruction noticed on this frame (e.g. `too_long:left_elbow-left_wrist`,
+    /// `key_triangle_recalibrated`); empty when all went well. Optional in the file.
+    pub flags: Vec<String>,
 }
 
 /// A reconstructed 3D skeleton sequence.
@@ -39,6 +42,8 @@ pub struct Skeleton3d {
 struct FrameFile {
     index: usize,
     points: Vec<[f64; 3]>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    flags: Vec<String>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -123,6 +128,7 @@ impl Skeleton3d {
                     let [x, y, z] = f.points[columns[j.index()]];
                     Point3::new(x, y, z)
                 }),
+                flags: f.flags,
             });
         }
         Ok(Skeleton3d {
@@ -146,6 +152,7 @@ impl Skeleton3d {
                 .map(|f| FrameFile {
                     index: f.index,
                     points: f.points.0.iter().map(|p| [p.x, p.y, p.z]).collect(),
+                    flags: f.flags.clone(),
                 })
                 .collect(),
         };
@@ -164,6 +171,7 @@ mod tests {
             frames: vec![Frame3d {
                 index: 0,
                 points: PerJoint::from_fn(|j| Point3::new(j.index() as f64 * 0.1, -0.5, 3.0)),
+                flags: vec!["too_long:left_elbow-left_wrist".to_owned()],
             }],
         }
     }

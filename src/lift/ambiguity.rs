@@ -4,7 +4,8 @@
 //! groups (the head and neck, the spine, the two hips, each arm, each leg); for each group every
 //! combination of its bones' roots is a candidate, scored per frame by a prior (the neck and
 //! spine lie along the key triangle's up direction, the hips are collinear with the pelvis and
-//! parallel to the shoulders, knees bend backwards and hanging elbows forwards), and the
+//! parallel to the shoulders, knees bend backwards and hanging elbows forwards, upper arms and
+//! thighs weakly prefer to hang), and the
 //! candidates are chained over the frames by dynamic programming (Viterbi over pairs of
 //! consecutive choices) that minimises the joints' 3D acceleration relative to the group's root
 //! plus the priors. Groups are solved centre outwards, each on the trajectory chosen for its
@@ -30,6 +31,8 @@ pub struct AmbiguityWeights {
     pub knee: f64,
     /// Elbows of hanging arms bend forwards.
     pub elbow: f64,
+    /// Upper arms and thighs hang along the trunk (a weak preference for the rest pose).
+    pub hanging: f64,
 }
 
 impl Default for AmbiguityWeights {
@@ -40,6 +43,7 @@ impl Default for AmbiguityWeights {
             hips_parallel: 1.0,
             knee: 2.0,
             elbow: 0.5,
+            hanging: 0.05,
         }
     }
 }
@@ -135,6 +139,8 @@ pub struct Resolved {
     pub choices: Vec<[Root; BONE_COUNT]>,
     /// Whether each bone was too long for its 2D image (flagged, placed off its ray).
     pub too_long: Vec<[bool; BONE_COUNT]>,
+    /// The minimised total: priors plus squared accelerations (squared metres).
+    pub cost: f64,
 }
 
 /// The key triangle's directions in one frame: left, up, forward (unit vectors).
@@ -196,14 +202,16 @@ fn prior_cost(
             let lower = p[end] - p[middle];
             // How the lower bone leaves the upper bone's line.
             let bend = lower - upper * upper.dot(&lower);
+            let upper_len = (p[middle] - p[root]).norm();
+            let rest = w.hanging * ((upper + trunk.up) * upper_len).norm_squared();
             if group.prior == Prior::Leg {
                 // A knee bends backwards: its bend must not point forwards.
-                w.knee * bend.dot(&trunk.forward).max(0.0).powi(2)
+                rest + w.knee * bend.dot(&trunk.forward).max(0.0).powi(2)
             } else {
                 // An elbow of an arm hanging down bends forwards; the weight fades as the arm
                 // rises (a raised arm can bend its elbow any way by turning the upper arm).
                 let hanging = ((-upper.dot(&trunk.up) - 0.3) / 0.7).clamp(0.0, 1.0);
-                w.elbow * hanging * (-bend.dot(&trunk.forward)).max(0.0).powi(2)
+                rest + w.elbow * hanging * (-bend.dot(&trunk.forward)).max(0.0).powi(2)
             }
         }
     }
@@ -246,6 +254,7 @@ pub fn resolve(
     let trunks: Vec<TrunkFrame> = points.iter().map(TrunkFrame::of).collect();
     let mut choices = vec![[Root::Near; BONE_COUNT]; n];
     let mut too_long = vec![[false; BONE_COUNT]; n];
+    let mut total = 0.0;
     for group in &GROUPS {
         let combos = 1usize << group.bones.len();
         let candidates: Vec<Vec<Candidate>> = (0..n)
@@ -289,7 +298,8 @@ pub fn resolve(
                     .collect()
             })
             .collect();
-        let path = viterbi(&candidates);
+        let (path, cost) = viterbi(&candidates);
+        total += cost;
         for (t, &combo) in path.iter().enumerate() {
             let c = &candidates[t][combo];
             for (k, bone) in group.bones.iter().enumerate() {
@@ -308,6 +318,7 @@ pub fn resolve(
         points,
         choices,
         too_long,
+        cost: total,
     }
 }
 
@@ -323,7 +334,7 @@ fn acceleration(a: &Candidate, b: &Candidate, c: &Candidate) -> f64 {
 const VELOCITY_WEIGHT: f64 = 0.01;
 
 /// The sequence of candidate indices minimising priors plus squared accelerations.
-fn viterbi(candidates: &[Vec<Candidate>]) -> Vec<usize> {
+fn viterbi(candidates: &[Vec<Candidate>]) -> (Vec<usize>, f64) {
     let n = candidates.len();
     let best_single = |t: usize| {
         (0..candidates[t].len())
@@ -331,7 +342,13 @@ fn viterbi(candidates: &[Vec<Candidate>]) -> Vec<usize> {
             .unwrap_or(0)
     };
     if n < 2 {
-        return (0..n).map(best_single).collect();
+        let path: Vec<usize> = (0..n).map(best_single).collect();
+        let cost = path
+            .iter()
+            .enumerate()
+            .map(|(t, &c)| candidates[t][c].unary)
+            .sum();
+        return (path, cost);
     }
     let k = candidates[0].len();
     // cost[a * k + b]: best total with frame t−1 at a and frame t at b.
@@ -379,7 +396,7 @@ fn viterbi(candidates: &[Vec<Candidate>]) -> Vec<usize> {
     for t in (2..n).rev() {
         path[t - 2] = back[t - 2][path[t - 1] * k + path[t]];
     }
-    path
+    (path, cost[end])
 }
 
 #[cfg(test)]
@@ -407,7 +424,7 @@ mod tests {
         // Start pinned to the positive root by a small prior.
         let mut frames = frames;
         frames[0][1].unary = 0.001;
-        let path = viterbi(&frames);
+        let (path, _) = viterbi(&frames);
         let chosen: Vec<f64> = path
             .iter()
             .enumerate()
@@ -424,7 +441,7 @@ mod tests {
             .map(|_| vec![cand(0.0, 0.0), cand(0.0, 1.0)])
             .collect();
         frames[2][0].unary = f64::INFINITY;
-        assert_eq!(viterbi(&frames)[2], 1);
-        assert_eq!(viterbi(&frames[..1])[0], 0);
+        assert_eq!(viterbi(&frames).0[2], 1);
+        assert_eq!(viterbi(&frames[..1]).0[0], 0);
     }
 }

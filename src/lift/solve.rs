@@ -216,96 +216,44 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
         &key_image(tracks, calibration_frame),
         job.params.calibration_tolerance_px,
     );
-    // Several poses fit three points. Build the whole body on each and keep the one that best
-    // explains every joint's track (bones too long for their image give themselves away), the
-    // most upright trunk breaking near-ties (people are filmed standing more often than not).
-    let one = [calibration_frame];
+    // Several poses fit three points. Each is carried through the whole sequence and the
+    // whole body is built on it; the one kept explains the tracks best (bones too long for
+    // their image give a wrong pose away) with the least prior and acceleration cost of the
+    // root choices (a wrong pose twists the shoulders against the hips and bends knees the
+    // wrong way for the whole clip).
     let key_of = |pose: &super::calibrate::Pose| triangle.points.map(|p| pose.apply(&p));
-    let best = calibrations
-        .iter()
-        .map(|c| {
-            let key = key_of(&c.pose);
-            let r = resolve(
-                &[key],
-                &rays[calibration_frame..=calibration_frame],
-                &one,
-                &job.subject,
-                &job.params.ambiguity,
-                &job.overrides,
-            );
-            let up = nalgebra::center(&key[0], &key[1]) - key[2];
-            let upright = -up.normalize().y;
-            let score =
-                miss_m(cam, &r.points[0], &images[calibration_frame]) + 0.1 * (1.0 - upright);
-            (score, key)
-        })
-        .min_by(|a, b| a.0.total_cmp(&b.0))
-        .map(|(_, key)| key)
-        .ok_or(LiftError::CalibrationFailed {
-            frame: frame_index[calibration_frame],
-        })?;
-
-    // Eqs. 10–11 outwards from the calibration frame, in both directions.
-    let mut key = vec![best; n];
-    let mut reports: Vec<FrameReport> = frame_index
-        .iter()
-        .map(|&index| FrameReport {
-            index,
-            key_rms_m: 0.0,
-            flags: Vec::new(),
-        })
-        .collect();
-    let order: Vec<(usize, usize)> = (calibration_frame + 1..n)
-        .map(|t| (t, t - 1))
-        .chain((0..calibration_frame).rev().map(|t| (t, t + 1)))
-        .collect();
-    for (t, from) in order {
-        let image = key_image(tracks, t);
-        let previous = key[from];
-        let mut found = key_depths(cam, &image, &sides, previous.map(|p| p.z));
-        if found.rms_m > job.params.propagation_tolerance_m {
-            let nearest =
-                calibrate_all(cam, &triangle, &image, job.params.calibration_tolerance_px)
-                    .iter()
-                    .map(|c| key_of(&c.pose))
-                    .min_by(|a, b| {
-                        let d = |k: &[Point3<f64>; 3]| {
-                            (0..3).map(|i| (k[i] - previous[i]).norm()).sum::<f64>()
-                        };
-                        d(a).total_cmp(&d(b))
-                    });
-            if let Some(k) = nearest {
-                let again = key_depths(cam, &image, &sides, k.map(|p| p.z));
-                if again.rms_m < found.rms_m {
-                    found = again;
+    let mut best: Option<(f64, Vec<[Point3<f64>; 3]>, Vec<FrameReport>, Resolved)> = None;
+    for c in &calibrations {
+        let (key, mut reports) =
+            propagate_all(job, &triangle, &sides, calibration_frame, key_of(&c.pose));
+        let resolved = resolve(
+            &key,
+            &rays,
+            &frame_index,
+            &job.subject,
+            &job.params.ambiguity,
+            &job.overrides,
+        );
+        let miss: f64 = (0..n)
+            .map(|t| miss_m(cam, &resolved.points[t], &images[t]))
+            .sum();
+        let score = miss + resolved.cost;
+        if best.as_ref().is_none_or(|b| score < b.0) {
+            for (t, report) in reports.iter_mut().enumerate() {
+                for (b, bone) in Bone::ALL.iter().enumerate() {
+                    if resolved.too_long[t][b] {
+                        report.flags.push(FrameFlag::TooLong(*bone));
+                    }
                 }
             }
-            reports[t]
-                .flags
-                .push(if found.rms_m > job.params.propagation_tolerance_m {
-                    super::solve::FrameFlag::KeyTriangleNotConverged
-                } else {
-                    FrameFlag::KeyTriangleRecalibrated
-                });
-        }
-        key[t] = found.points;
-        reports[t].key_rms_m = found.rms_m;
-    }
-    let resolved = resolve(
-        &key,
-        &rays,
-        &frame_index,
-        &job.subject,
-        &job.params.ambiguity,
-        &job.overrides,
-    );
-    for (t, report) in reports.iter_mut().enumerate() {
-        for (b, bone) in Bone::ALL.iter().enumerate() {
-            if resolved.too_long[t][b] {
-                report.flags.push(FrameFlag::TooLong(*bone));
-            }
+            best = Some((score, key, reports, resolved));
         }
     }
+    let Some((_, _, reports, resolved)) = best else {
+        return Err(LiftError::CalibrationFailed {
+            frame: frame_index[calibration_frame],
+        });
+    };
     Ok(PerFrame {
         resolved,
         reports,
@@ -313,11 +261,67 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
     })
 }
 
+/// The key triangle in every frame: eqs. 10–11 outwards from the calibration frame in both
+/// directions, re-calibrating a frame where they do not hold.
+fn propagate_all(
+    job: &LiftJob<'_>,
+    triangle: &KeyTriangle,
+    sides: &[f64; 3],
+    calibration_frame: usize,
+    start: [Point3<f64>; 3],
+) -> (Vec<[Point3<f64>; 3]>, Vec<FrameReport>) {
+    let cam = &job.camera;
+    let tracks = job.tracks;
+    let n = tracks.frames.len();
+    let mut key = vec![start; n];
+    let mut reports: Vec<FrameReport> = tracks
+        .frames
+        .iter()
+        .map(|f| FrameReport {
+            index: f.index,
+            key_rms_m: 0.0,
+            flags: Vec::new(),
+        })
+        .collect();
+    let order = (calibration_frame + 1..n)
+        .map(|t| (t, t - 1))
+        .chain((0..calibration_frame).rev().map(|t| (t, t + 1)));
+    let tolerance = job.params.propagation_tolerance_m;
+    for (t, from) in order {
+        let image = key_image(tracks, t);
+        let previous = key[from];
+        let mut found = key_depths(cam, &image, sides, previous.map(|p| p.z));
+        if found.rms_m > tolerance {
+            let distance =
+                |k: &[Point3<f64>; 3]| (0..3).map(|i| (k[i] - previous[i]).norm()).sum::<f64>();
+            let nearest = calibrate_all(cam, triangle, &image, job.params.calibration_tolerance_px)
+                .iter()
+                .map(|c| triangle.points.map(|p| c.pose.apply(&p)))
+                .min_by(|a, b| distance(a).total_cmp(&distance(b)));
+            if let Some(k) = nearest {
+                let again = key_depths(cam, &image, sides, k.map(|p| p.z));
+                if again.rms_m < found.rms_m {
+                    found = again;
+                }
+            }
+            reports[t].flags.push(if found.rms_m > tolerance {
+                FrameFlag::KeyTriangleNotConverged
+            } else {
+                FrameFlag::KeyTriangleRecalibrated
+            });
+        }
+        key[t] = found.points;
+        reports[t].key_rms_m = found.rms_m;
+    }
+    (key, reports)
+}
+
 /// A skeleton3d from per-frame joints.
 fn skeleton(
     job: &LiftJob<'_>,
     points: &[PerJoint<Point3<f64>>],
     bone_lengths: &[f64; BONE_COUNT],
+    reports: &[FrameReport],
 ) -> Skeleton3d {
     Skeleton3d {
         camera: job.camera,
@@ -331,9 +335,11 @@ fn skeleton(
             .frames
             .iter()
             .zip(points)
-            .map(|(f, p)| Frame3d {
+            .zip(reports)
+            .map(|((f, p), r)| Frame3d {
                 index: f.index,
                 points: *p,
+                flags: r.flags.iter().map(ToString::to_string).collect(),
             })
             .collect(),
     }
@@ -354,7 +360,12 @@ pub fn lift(
     if cancel.load(Ordering::Relaxed) {
         return Err(LiftError::Cancelled);
     }
-    let per_frame = skeleton(job, &per.resolved.points, &job.subject.bone_length_m);
+    let per_frame = skeleton(
+        job,
+        &per.resolved.points,
+        &job.subject.bone_length_m,
+        &per.reports,
+    );
     let (final_skeleton, refinement) = if job.params.refine {
         let weights: Vec<PerJoint<f64>> = job
             .tracks
@@ -386,7 +397,7 @@ pub fn lift(
             cancel,
         )?;
         (
-            skeleton(job, &refined.points, &refined.bone_lengths),
+            skeleton(job, &refined.points, &refined.bone_lengths, &per.reports),
             Some(refined.summary),
         )
     } else {

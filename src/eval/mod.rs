@@ -1,7 +1,10 @@
 //! Accuracy of 2D tracks against ground truth (`gt.json`): mean error in pixels, error over the
 //! torso length (neck–pelvis in the reference, per frame), PCK@0.1 and PCK@0.2 of the torso
 //! length, and the share lost (error above half the torso), per joint and overall, visible and
-//! occluded joints apart. Joints the reference marks as derived are not scored.
+//! occluded joints apart. Joints the reference marks as derived are not scored. The 3D
+//! measures live in [`pose3d`].
+
+pub mod pose3d;
 
 use crate::formats::Tracks2d;
 use crate::skeleton::{Joint, PerJoint};

@@ -1,0 +1,168 @@
+//! `videomocap lift`: from tracks2d.json to skeleton3d.json (the lift step of `run` too).
+
+use super::args::{GlobalArgs, LiftArgs, LiftOptions};
+use super::{ExitError, progress_bar, say};
+use anyhow::anyhow;
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+use videomocap::camera::PinholeCamera;
+use videomocap::formats::Tracks2d;
+use videomocap::lift::focal::estimate_focal;
+use videomocap::lift::{FrameFlag, LiftError, LiftJob, LiftOutput, LiftParams, lift};
+use videomocap::skeleton::{DEFAULT_HEIGHT_M, Proportions, SubjectModel};
+
+/// Checks the camera and subject options before any work.
+pub fn check_options(o: &LiftOptions) -> Result<(), ExitError> {
+    if let Some(f) = o.focal_px
+        && !(f.is_finite() && f > 0.0)
+    {
+        return Err(ExitError::bad_input(anyhow!(
+            "--focal-px must be positive, got {f}"
+        )));
+    }
+    if let Some(d) = o.fov_deg
+        && !(d.is_finite() && d > 0.0 && d < 180.0)
+    {
+        return Err(ExitError::bad_input(anyhow!(
+            "--fov-deg must be between 0 and 180, got {d}"
+        )));
+    }
+    if let Some(h) = o.height_m
+        && !(h.is_finite() && h > 0.3 && h < 3.0)
+    {
+        return Err(ExitError::bad_input(anyhow!(
+            "--height-m must be a person's height in metres (0.3 to 3), got {h}"
+        )));
+    }
+    if let Some(p) = &o.lift_settings {
+        load_settings(p)?;
+    }
+    Ok(())
+}
+
+/// Reads lift settings from a JSON file.
+pub fn load_settings(path: &Path) -> Result<LiftParams, ExitError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| ExitError::bad_input(anyhow!("{}: cannot read: {e}", path.display())))?;
+    serde_json::from_str(&text)
+        .map_err(|e| ExitError::bad_input(anyhow!("{}: bad lift settings: {e}", path.display())))
+}
+
+fn lift_error(e: LiftError) -> ExitError {
+    match e {
+        LiftError::Cancelled | LiftError::CalibrationFailed { .. } => ExitError::failed(e),
+        _ => ExitError::bad_input(e),
+    }
+}
+
+/// Lifts tracks with the options' camera and subject, with progress; shared by `lift` and `run`.
+pub fn lift_with_progress(
+    tracks: &Tracks2d,
+    o: &LiftOptions,
+    global: &GlobalArgs,
+) -> Result<LiftOutput, ExitError> {
+    let params = match &o.lift_settings {
+        Some(p) => load_settings(p)?,
+        None => LiftParams::default(),
+    };
+    let subject = SubjectModel::from_height(
+        o.height_m.unwrap_or(DEFAULT_HEIGHT_M),
+        Proportions::default(),
+    )
+    .map_err(ExitError::bad_input)?;
+    let (w, h) = (tracks.source.width, tracks.source.height);
+    let mut job = LiftJob {
+        tracks,
+        camera: PinholeCamera::centred(1.0, w, h),
+        subject,
+        params,
+        overrides: Default::default(),
+    };
+    if let Some(f) = o.focal_px {
+        job.camera.focal_px = f;
+    } else if let Some(fov) = o.fov_deg {
+        job.camera.focal_px = PinholeCamera::focal_from_horizontal_fov(fov, w);
+    } else {
+        say(
+            global,
+            "estimating the focal length (give --focal-px or --fov-deg to skip) …",
+        );
+        let est = estimate_focal(&job).map_err(lift_error)?;
+        job.camera.focal_px = est.focal_px;
+        let fov = 2.0 * (f64::from(w) / 2.0 / est.focal_px).atan().to_degrees();
+        say(
+            global,
+            &format!(
+                "estimated focal length {:.0} px (horizontal field of view {fov:.0}°)",
+                est.focal_px
+            ),
+        );
+    }
+    let bar = progress_bar(global, 1, "lifting");
+    let cancel = AtomicBool::new(false);
+    let out = lift(
+        &job,
+        &mut |p| {
+            bar.set_message(p.stage);
+            bar.set_length(p.total as u64);
+            bar.set_position(p.done as u64);
+        },
+        &cancel,
+    )
+    .map_err(lift_error)?;
+    bar.finish_and_clear();
+    Ok(out)
+}
+
+/// Prints what the lift found.
+pub fn report(out: &LiftOutput, global: &GlobalArgs) {
+    let n = out.reports.len();
+    let count = |pred: &dyn Fn(&FrameFlag) -> bool| {
+        out.reports
+            .iter()
+            .filter(|r| r.flags.iter().any(pred))
+            .count()
+    };
+    say(
+        global,
+        &format!(
+            "lifted {n} frames with focal length {:.0} px; camera calibrated on frame {}",
+            out.skeleton.camera.focal_px, out.reports[out.calibration_frame].index
+        ),
+    );
+    say(
+        global,
+        &format!(
+            "frames with a bone too long for its 2D image: {}; key triangle re-calibrated: {}; not converged: {}",
+            count(&|f| matches!(f, FrameFlag::TooLong(_))),
+            count(&|f| matches!(f, FrameFlag::KeyTriangleRecalibrated)),
+            count(&|f| matches!(f, FrameFlag::KeyTriangleNotConverged)),
+        ),
+    );
+    if let Some(r) = &out.refinement {
+        say(
+            global,
+            &format!(
+                "global refinement: {} iterations, reprojection RMS {:.2} → {:.2} px",
+                r.iterations, r.reprojection_px_before, r.reprojection_px_after
+            ),
+        );
+    }
+}
+
+/// `lift`.
+pub fn run(a: &LiftArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+    check_options(&a.options)?;
+    let tracks = Tracks2d::load(&a.tracks).map_err(ExitError::bad_input)?;
+    let out = lift_with_progress(&tracks, &a.options, global)?;
+    out.skeleton.save(&a.output).map_err(ExitError::failed)?;
+    report(&out, global);
+    say(global, &format!("wrote {}", a.output.display()));
+    if a.bvh.is_some() {
+        return Err(ExitError::bad_input(anyhow!(
+            "BVH export is not built yet in this version of videomocap; {} was written",
+            a.output.display()
+        )));
+    }
+    Ok(())
+}

@@ -1,0 +1,269 @@
+//! Accuracy of a 3D skeleton against ground truth: MPJPE after aligning the pelvis, PA-MPJPE
+//! (after the best similarity transform, per frame), the spread of each bone's length across
+//! frames, and the share of bone-frames whose depth root is the wrong one. Also builds the
+//! inputs of the lift benchmark from ground truth (true or noisy 2D, the true subject).
+
+use super::EvalError;
+use crate::formats::{FrameTracks, PointSource, Skeleton3d, SourceInfo, TrackedPoint, Tracks2d};
+use crate::skeleton::{Bone, Joint, PerJoint, Proportions, SubjectModel};
+use crate::synth::GroundTruth;
+use nalgebra::{Matrix3, Point2, Point3, Vector3};
+use rand::SeedableRng;
+use rand_distr::{Distribution, Normal};
+use std::collections::BTreeMap;
+
+/// Accumulated 3D errors.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Pose3dScore {
+    /// Sum of per-joint errors after pelvis alignment, metres.
+    pub sum_pelvis_m: f64,
+    /// Sum of per-joint errors after Procrustes alignment, metres.
+    pub sum_pa_m: f64,
+    /// Joint samples scored.
+    pub joints: usize,
+    /// Sum over bones of the standard deviation of their length across frames, metres.
+    pub sum_spread_m: f64,
+    /// Bones whose spread was measured (per clip).
+    pub bones: usize,
+    /// Bone-frames whose two roots are far enough apart for the choice to matter.
+    pub choices: usize,
+    /// Of those, the ones where the other root is nearer the truth.
+    pub wrong: usize,
+}
+
+impl Pose3dScore {
+    /// Adds another score.
+    pub fn merge(&mut self, o: &Pose3dScore) {
+        self.sum_pelvis_m += o.sum_pelvis_m;
+        self.sum_pa_m += o.sum_pa_m;
+        self.joints += o.joints;
+        self.sum_spread_m += o.sum_spread_m;
+        self.bones += o.bones;
+        self.choices += o.choices;
+        self.wrong += o.wrong;
+    }
+    /// MPJPE after pelvis alignment, mm.
+    pub fn mpjpe_mm(&self) -> f64 {
+        1000.0 * self.sum_pelvis_m / self.joints.max(1) as f64
+    }
+    /// PA-MPJPE, mm.
+    pub fn pa_mpjpe_mm(&self) -> f64 {
+        1000.0 * self.sum_pa_m / self.joints.max(1) as f64
+    }
+    /// Mean standard deviation of a bone's length across frames, mm.
+    pub fn spread_mm(&self) -> f64 {
+        1000.0 * self.sum_spread_m / self.bones.max(1) as f64
+    }
+    /// Share of depth choices that are wrong.
+    pub fn wrong_share(&self) -> f64 {
+        self.wrong as f64 / self.choices.max(1) as f64
+    }
+}
+
+/// The best similarity transform taking `a` onto `b` (Umeyama 1991), applied to `a`.
+fn procrustes(a: &[Point3<f64>], b: &[Point3<f64>]) -> Vec<Point3<f64>> {
+    let n = a.len() as f64;
+    let ca = a.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / n;
+    let cb = b.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / n;
+    let mut cov = Matrix3::zeros();
+    let mut var_a = 0.0;
+    for (p, q) in a.iter().zip(b) {
+        let (da, db) = (p.coords - ca, q.coords - cb);
+        cov += db * da.transpose();
+        var_a += da.norm_squared();
+    }
+    let svd = cov.svd(true, true);
+    let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
+        return a.to_vec();
+    };
+    let mut s = Matrix3::identity();
+    if (u * v_t).determinant() < 0.0 {
+        s[(2, 2)] = -1.0;
+    }
+    let r = u * s * v_t;
+    let scale = if var_a > 0.0 {
+        (svd.singular_values.component_mul(&s.diagonal())).sum() / var_a
+    } else {
+        1.0
+    };
+    a.iter()
+        .map(|p| Point3::from(cb + r * (p.coords - ca) * scale))
+        .collect()
+}
+
+/// The bones in the order the lift solves them (the spine from the chest down): `(known, solved)`.
+fn lift_order(b: Bone) -> (Joint, Joint) {
+    if b.parent == Joint::Pelvis && b.child == Joint::Chest {
+        (Joint::Chest, Joint::Pelvis)
+    } else {
+        (b.parent, b.child)
+    }
+}
+
+/// Scores a skeleton against the reference (frames matched by index).
+pub fn score_skeleton(gt: &GroundTruth, skeleton: &Skeleton3d) -> Result<Pose3dScore, EvalError> {
+    let derived: Vec<Joint> = gt
+        .derived_joints
+        .iter()
+        .filter_map(|n| Joint::from_name(n))
+        .collect();
+    let scored: Vec<Joint> = Joint::ALL
+        .into_iter()
+        .filter(|j| !derived.contains(j))
+        .collect();
+    let mut s = Pose3dScore::default();
+    let mut lengths: BTreeMap<Bone, Vec<f64>> = BTreeMap::new();
+    for frame in &skeleton.frames {
+        let truth = gt
+            .frames
+            .get(frame.index)
+            .ok_or(EvalError {
+                gt: gt.frames.len(),
+                frame: frame.index,
+            })?
+            .points3d();
+        let p = &frame.points;
+        let (pp, tp) = (p[Joint::Pelvis], truth[Joint::Pelvis]);
+        for &j in &scored {
+            s.sum_pelvis_m += ((p[j] - pp) - (truth[j] - tp)).norm();
+        }
+        let ours: Vec<Point3<f64>> = scored.iter().map(|&j| p[j]).collect();
+        let theirs: Vec<Point3<f64>> = scored.iter().map(|&j| truth[j]).collect();
+        for (a, b) in procrustes(&ours, &theirs).iter().zip(&theirs) {
+            s.sum_pa_m += (a - b).norm();
+        }
+        s.joints += scored.len();
+        for bone in Bone::ALL {
+            let (known, solved) = lift_order(bone);
+            if derived.contains(&known) || derived.contains(&solved) {
+                continue;
+            }
+            let (k, c) = (p[known], p[solved]);
+            let len = (c - k).norm();
+            lengths.entry(bone).or_default().push(len);
+            // The other root on the same ray: s' = 2(r·K) − s.
+            let r = c.coords.normalize();
+            let along = r.dot(&c.coords);
+            let other = 2.0 * r.dot(&k.coords) - along;
+            if (other - along).abs() < 0.1 * len {
+                continue;
+            }
+            let alt = Point3::from(r * other);
+            let want = truth[solved] - truth[known];
+            s.choices += 1;
+            if ((alt - k) - want).norm() < ((c - k) - want).norm() {
+                if std::env::var("DBG").is_ok() {
+                    eprintln!(
+                        "wrong {} f{} ours {:.3} alt {:.3}",
+                        bone.key(),
+                        frame.index,
+                        ((c - k) - want).norm(),
+                        ((alt - k) - want).norm()
+                    );
+                }
+                s.wrong += 1;
+            }
+        }
+    }
+    for values in lengths.values() {
+        let n = values.len() as f64;
+        let mean = values.iter().sum::<f64>() / n;
+        let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n;
+        s.sum_spread_m += var.sqrt();
+        s.bones += 1;
+    }
+    Ok(s)
+}
+
+/// Mean distance between two joints over the reference's frames.
+fn mean_distance(gt: &GroundTruth, a: Joint, b: Joint) -> f64 {
+    let sum: f64 = gt
+        .frames
+        .iter()
+        .map(|f| {
+            let p = f.points3d();
+            (p[a] - p[b]).norm()
+        })
+        .sum();
+    sum / gt.frames.len().max(1) as f64
+}
+
+/// The subject's stature as a user would give it: the reference's leg, spine, neck and head
+/// lengths stacked, divided by the fraction of stature the default proportions give that stack
+/// (ankle height is not in the stack).
+pub fn stature_from_truth(gt: &GroundTruth) -> f64 {
+    let p = Proportions::default();
+    let chain = [
+        (Joint::LeftKnee, Joint::LeftAnkle),
+        (Joint::LeftHip, Joint::LeftKnee),
+        (Joint::Pelvis, Joint::Chest),
+        (Joint::Chest, Joint::Neck),
+        (Joint::Neck, Joint::HeadTop),
+    ];
+    let stack: f64 = chain.iter().map(|&(a, b)| mean_distance(gt, a, b)).sum();
+    let fraction: f64 = chain.iter().map(|&(a, b)| p.fraction_between(a, b)).sum();
+    stack / fraction
+}
+
+/// The subject with the reference's own mean bone lengths and shoulder width.
+pub fn subject_from_truth(gt: &GroundTruth) -> SubjectModel {
+    let mut s = SubjectModel::default();
+    s.height_m = stature_from_truth(gt);
+    for (k, b) in Bone::ALL.iter().enumerate() {
+        s.bone_length_m[k] = mean_distance(gt, b.parent, b.child);
+    }
+    s.shoulder_width_m = mean_distance(gt, Joint::LeftShoulder, Joint::RightShoulder);
+    s
+}
+
+/// Tracks made from the reference's 2D points, plus Gaussian noise of `noise_px` per
+/// coordinate (seeded), all fully trusted.
+pub fn tracks_from_truth(gt: &GroundTruth, noise_px: f64, seed: u64) -> Tracks2d {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    let normal = Normal::new(0.0, noise_px.max(0.0)).ok();
+    let mut jitter = || normal.map_or(0.0, |n| n.sample(&mut rng));
+    Tracks2d {
+        source: SourceInfo {
+            path: "gt.json".into(),
+            width: gt.width,
+            height: gt.height,
+            fps: gt.fps,
+            frame_count: gt.frames.len(),
+        },
+        frames: gt
+            .frames
+            .iter()
+            .map(|f| {
+                let p = f.points2d();
+                FrameTracks {
+                    index: f.index,
+                    points: PerJoint::from_fn(|j| TrackedPoint {
+                        pos: Point2::new(p[j].x + jitter(), p[j].y + jitter()),
+                        confidence: 1.0,
+                        source: PointSource::Tracked,
+                    }),
+                }
+            })
+            .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn procrustes_undoes_a_similarity() {
+        let a: Vec<Point3<f64>> = (0..6)
+            .map(|i| Point3::new(i as f64, (i * i) as f64 * 0.1, (i % 3) as f64))
+            .collect();
+        let r = nalgebra::Rotation3::from_euler_angles(0.3, -0.5, 1.1);
+        let b: Vec<Point3<f64>> = a
+            .iter()
+            .map(|p| Point3::from(r * p.coords * 1.7 + Vector3::new(1.0, 2.0, 3.0)))
+            .collect();
+        for (p, q) in procrustes(&a, &b).iter().zip(&b) {
+            assert!((p - q).norm() < 1e-9);
+        }
+    }
+}
