@@ -22,10 +22,10 @@ set +e
 "$bin" run "$sample/video.mp4" --marks "$sample/marks.json" --out-dir "$out"
 code=$?
 set -e
-if [ "$code" -eq 2 ] && [ -f "$out/tracks2d.json" ] && [ ! -f "$out/motion.bvh" ]; then
+if [ "$code" -eq 2 ] && [ -f "$out/skeleton3d.json" ] && [ ! -f "$out/motion.bvh" ]; then
   echo
-  echo "Tracked the sample: $out/tracks2d.json. 3D reconstruction and BVH export are not built"
-  echo "yet in this version, so the pipeline stops after tracking. Also written: $out/info.json"
+  echo "Tracked and lifted the sample: $out/tracks2d.json, $out/skeleton3d.json. BVH export is"
+  echo "not built yet in this version, so the pipeline stops there. Also written: $out/info.json"
   exit 0
 fi
 if [ "$code" -ne 0 ]; then exit "$code"; fi

@@ -186,3 +186,36 @@ fn info_prints_the_samples_portrait_size_and_json() {
     );
     assert_eq!(v["fps"].as_f64(), Some(60.0));
 }
+
+#[test]
+fn lift_writes_a_skeleton_and_refuses_a_bad_focal_length() {
+    let dir = tempfile::tempdir().unwrap();
+    let gt_path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("sample_videos/synth_walk_oblique/gt.json");
+    let gt = videomocap::synth::GroundTruth::load(&gt_path).unwrap();
+    let tracks = videomocap::eval::pose3d::tracks_from_truth(&gt, 0.0, 1);
+    let tp = dir.path().join("tracks2d.json");
+    tracks.save(&tp).unwrap();
+    let out = dir.path().join("skeleton3d.json");
+    let (tp, outs) = (tp.to_str().unwrap(), out.to_str().unwrap());
+    assert_bad(
+        &["lift", tp, "-o", outs, "--focal-px=-3"],
+        &["--focal-px", "positive"],
+    );
+    assert!(!out.exists());
+    let (code, stderr) = run(&[
+        "lift",
+        tp,
+        "-o",
+        outs,
+        "--focal-px",
+        "600",
+        "--height-m",
+        "1.75",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let s = videomocap::formats::Skeleton3d::load(&out).unwrap();
+    assert_eq!(s.frames.len(), gt.frames.len());
+    assert_eq!(s.camera.focal_px, 600.0);
+    assert!(stderr.contains("lifted 60 frames"), "{stderr}");
+}

@@ -152,15 +152,6 @@ pub fn score_skeleton(gt: &GroundTruth, skeleton: &Skeleton3d) -> Result<Pose3dS
             let want = truth[solved] - truth[known];
             s.choices += 1;
             if ((alt - k) - want).norm() < ((c - k) - want).norm() {
-                if std::env::var("DBG").is_ok() {
-                    eprintln!(
-                        "wrong {} f{} ours {:.3} alt {:.3}",
-                        bone.key(),
-                        frame.index,
-                        ((c - k) - want).norm(),
-                        ((alt - k) - want).norm()
-                    );
-                }
                 s.wrong += 1;
             }
         }
@@ -207,8 +198,10 @@ pub fn stature_from_truth(gt: &GroundTruth) -> f64 {
 
 /// The subject with the reference's own mean bone lengths and shoulder width.
 pub fn subject_from_truth(gt: &GroundTruth) -> SubjectModel {
-    let mut s = SubjectModel::default();
-    s.height_m = stature_from_truth(gt);
+    let mut s = SubjectModel {
+        height_m: stature_from_truth(gt),
+        ..SubjectModel::default()
+    };
     for (k, b) in Bone::ALL.iter().enumerate() {
         s.bone_length_m[k] = mean_distance(gt, b.parent, b.child);
     }

@@ -33,6 +33,8 @@ pub struct AmbiguityWeights {
     pub elbow: f64,
     /// Upper arms and thighs hang along the trunk (a weak preference for the rest pose).
     pub hanging: f64,
+    /// A joint off its viewing ray (its bone too short for its 2D image).
+    pub miss: f64,
 }
 
 impl Default for AmbiguityWeights {
@@ -44,6 +46,7 @@ impl Default for AmbiguityWeights {
             knee: 2.0,
             elbow: 0.5,
             hanging: 0.05,
+            miss: 10.0,
         }
     }
 }
@@ -285,13 +288,20 @@ pub fn resolve(
                             {
                                 c.unary = f64::INFINITY;
                             }
+                            if roots.too_long {
+                                // The joint cannot lie on its ray: the miss counts against
+                                // this candidate (a wrong parent often causes it).
+                                let q = roots.get(root).coords;
+                                let ray = &rays[t][bone.child];
+                                c.unary += weights.miss * (q - ray * ray.dot(&q)).norm_squared();
+                            }
                             p.0[bone.child.index()] = roots.get(root);
                             c.absolute[k] = roots.get(root);
                             c.relative[k] = roots.get(root) - p[group.bones[0].parent];
                             c.too_long[k] = roots.too_long;
                         }
                         if c.unary.is_finite() {
-                            c.unary = prior_cost(group, &p, &trunks[t], subject, weights);
+                            c.unary += prior_cost(group, &p, &trunks[t], subject, weights);
                         }
                         c
                     })

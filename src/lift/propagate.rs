@@ -80,8 +80,8 @@ mod tests {
         let image = after.map(|p| cam.project(&p).unwrap());
         let found = key_depths(&cam, &image, &sides, before.map(|p| p.z));
         assert!(found.rms_m < 1e-9);
-        for k in 0..3 {
-            assert!((found.points[k] - after[k]).norm() < 1e-6, "joint {k}");
+        for (k, (f, a)) in found.points.iter().zip(&after).enumerate() {
+            assert!((f - a).norm() < 1e-6, "joint {k}");
         }
     }
 }

@@ -249,27 +249,6 @@ impl Problem<'_> {
         c
     }
 
-    fn breakdown(&self, x: &DVector<f64>) -> Vec<f64> {
-        let mut c = vec![0.0; 8];
-        self.rows(x, |r| {
-            let k = match r.len {
-                2 => 0,
-                7 => 1,
-                3 => {
-                    if r.entries[1].1 < 0.0 {
-                        3
-                    } else {
-                        2
-                    }
-                }
-                1 => 4,
-                _ => 5,
-            };
-            c[k] += r.value * r.value
-        });
-        c
-    }
-
     fn reprojection_rms(&self, x: &DVector<f64>) -> f64 {
         let mut sum = 0.0;
         let mut count = 0.0f64;
@@ -385,25 +364,6 @@ pub fn refine(
         }
     }
     progress(params.max_iterations, params.max_iterations);
-    if std::env::var("DBG").is_ok() {
-        let mut x0 = DVector::zeros(m);
-        for (t, frame) in start.iter().enumerate() {
-            for j in Joint::ALL {
-                let c = Problem::col(t, j);
-                x0[c] = frame[j].x;
-                x0[c + 1] = frame[j].y;
-                x0[c + 2] = frame[j].z;
-            }
-        }
-        for k in 0..LENGTHS {
-            x0[n * PER_FRAME + k] = start_lengths[k];
-        }
-        eprintln!(
-            "breakdown before {:?}\nafter {:?}",
-            problem.breakdown(&x0),
-            problem.breakdown(&x)
-        );
-    }
     let points = (0..n)
         .map(|t| PerJoint::from_fn(|j| Problem::point(&x, t, j)))
         .collect();

@@ -26,6 +26,10 @@ pub struct LiftParams {
     /// A frame's key triangle is re-calibrated when eq. 11 leaves more than this RMS residual,
     /// metres (default 0.005).
     pub propagation_tolerance_m: f64,
+    /// The per-frame solve works on tracks smoothed over time by a Gaussian of this many
+    /// seconds (default 0.066: two frames at 30 fps; 0 = raw tracks). Measured on the synthetic
+    /// suite with 2 px noise it halves the per-frame error; on exact tracks it costs a little.
+    pub smoothing_s: f64,
     /// Weights of the depth-ambiguity priors.
     pub ambiguity: AmbiguityWeights,
     /// Weights of the global refinement.
@@ -38,6 +42,7 @@ impl Default for LiftParams {
             refine: true,
             calibration_tolerance_px: 1.0,
             propagation_tolerance_m: 0.005,
+            smoothing_s: 0.066,
             ambiguity: AmbiguityWeights::default(),
             refinement: RefineParams::default(),
         }
@@ -152,8 +157,42 @@ fn check(job: &LiftJob<'_>) -> Result<(), LiftError> {
     Ok(())
 }
 
-fn key_image(tracks: &Tracks2d, t: usize) -> [Point2<f64>; 3] {
-    KEY_JOINTS.map(|j| tracks.frames[t].points[j].pos)
+fn key_image(images: &[PerJoint<Point2<f64>>], t: usize) -> [Point2<f64>; 3] {
+    KEY_JOINTS.map(|j| images[t][j])
+}
+
+/// The tracks smoothed over time by a Gaussian of `sigma` frames, each point weighted by its
+/// trust ([`super::refine::track_weight`]): the per-frame solve amplifies 2D noise (a 2 px error
+/// on a shoulder moves its depth by centimetres), and the refinement sees the raw tracks again.
+fn smoothed_images(tracks: &Tracks2d, sigma: f64) -> Vec<PerJoint<Point2<f64>>> {
+    let raw: Vec<PerJoint<Point2<f64>>> = tracks
+        .frames
+        .iter()
+        .map(|f| f.points.map(|_, p| p.pos))
+        .collect();
+    if sigma <= 0.0 {
+        return raw;
+    }
+    let reach = (3.0 * sigma).ceil() as usize;
+    let n = raw.len();
+    (0..n)
+        .map(|t| {
+            PerJoint::from_fn(|j| {
+                let mut sum = nalgebra::Vector2::zeros();
+                let mut total = 0.0;
+                let first = t.saturating_sub(reach);
+                let window = raw.iter().zip(&tracks.frames).enumerate();
+                for (u, (point, frame)) in window.skip(first).take(t + reach + 1 - first) {
+                    let d = u as f64 - t as f64;
+                    let w = (-0.5 * d * d / (sigma * sigma)).exp()
+                        * super::refine::track_weight(&frame.points[j]);
+                    sum += point[j].coords * w;
+                    total += w;
+                }
+                Point2::from(sum / total)
+            })
+        })
+        .collect()
 }
 
 /// Shoulders on top of each other or on the chest (closer than one pixel).
@@ -187,17 +226,18 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
     let n = tracks.frames.len();
     let triangle = KeyTriangle::from_subject(&job.subject)?;
     let sides = super::calibrate::KEY_LINES.map(|(i, j)| triangle.side(i, j));
-    let images: Vec<PerJoint<Point2<f64>>> = tracks
-        .frames
-        .iter()
-        .map(|f| f.points.map(|_, p| p.pos))
-        .collect();
+    let fps = if tracks.source.fps.is_finite() && tracks.source.fps > 0.0 {
+        tracks.source.fps
+    } else {
+        30.0
+    };
+    let images = smoothed_images(tracks, job.params.smoothing_s * fps);
     let rays: Vec<_> = images.iter().map(|im| im.map(|_, p| cam.ray(p))).collect();
     let frame_index: Vec<usize> = tracks.frames.iter().map(|f| f.index).collect();
 
     // The calibration frame: the best-shaped key triangle, weighted by the trust in its points.
     let calibration_frame = (0..n)
-        .filter(|&t| !degenerate(&key_image(tracks, t)))
+        .filter(|&t| !degenerate(&key_image(&images, t)))
         .max_by(|&a, &b| {
             let score = |t: usize| {
                 let trust = KEY_JOINTS
@@ -205,7 +245,7 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
                     .map(|&j| f64::from(tracks.frames[t].points[j].confidence))
                     .fold(1.0, f64::min)
                     .max(0.05);
-                shape(&key_image(tracks, t)) * trust
+                shape(&key_image(&images, t)) * trust
             };
             score(a).total_cmp(&score(b))
         })
@@ -213,7 +253,7 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
     let calibrations = calibrate_all(
         cam,
         &triangle,
-        &key_image(tracks, calibration_frame),
+        &key_image(&images, calibration_frame),
         job.params.calibration_tolerance_px,
     );
     // Several poses fit three points. Each is carried through the whole sequence and the
@@ -222,10 +262,16 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
     // root choices (a wrong pose twists the shoulders against the hips and bends knees the
     // wrong way for the whole clip).
     let key_of = |pose: &super::calibrate::Pose| triangle.points.map(|p| pose.apply(&p));
-    let mut best: Option<(f64, Vec<[Point3<f64>; 3]>, Vec<FrameReport>, Resolved)> = None;
+    let mut best: Option<(f64, Vec<FrameReport>, Resolved)> = None;
     for c in &calibrations {
-        let (key, mut reports) =
-            propagate_all(job, &triangle, &sides, calibration_frame, key_of(&c.pose));
+        let (key, mut reports) = propagate_all(
+            job,
+            &images,
+            &triangle,
+            &sides,
+            calibration_frame,
+            key_of(&c.pose),
+        );
         let resolved = resolve(
             &key,
             &rays,
@@ -246,10 +292,10 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
                     }
                 }
             }
-            best = Some((score, key, reports, resolved));
+            best = Some((score, reports, resolved));
         }
     }
-    let Some((_, _, reports, resolved)) = best else {
+    let Some((_, reports, resolved)) = best else {
         return Err(LiftError::CalibrationFailed {
             frame: frame_index[calibration_frame],
         });
@@ -265,6 +311,7 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
 /// directions, re-calibrating a frame where they do not hold.
 fn propagate_all(
     job: &LiftJob<'_>,
+    images: &[PerJoint<Point2<f64>>],
     triangle: &KeyTriangle,
     sides: &[f64; 3],
     calibration_frame: usize,
@@ -283,14 +330,25 @@ fn propagate_all(
             flags: Vec::new(),
         })
         .collect();
+    // (frame, previous frame, the one before it if already solved).
     let order = (calibration_frame + 1..n)
-        .map(|t| (t, t - 1))
-        .chain((0..calibration_frame).rev().map(|t| (t, t + 1)));
+        .map(|t| (t, t - 1, (t >= calibration_frame + 2).then(|| t - 2)))
+        .chain(
+            (0..calibration_frame)
+                .rev()
+                .map(|t| (t, t + 1, (t + 2 <= calibration_frame).then_some(t + 2))),
+        );
     let tolerance = job.params.propagation_tolerance_m;
-    for (t, from) in order {
-        let image = key_image(tracks, t);
+    for (t, from, before) in order {
+        let image = key_image(images, t);
         let previous = key[from];
-        let mut found = key_depths(cam, &image, sides, previous.map(|p| p.z));
+        // Start from the depths extrapolated at constant velocity, so that where two solutions
+        // of eq. 11 meet and part again the one continuing the motion is followed.
+        let start = [0, 1, 2].map(|i| match before {
+            Some(b) => (2.0 * previous[i].z - key[b][i].z).max(0.1),
+            None => previous[i].z,
+        });
+        let mut found = key_depths(cam, &image, sides, start);
         if found.rms_m > tolerance {
             let distance =
                 |k: &[Point3<f64>; 3]| (0..3).map(|i| (k[i] - previous[i]).norm()).sum::<f64>();
