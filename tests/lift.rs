@@ -304,3 +304,24 @@ fn bad_tracks_are_refused_with_a_reason() {
         .to_string();
     assert!(e.contains("frame 7") && e.contains("left_knee"), "{e}");
 }
+
+#[test]
+fn the_refinement_lowers_its_cost_and_keeps_bones_near_their_lengths() {
+    let (gt, subject) = truth();
+    let out = run(&gt, &subject, 2.0, true);
+    let r = out.refinement.expect("refinement ran");
+    assert!(r.cost_after < r.cost_before, "{r:?}");
+    assert_eq!(out.skeleton.frames.len(), FRAMES);
+    for f in &out.skeleton.frames {
+        for b in Bone::ALL {
+            let l = (f.points[b.child] - f.points[b.parent]).norm();
+            let l0 = subject.bone_length(b);
+            assert!(
+                (l - l0).abs() < 0.05 * l0,
+                "frame {} {}: {l} vs {l0}",
+                f.index,
+                b.key()
+            );
+        }
+    }
+}

@@ -97,8 +97,12 @@ pub struct LiftOptions {
     #[arg(long, conflicts_with = "fov_deg")]
     pub focal_px: Option<f64>,
     /// Horizontal field of view in degrees (instead of --focal-px).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "focal_px")]
     pub fov_deg: Option<f64>,
+    /// Estimate the focal length from the tracks (instead of the default 60° across the
+    /// longer image side when neither --focal-px nor --fov-deg is given; experimental).
+    #[arg(long, conflicts_with_all = ["focal_px", "fov_deg"])]
+    pub estimate_focal: bool,
     /// The subject's height in metres (scales the bone lengths; default 1.70).
     #[arg(long)]
     pub height_m: Option<f64>,

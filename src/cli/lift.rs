@@ -7,7 +7,7 @@ use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use videomocap::camera::PinholeCamera;
 use videomocap::formats::Tracks2d;
-use videomocap::lift::focal::estimate_focal;
+use videomocap::lift::focal::{DEFAULT_FOV_LONG_SIDE_DEG, default_focal, estimate_focal};
 use videomocap::lift::{FrameFlag, LiftError, LiftJob, LiftOutput, LiftParams, lift};
 use videomocap::skeleton::{DEFAULT_HEIGHT_M, Proportions, SubjectModel};
 
@@ -82,11 +82,8 @@ pub fn lift_with_progress(
         job.camera.focal_px = f;
     } else if let Some(fov) = o.fov_deg {
         job.camera.focal_px = PinholeCamera::focal_from_horizontal_fov(fov, w);
-    } else {
-        say(
-            global,
-            "estimating the focal length (give --focal-px or --fov-deg to skip) …",
-        );
+    } else if o.estimate_focal {
+        say(global, "estimating the focal length …");
         let est = estimate_focal(&job).map_err(lift_error)?;
         job.camera.focal_px = est.focal_px;
         let fov = 2.0 * (f64::from(w) / 2.0 / est.focal_px).atan().to_degrees();
@@ -95,6 +92,15 @@ pub fn lift_with_progress(
             &format!(
                 "estimated focal length {:.0} px (horizontal field of view {fov:.0}°)",
                 est.focal_px
+            ),
+        );
+    } else {
+        job.camera.focal_px = default_focal(w, h);
+        say(
+            global,
+            &format!(
+                "focal length {:.0} px: the default {DEFAULT_FOV_LONG_SIDE_DEG:.0}° across the longer image side (give --focal-px or --fov-deg if you know the camera)",
+                job.camera.focal_px
             ),
         );
     }

@@ -31,9 +31,12 @@ pub struct RefineParams {
     pub reprojection_sigma_px: f64,
     /// Allowed deviation of a bone from its length, metres (default 0.005).
     pub length_sigma_m: f64,
-    /// Typical joint acceleration, m/s² (default 20).
+    /// Typical joint acceleration, m/s² (default 100: only jitter is smoothed; at 20 the
+    /// refinement bent fast motions such as jumping jacks out of shape on the suite).
     pub acceleration_sigma_mps2: f64,
-    /// Allowed relative change of each bone length from its start (default 0.1).
+    /// Allowed relative change of each bone length from its start (default 0.01: one camera
+    /// cannot tell a longer bone from a bone turned towards it, and at 0.1 the refinement traded
+    /// lengths for depth and tilted whole poses on the suite).
     pub length_prior: f64,
     /// Levenberg–Marquardt iterations at most (default 20).
     pub max_iterations: usize,
@@ -44,8 +47,8 @@ impl Default for RefineParams {
         RefineParams {
             reprojection_sigma_px: 2.0,
             length_sigma_m: 0.005,
-            acceleration_sigma_mps2: 20.0,
-            length_prior: 0.1,
+            acceleration_sigma_mps2: 100.0,
+            length_prior: 0.01,
             max_iterations: 20,
         }
     }
