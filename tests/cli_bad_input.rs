@@ -219,3 +219,24 @@ fn lift_writes_a_skeleton_and_refuses_a_bad_focal_length() {
     assert_eq!(s.camera.focal_px, 600.0);
     assert!(stderr.contains("lifted 60 frames"), "{stderr}");
 }
+
+#[test]
+fn a_degenerate_key_triangle_is_named_with_its_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let gt_path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("sample_videos/synth_walk_oblique/gt.json");
+    let gt = videomocap::synth::GroundTruth::load(&gt_path).unwrap();
+    let mut tracks = videomocap::eval::pose3d::tracks_from_truth(&gt, 0.0, 1);
+    for f in &mut tracks.frames {
+        let left = f.points[videomocap::skeleton::Joint::LeftShoulder];
+        f.points.0[videomocap::skeleton::Joint::RightShoulder.index()] = left;
+    }
+    let tp = dir.path().join("flat.json");
+    tracks.save(&tp).unwrap();
+    let tp = tp.to_str().unwrap();
+    let out = dir.path().join("s.json");
+    assert_bad(
+        &["lift", tp, "-o", out.to_str().unwrap(), "--fov-deg", "60"],
+        &[tp, "shoulders"],
+    );
+}

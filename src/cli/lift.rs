@@ -48,16 +48,20 @@ pub fn load_settings(path: &Path) -> Result<LiftParams, ExitError> {
         .map_err(|e| ExitError::bad_input(anyhow!("{}: bad lift settings: {e}", path.display())))
 }
 
-fn lift_error(e: LiftError) -> ExitError {
+/// A lift error naming the input it came from.
+fn lift_error(source: &Path, e: LiftError) -> ExitError {
+    let named = anyhow!("{}: {e}", source.display());
     match e {
-        LiftError::Cancelled | LiftError::CalibrationFailed { .. } => ExitError::failed(e),
-        _ => ExitError::bad_input(e),
+        LiftError::Cancelled | LiftError::CalibrationFailed { .. } => ExitError::failed(named),
+        _ => ExitError::bad_input(named),
     }
 }
 
 /// Lifts tracks with the options' camera and subject, with progress; shared by `lift` and `run`.
+/// `source` names the tracks (or the video they came from) in errors.
 pub fn lift_with_progress(
     tracks: &Tracks2d,
+    source: &Path,
     o: &LiftOptions,
     global: &GlobalArgs,
 ) -> Result<LiftOutput, ExitError> {
@@ -84,7 +88,7 @@ pub fn lift_with_progress(
         job.camera.focal_px = PinholeCamera::focal_from_horizontal_fov(fov, w);
     } else if o.estimate_focal {
         say(global, "estimating the focal length …");
-        let est = estimate_focal(&job).map_err(lift_error)?;
+        let est = estimate_focal(&job).map_err(|e| lift_error(source, e))?;
         job.camera.focal_px = est.focal_px;
         let fov = 2.0 * (f64::from(w) / 2.0 / est.focal_px).atan().to_degrees();
         say(
@@ -115,7 +119,7 @@ pub fn lift_with_progress(
         },
         &cancel,
     )
-    .map_err(lift_error)?;
+    .map_err(|e| lift_error(source, e))?;
     bar.finish_and_clear();
     Ok(out)
 }
@@ -160,7 +164,7 @@ pub fn report(out: &LiftOutput, global: &GlobalArgs) {
 pub fn run(a: &LiftArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     check_options(&a.options)?;
     let tracks = Tracks2d::load(&a.tracks).map_err(ExitError::bad_input)?;
-    let out = lift_with_progress(&tracks, &a.options, global)?;
+    let out = lift_with_progress(&tracks, &a.tracks, &a.options, global)?;
     out.skeleton.save(&a.output).map_err(ExitError::failed)?;
     report(&out, global);
     say(global, &format!("wrote {}", a.output.display()));

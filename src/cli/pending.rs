@@ -35,7 +35,7 @@ pub fn run_all(a: &RunArgs, global: &super::args::GlobalArgs) -> Result<(), Exit
     out.tracks.save(&path).map_err(ExitError::failed)?;
     super::track::report(&out, global);
     super::say(global, &format!("wrote {}", path.display()));
-    let lifted = super::lift::lift_with_progress(&out.tracks, &a.options, global)?;
+    let lifted = super::lift::lift_with_progress(&out.tracks, &a.video, &a.options, global)?;
     let path = a.out_dir.join("skeleton3d.json");
     lifted.skeleton.save(&path).map_err(ExitError::failed)?;
     super::lift::report(&lifted, global);

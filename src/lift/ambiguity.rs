@@ -116,12 +116,7 @@ const GROUPS: [Group; 7] = [
 /// Length of a bone of the lifting order (which runs chest-outwards, so the spine is
 /// `chest → pelvis` although the model's tree is rooted at the pelvis).
 fn length(subject: &SubjectModel, bone: Bone) -> f64 {
-    let modelled = if bone.parent == Chest && bone.child == Pelvis {
-        Bone::new(Pelvis, Chest)
-    } else {
-        bone
-    };
-    subject.bone_length(modelled)
+    subject.bone_length(model_bone(bone))
 }
 
 /// The model's bone that a lifting-order bone stands for.

@@ -23,5 +23,6 @@ pub use ambiguity::{AmbiguityWeights, DepthOverrides};
 pub use backproject::Root;
 pub use error::LiftError;
 pub use solve::{
-    FrameFlag, FrameReport, LiftJob, LiftOutput, LiftParams, LiftProgress, lift, lift_per_frame,
+    FrameFlag, FrameReport, LiftJob, LiftOutput, LiftParams, LiftProgress, PerFrame, lift,
+    lift_per_frame,
 };
