@@ -19,7 +19,7 @@ use videomocap::eval::pose3d::{
 };
 use videomocap::formats::{Marks, Tracks2d};
 use videomocap::lift::focal::estimate_focal;
-use videomocap::lift::{FrameFlag, LiftJob, LiftParams, lift, lift_per_frame};
+use videomocap::lift::{LiftJob, LiftParams, lift, lift_per_frame};
 use videomocap::skeleton::{Proportions, SubjectModel};
 use videomocap::synth::GroundTruth;
 use videomocap::track::TrackerParams;
@@ -75,15 +75,7 @@ fn lift_case(
     case.refined
         .merge(&score_skeleton(gt, &out.skeleton).map_err(ExitError::failed)?);
     case.frames += out.reports.len();
-    case.flagged += out
-        .reports
-        .iter()
-        .filter(|r| {
-            r.flags
-                .iter()
-                .any(|f| !matches!(f, FrameFlag::KeyTriangleRecalibrated))
-        })
-        .count();
+    case.flagged += out.reports.iter().filter(|r| !r.flags.is_empty()).count();
     Ok(())
 }
 

@@ -143,9 +143,8 @@ pub fn report(out: &LiftOutput, global: &GlobalArgs) {
     say(
         global,
         &format!(
-            "frames with a bone too long for its 2D image: {}; key triangle re-calibrated: {}; not converged: {}",
+            "frames with a bone too long for its 2D image: {}; with no key-triangle pose that fits: {}",
             count(&|f| matches!(f, FrameFlag::TooLong(_))),
-            count(&|f| matches!(f, FrameFlag::KeyTriangleRecalibrated)),
             count(&|f| matches!(f, FrameFlag::KeyTriangleNotConverged)),
         ),
     );

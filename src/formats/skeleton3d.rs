@@ -23,7 +23,7 @@ pub struct Frame3d {
     /// Joint positions in camera space, metres.
     pub points: PerJoint<Point3<f64>>,
     /// What the reconstruction noticed on this frame (e.g. `too_long:left_elbow-left_wrist`,
-    /// `key_triangle_recalibrated`); empty when all went well. Optional in the file.
+    /// `key_triangle_not_converged`); empty when all went well. Optional in the file.
     pub flags: Vec<String>,
 }
 

@@ -3,7 +3,9 @@
 
 use super::ambiguity::{AmbiguityWeights, DepthOverrides, Resolved, resolve};
 use super::backproject::Root;
-use super::calibrate::{KEY_JOINTS, KeyTriangle, calibrate_all, shape};
+use super::calibrate::{
+    KEY_JOINTS, KeyTriangle, Residuals, calibrate_all, calibrate_from, shape, starting_poses,
+};
 use super::error::LiftError;
 use super::propagate::key_depths;
 use super::refine::{RefineParams, RefineSummary, refine};
@@ -28,8 +30,10 @@ pub struct LiftParams {
     /// metres (default 0.005).
     pub propagation_tolerance_m: f64,
     /// The per-frame solve works on tracks smoothed over time by a Gaussian of this many
-    /// seconds (default 0.066: two frames at 30 fps; 0 = raw tracks). Measured on the synthetic
-    /// suite with 2 px noise it halves the per-frame error; on exact tracks it costs a little.
+    /// seconds (default 0 = raw tracks). Measured on the synthetic suite, 0.066 s (two frames
+    /// at 30 fps) halved the error with 2 px white noise (150 → 80 mm) but raised it with exact
+    /// tracks (31 → 51 mm: a grazing key triangle turns a pixel of lag into centimetres of
+    /// depth) and with the tracker's own output (147 → 159 mm), so it is off by default.
     pub smoothing_s: f64,
     /// Weights of the depth-ambiguity priors.
     pub ambiguity: AmbiguityWeights,
@@ -43,7 +47,7 @@ impl Default for LiftParams {
             refine: false,
             calibration_tolerance_px: 1.0,
             propagation_tolerance_m: 0.005,
-            smoothing_s: 0.066,
+            smoothing_s: 0.0,
             ambiguity: AmbiguityWeights::default(),
             refinement: RefineParams::default(),
         }
@@ -68,9 +72,7 @@ pub struct LiftJob<'a> {
 /// Something worth knowing about one frame of the result.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FrameFlag {
-    /// Eq. 11 did not hold from the previous frame; the key triangle was calibrated afresh.
-    KeyTriangleRecalibrated,
-    /// Neither propagation nor calibration fitted the key triangle; the closest fit is kept.
+    /// No pose of the key triangle fits the frame's three points; the closest fit is kept.
     KeyTriangleNotConverged,
     /// The bone's 2D image is longer than its 3D length allows: the joint is off its ray.
     TooLong(Bone),
@@ -79,7 +81,6 @@ pub enum FrameFlag {
 impl fmt::Display for FrameFlag {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            FrameFlag::KeyTriangleRecalibrated => f.write_str("key_triangle_recalibrated"),
             FrameFlag::KeyTriangleNotConverged => f.write_str("key_triangle_not_converged"),
             FrameFlag::TooLong(b) => write!(f, "too_long:{}", b.key()),
         }
@@ -266,15 +267,36 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
     // wrong way for the whole clip).
     let key_of = |pose: &super::calibrate::Pose| triangle.points.map(|p| pose.apply(&p));
     let mut best: Option<(f64, Vec<FrameReport>, Resolved)> = None;
+    // Every frame's candidate poses, computed once.
+    let per_frame: Vec<(Vec<[Point3<f64>; 3]>, bool)> = (0..n)
+        .map(|t| key_candidates(job, &triangle, &sides, &key_image(&images, t)))
+        .collect();
     for c in &calibrations {
-        let (key, mut reports) = propagate_all(
-            job,
-            &images,
-            &triangle,
-            &sides,
-            calibration_frame,
-            key_of(&c.pose),
-        );
+        let mut candidates: Vec<Vec<[Point3<f64>; 3]>> =
+            per_frame.iter().map(|(k, _)| k.clone()).collect();
+        candidates[calibration_frame] = vec![key_of(&c.pose)];
+        let key = smoothest_key_path(&candidates);
+        let mut reports: Vec<FrameReport> = tracks
+            .frames
+            .iter()
+            .zip(&per_frame)
+            .zip(&key)
+            .map(|((f, (_, converged)), k)| FrameReport {
+                index: f.index,
+                key_rms_m: super::calibrate::KEY_LINES
+                    .iter()
+                    .zip(&sides)
+                    .map(|(&(i, j), side)| ((k[i] - k[j]).norm() - side).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+                    / 3f64.sqrt(),
+                flags: if *converged {
+                    Vec::new()
+                } else {
+                    vec![FrameFlag::KeyTriangleNotConverged]
+                },
+            })
+            .collect();
         let resolved = resolve(
             &key,
             &rays,
@@ -311,71 +333,117 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
     })
 }
 
-/// The key triangle in every frame: eqs. 10–11 outwards from the calibration frame in both
-/// directions, re-calibrating a frame where they do not hold.
-fn propagate_all(
+/// Every pose of the key triangle that fits one frame (a three-point pose has up to four), each
+/// made exact by eqs. 10–11; when none fits within tolerance, the closest fit, and `false`.
+fn key_candidates(
     job: &LiftJob<'_>,
-    images: &[PerJoint<Point2<f64>>],
     triangle: &KeyTriangle,
     sides: &[f64; 3],
-    calibration_frame: usize,
-    start: [Point3<f64>; 3],
-) -> (Vec<[Point3<f64>; 3]>, Vec<FrameReport>) {
+    image: &[Point2<f64>; 3],
+) -> (Vec<[Point3<f64>; 3]>, bool) {
     let cam = &job.camera;
-    let tracks = job.tracks;
-    let n = tracks.frames.len();
-    let mut key = vec![start; n];
-    let mut reports: Vec<FrameReport> = tracks
-        .frames
+    let fits = calibrate_all(cam, triangle, image, job.params.calibration_tolerance_px);
+    let converged = !fits.is_empty();
+    let poses: Vec<_> = if converged {
+        fits.iter().map(|c| c.pose).collect()
+    } else {
+        starting_poses(cam, triangle, image)
+            .into_iter()
+            .map(|start| calibrate_from(cam, triangle, image, start, Residuals::Points))
+            .min_by(|a, b| a.rms_px.total_cmp(&b.rms_px))
+            .map(|c| c.pose)
+            .into_iter()
+            .collect()
+    };
+    let mut out: Vec<[Point3<f64>; 3]> = Vec::new();
+    for pose in poses {
+        let k = triangle.points.map(|p| pose.apply(&p));
+        let snapped = key_depths(cam, image, sides, k.map(|p| p.z));
+        let k = if snapped.rms_m < job.params.propagation_tolerance_m {
+            snapped.points
+        } else {
+            k
+        };
+        if !out
+            .iter()
+            .any(|o| (0..3).all(|i| (o[i] - k[i]).norm() < 1e-3))
+        {
+            out.push(k);
+        }
+    }
+    (out, converged)
+}
+
+/// Squared acceleration of the key joints over three frames.
+fn key_acceleration(a: &[Point3<f64>; 3], b: &[Point3<f64>; 3], c: &[Point3<f64>; 3]) -> f64 {
+    (0..3)
+        .map(|i| (c[i].coords - b[i].coords * 2.0 + a[i].coords).norm_squared())
+        .sum()
+}
+
+/// The smoothest sequence of key-triangle poses through the per-frame candidates (Viterbi over
+/// pairs of frames, least squared acceleration): where two solutions of eqs. 10–11 meet and
+/// part again, the one continuing the motion is kept.
+fn smoothest_key_path(candidates: &[Vec<[Point3<f64>; 3]>]) -> Vec<[Point3<f64>; 3]> {
+    let n = candidates.len();
+    if n == 0 {
+        return Vec::new();
+    }
+    if n == 1 {
+        return vec![candidates[0][0]];
+    }
+    // cost[(a, b)]: best with frame t−1 at a and frame t at b.
+    let mut cost: Vec<Vec<f64>> = candidates[0]
         .iter()
-        .map(|f| FrameReport {
-            index: f.index,
-            key_rms_m: 0.0,
-            flags: Vec::new(),
+        .map(|a| {
+            candidates[1]
+                .iter()
+                .map(|b| (0..3).map(|i| (b[i] - a[i]).norm_squared()).sum())
+                .collect()
         })
         .collect();
-    // (frame, previous frame, the one before it if already solved).
-    let order = (calibration_frame + 1..n)
-        .map(|t| (t, t - 1, (t >= calibration_frame + 2).then(|| t - 2)))
-        .chain(
-            (0..calibration_frame)
-                .rev()
-                .map(|t| (t, t + 1, (t + 2 <= calibration_frame).then_some(t + 2))),
-        );
-    let tolerance = job.params.propagation_tolerance_m;
-    for (t, from, before) in order {
-        let image = key_image(images, t);
-        let previous = key[from];
-        // Start from the depths extrapolated at constant velocity, so that where two solutions
-        // of eq. 11 meet and part again the one continuing the motion is followed.
-        let start = [0, 1, 2].map(|i| match before {
-            Some(b) => (2.0 * previous[i].z - key[b][i].z).max(0.1),
-            None => previous[i].z,
-        });
-        let mut found = key_depths(cam, &image, sides, start);
-        if found.rms_m > tolerance {
-            let distance =
-                |k: &[Point3<f64>; 3]| (0..3).map(|i| (k[i] - previous[i]).norm()).sum::<f64>();
-            let nearest = calibrate_all(cam, triangle, &image, job.params.calibration_tolerance_px)
-                .iter()
-                .map(|c| triangle.points.map(|p| c.pose.apply(&p)))
-                .min_by(|a, b| distance(a).total_cmp(&distance(b)));
-            if let Some(k) = nearest {
-                let again = key_depths(cam, &image, sides, k.map(|p| p.z));
-                if again.rms_m < found.rms_m {
-                    found = again;
+    let mut back: Vec<Vec<Vec<usize>>> = Vec::new();
+    for t in 2..n {
+        let (kb, kc) = (candidates[t - 1].len(), candidates[t].len());
+        let mut next = vec![vec![f64::INFINITY; kc]; kb];
+        let mut from = vec![vec![0usize; kc]; kb];
+        for b in 0..kb {
+            for c in 0..kc {
+                for (a, row) in cost.iter().enumerate() {
+                    let total = row[b]
+                        + key_acceleration(
+                            &candidates[t - 2][a],
+                            &candidates[t - 1][b],
+                            &candidates[t][c],
+                        );
+                    if total < next[b][c] {
+                        next[b][c] = total;
+                        from[b][c] = a;
+                    }
                 }
             }
-            reports[t].flags.push(if found.rms_m > tolerance {
-                FrameFlag::KeyTriangleNotConverged
-            } else {
-                FrameFlag::KeyTriangleRecalibrated
-            });
         }
-        key[t] = found.points;
-        reports[t].key_rms_m = found.rms_m;
+        cost = next;
+        back.push(from);
     }
-    (key, reports)
+    let mut best = (0, 0, f64::INFINITY);
+    for (a, row) in cost.iter().enumerate() {
+        for (b, &v) in row.iter().enumerate() {
+            if v < best.2 {
+                best = (a, b, v);
+            }
+        }
+    }
+    let mut path = vec![0usize; n];
+    path[n - 2] = best.0;
+    path[n - 1] = best.1;
+    for t in (2..n).rev() {
+        path[t - 2] = back[t - 2][path[t - 1]][path[t]];
+    }
+    path.iter()
+        .enumerate()
+        .map(|(t, &k)| candidates[t][k])
+        .collect()
 }
 
 /// A skeleton3d from per-frame joints.
