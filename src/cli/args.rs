@@ -10,10 +10,10 @@ Examples:
   videomocap info clip.mp4 --json
   videomocap run clip.mp4 --marks marks.json --out-dir out/ --height-m 1.75
   videomocap track clip.mp4 --marks marks.json -o tracks2d.json
-  videomocap lift tracks2d.json -o skeleton3d.json --fov-deg 60 --bvh motion.bvh
+  videomocap lift tracks2d.json -o skeleton3d.json --fov-deg 60 --height-m 1.80
   videomocap synth --motion walk --view side --frames 150 -o synth_walk/
   videomocap synth --motion tests/data/cmu_02_01_walk.bvh --view oblique -o walk/
-  videomocap bench
+  videomocap bench lift
 
 Exit codes: 0 success, 1 processing failed, 2 bad usage or bad input.";
 
