@@ -5,6 +5,7 @@ use nalgebra::{Point3, Rotation3, Vector3};
 use std::sync::atomic::AtomicBool;
 use videomocap::camera::PinholeCamera;
 use videomocap::eval::pose3d::{score_skeleton, tracks_from_truth};
+use videomocap::lift::ambiguity::lift_order;
 use videomocap::lift::backproject::bone_roots;
 use videomocap::lift::calibrate::KeyTriangle;
 use videomocap::lift::{
@@ -188,11 +189,7 @@ fn with_the_true_roots_exact_tracks_give_back_every_joint() {
     for (t, f) in gt.frames.iter().enumerate() {
         let p = f.points3d();
         for bone in Bone::ALL {
-            let (known, solved) = if bone == Bone::new(Joint::Pelvis, Joint::Chest) {
-                (Joint::Chest, Joint::Pelvis)
-            } else {
-                (bone.parent, bone.child)
-            };
+            let (known, solved) = lift_order(bone);
             if matches!(solved, Joint::LeftShoulder | Joint::RightShoulder) {
                 continue;
             }

@@ -4,7 +4,6 @@
 
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
-use videomocap::camera::PinholeCamera;
 use videomocap::formats::Marks;
 use videomocap::skeleton::{Bone, Joint};
 use videomocap::synth::{
@@ -38,13 +37,7 @@ fn points2d_are_the_projections_of_points3d_and_bones_are_rigid() {
         View::Frontal,
         12,
     );
-    let cam = PinholeCamera {
-        focal_px: gt.focal_px,
-        cx: gt.cx,
-        cy: gt.cy,
-        width: gt.width,
-        height: gt.height,
-    };
+    let cam = gt.camera();
     for f in &gt.frames {
         let p3 = f.points3d();
         let p2 = f.points2d();

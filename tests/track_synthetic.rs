@@ -10,7 +10,7 @@ use videomocap::skeleton::Joint;
 use videomocap::synth::{
     GroundTruth, MotionSource, ProceduralMotion, SynthParams, VideoOutput, View, render_clip,
 };
-use videomocap::track::{KeyFrames, TrackError, TrackJob, TrackerParams, track_video};
+use videomocap::track::{TrackError, TrackJob, TrackerParams, track_video};
 use videomocap::video::{OpenOptions, Video};
 
 fn render(dir: &Path, motion: ProceduralMotion, frames: usize, view: View) {
@@ -29,13 +29,7 @@ fn render(dir: &Path, motion: ProceduralMotion, frames: usize, view: View) {
 }
 
 fn job(marks: &Marks, threads: usize) -> TrackJob {
-    TrackJob {
-        keys: KeyFrames::from_marks(marks),
-        params: TrackerParams::default(),
-        threads,
-        from: None,
-        previous: None,
-    }
+    TrackJob::from_marks(marks, TrackerParams::default(), threads)
 }
 
 #[test]

@@ -13,7 +13,6 @@ use super::{ExitError, say};
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
-use videomocap::camera::PinholeCamera;
 use videomocap::eval::pose3d::{
     Pose3dScore, score_skeleton, stature_from_truth, subject_from_truth, tracks_from_truth,
 };
@@ -40,16 +39,6 @@ struct Case {
     total_s: f64,
 }
 
-fn camera_of(gt: &GroundTruth) -> PinholeCamera {
-    PinholeCamera {
-        focal_px: gt.focal_px,
-        cx: gt.cx,
-        cy: gt.cy,
-        width: gt.width,
-        height: gt.height,
-    }
-}
-
 fn lift_case(
     gt: &GroundTruth,
     tracks: &Tracks2d,
@@ -59,7 +48,7 @@ fn lift_case(
 ) -> Result<(), ExitError> {
     let job = LiftJob {
         tracks,
-        camera: camera_of(gt),
+        camera: gt.camera(),
         subject,
         params: params.clone(),
         overrides: Default::default(),
@@ -188,7 +177,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             .map_err(ExitError::failed)?;
         let job = LiftJob {
             tracks: &tracks,
-            camera: camera_of(&gt),
+            camera: gt.camera(),
             subject,
             params: params.clone(),
             overrides: Default::default(),

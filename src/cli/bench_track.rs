@@ -25,7 +25,7 @@ use videomocap::synth::{
     GroundTruth, MotionSource, ProceduralMotion, SynthParams, VideoOutput, View, render_clip,
 };
 use videomocap::track::similarity::FrameView;
-use videomocap::track::{KeyFrames, TrackJob, TrackerParams, track_video};
+use videomocap::track::{TrackJob, TrackerParams, track_video};
 use videomocap::video::{OpenOptions, Video};
 
 /// One clip of the synthetic suite.
@@ -275,13 +275,7 @@ pub fn track_opened(
     threads: usize,
     params: TrackerParams,
 ) -> Result<videomocap::formats::Tracks2d, ExitError> {
-    let job = TrackJob {
-        keys: KeyFrames::from_marks(marks),
-        params,
-        threads,
-        from: None,
-        previous: None,
-    };
+    let job = TrackJob::from_marks(marks, params, threads);
     let out = track_video(video, &job, &mut |_| {}, &AtomicBool::new(false))
         .map_err(ExitError::failed)?;
     Ok(out.tracks)
@@ -457,13 +451,7 @@ fn speed(
             let _: Arc<_> = video.frame(i).map_err(ExitError::failed)?.image;
         }
     }
-    let job = TrackJob {
-        keys: KeyFrames::from_marks(&marks),
-        params,
-        threads,
-        from: None,
-        previous: None,
-    };
+    let job = TrackJob::from_marks(&marks, params, threads);
     let t0 = Instant::now();
     track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false))
         .map_err(ExitError::failed)?;

@@ -8,9 +8,7 @@ use std::sync::atomic::AtomicBool;
 use videomocap::eval::score_tracks;
 use videomocap::formats::Marks;
 use videomocap::synth::GroundTruth;
-use videomocap::track::{
-    KeyFrames, SpanKind, TrackError, TrackJob, TrackOutput, TrackerParams, track_video,
-};
+use videomocap::track::{SpanKind, TrackError, TrackJob, TrackOutput, TrackerParams, track_video};
 use videomocap::video::{OpenOptions, Video};
 
 /// Opens the video and marks and checks that they fit together.
@@ -50,13 +48,7 @@ pub fn track_with_progress(
             "--threads must be at least 1"
         )));
     }
-    let job = TrackJob {
-        keys: KeyFrames::from_marks(marks),
-        params,
-        threads,
-        from: None,
-        previous: None,
-    };
+    let job = TrackJob::from_marks(marks, params, threads);
     let bar = progress_bar(global, video.info().frame_count as u64, "tracking");
     let cancel = AtomicBool::new(false);
     let mut on_progress = |p: &videomocap::track::TrackProgress| {

@@ -5,6 +5,7 @@
 
 use super::EvalError;
 use crate::formats::{FrameTracks, PointSource, Skeleton3d, SourceInfo, TrackedPoint, Tracks2d};
+use crate::lift::ambiguity::lift_order;
 use crate::skeleton::{Bone, Joint, PerJoint, Proportions, SubjectModel};
 use crate::synth::GroundTruth;
 use nalgebra::{Matrix3, Point2, Point3, Vector3};
@@ -89,15 +90,6 @@ fn procrustes(a: &[Point3<f64>], b: &[Point3<f64>]) -> Vec<Point3<f64>> {
     a.iter()
         .map(|p| Point3::from(cb + r * (p.coords - ca) * scale))
         .collect()
-}
-
-/// The bones in the order the lift solves them (the spine from the chest down): `(known, solved)`.
-fn lift_order(b: Bone) -> (Joint, Joint) {
-    if b.parent == Joint::Pelvis && b.child == Joint::Chest {
-        (Joint::Chest, Joint::Pelvis)
-    } else {
-        (b.parent, b.child)
-    }
 }
 
 /// Scores a skeleton against the reference (frames matched by index).

@@ -79,7 +79,7 @@ const GROUPS: [Group; 7] = [
         prior: Prior::Head,
     },
     Group {
-        bones: &[Bone::new(Chest, Pelvis)],
+        bones: &[Bone::new(Pelvis, Chest)],
         prior: Prior::Spine,
     },
     Group {
@@ -113,18 +113,14 @@ const GROUPS: [Group; 7] = [
     },
 ];
 
-/// Length of a bone of the lifting order (which runs chest-outwards, so the spine is
-/// `chest → pelvis` although the model's tree is rooted at the pelvis).
-fn length(subject: &SubjectModel, bone: Bone) -> f64 {
-    subject.bone_length(model_bone(bone))
-}
-
-/// The model's bone that a lifting-order bone stands for.
-pub fn model_bone(bone: Bone) -> Bone {
-    if bone.parent == Chest && bone.child == Pelvis {
-        Bone::new(Pelvis, Chest)
+/// A bone's ends in the order the lift visits them, `(known, solved)`: the lift runs from the
+/// key triangle outwards, so the spine is solved from the chest down to the pelvis although the
+/// model's tree is rooted at the pelvis. Every other bone runs parent to child.
+pub fn lift_order(bone: Bone) -> (Joint, Joint) {
+    if bone == Bone::new(Pelvis, Chest) {
+        (Chest, Pelvis)
     } else {
-        bone
+        (bone.parent, bone.child)
     }
 }
 
@@ -171,15 +167,20 @@ fn prior_cost(
     subject: &SubjectModel,
     w: &AmbiguityWeights,
 ) -> f64 {
-    let along_up = |from: Joint, to: Joint, sign: f64| {
-        let len = length(subject, Bone::new(from, to));
+    // How far a bone's solved end lies from where the trunk's up (sign 1) or down (sign −1)
+    // direction would put it.
+    let along_up = |bone: Bone, sign: f64| {
+        let (from, to) = lift_order(bone);
+        let len = subject.bone_length(bone);
         (p[to] - (p[from] + trunk.up * (sign * len))).norm_squared()
     };
     match group.prior {
         Prior::Head => {
-            w.trunk_up * (along_up(Chest, Neck, 1.0) + 0.5 * along_up(Neck, HeadTop, 1.0))
+            w.trunk_up
+                * (along_up(Bone::new(Chest, Neck), 1.0)
+                    + 0.5 * along_up(Bone::new(Neck, HeadTop), 1.0))
         }
-        Prior::Spine => w.trunk_up * along_up(Chest, Pelvis, -1.0),
+        Prior::Spine => w.trunk_up * along_up(Bone::new(Pelvis, Chest), -1.0),
         Prior::Hips => {
             let off_line =
                 (p[LeftHip].coords + p[RightHip].coords - p[Pelvis].coords * 2.0).norm_squared();
@@ -266,19 +267,18 @@ pub fn resolve(
                             too_long: [false; 2],
                             unary: 0.0,
                         };
+                        let (group_root, _) = lift_order(group.bones[0]);
                         for (k, bone) in group.bones.iter().enumerate() {
-                            let roots = bone_roots(
-                                &p[bone.parent],
-                                &rays[t][bone.child],
-                                length(subject, *bone),
-                            );
+                            let (known, solved) = lift_order(*bone);
+                            let roots =
+                                bone_roots(&p[known], &rays[t][solved], subject.bone_length(*bone));
                             let root = if combo >> k & 1 == 0 {
                                 Root::Near
                             } else {
                                 Root::Far
                             };
                             if overrides
-                                .get(&(frame_index[t], model_bone(*bone)))
+                                .get(&(frame_index[t], *bone))
                                 .is_some_and(|o| *o != root)
                             {
                                 c.unary = f64::INFINITY;
@@ -287,12 +287,12 @@ pub fn resolve(
                                 // The joint cannot lie on its ray: the miss counts against
                                 // this candidate (a wrong parent often causes it).
                                 let q = roots.get(root).coords;
-                                let ray = &rays[t][bone.child];
+                                let ray = &rays[t][solved];
                                 c.unary += weights.miss * (q - ray * ray.dot(&q)).norm_squared();
                             }
-                            p.0[bone.child.index()] = roots.get(root);
+                            p.0[solved.index()] = roots.get(root);
                             c.absolute[k] = roots.get(root);
-                            c.relative[k] = roots.get(root) - p[group.bones[0].parent];
+                            c.relative[k] = roots.get(root) - p[group_root];
                             c.too_long[k] = roots.too_long;
                         }
                         if c.unary.is_finite() {
@@ -308,8 +308,8 @@ pub fn resolve(
         for (t, &combo) in path.iter().enumerate() {
             let c = &candidates[t][combo];
             for (k, bone) in group.bones.iter().enumerate() {
-                points[t].0[bone.child.index()] = c.absolute[k];
-                let b = model_bone(*bone).index();
+                points[t].0[lift_order(*bone).1.index()] = c.absolute[k];
+                let b = bone.index();
                 choices[t][b] = if combo >> k & 1 == 0 {
                     Root::Near
                 } else {

@@ -10,7 +10,6 @@
 use super::error::LiftError;
 use super::solve::{LiftJob, lift_per_frame, miss_m};
 use crate::camera::PinholeCamera;
-use nalgebra::Point2;
 
 /// Field of view across the longer image side assumed when the focal length is neither given
 /// nor estimated: 60°, what phone main cameras and most webcams film at (the real sample's
@@ -47,7 +46,7 @@ fn score(job: &LiftJob<'_>, focal_px: f64) -> f64 {
         .iter()
         .zip(&job.tracks.frames)
         .map(|(p, f)| {
-            let image = f.points.map(|_, q| Point2::from(q.pos.coords));
+            let image = f.points.map(|_, q| q.pos);
             miss_m(&j.camera, p, &image)
         })
         .sum();

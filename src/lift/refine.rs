@@ -139,9 +139,34 @@ impl Row {
     }
 }
 
+/// The subject's lengths in refinement order: the 15 bones, then the shoulder width.
+fn subject_lengths(subject: &SubjectModel) -> [f64; LENGTHS] {
+    let mut lengths = [subject.shoulder_width_m; LENGTHS];
+    lengths[..BONE_COUNT].copy_from_slice(&subject.bone_length_m);
+    lengths
+}
+
 impl Problem<'_> {
     fn unknowns(&self) -> usize {
         self.images.len() * PER_FRAME + LENGTHS
+    }
+
+    /// The unknowns as one vector: every frame's joints, then the lengths.
+    fn pack(points: &[PerJoint<Point3<f64>>], lengths: &[f64; LENGTHS]) -> DVector<f64> {
+        let n = points.len();
+        let mut x = DVector::zeros(n * PER_FRAME + LENGTHS);
+        for (t, frame) in points.iter().enumerate() {
+            for j in Joint::ALL {
+                let c = Self::col(t, j);
+                x[c] = frame[j].x;
+                x[c + 1] = frame[j].y;
+                x[c + 2] = frame[j].z;
+            }
+        }
+        for (k, l) in lengths.iter().enumerate() {
+            x[n * PER_FRAME + k] = *l;
+        }
+        x
     }
 
     fn col(t: usize, j: Joint) -> usize {
@@ -281,8 +306,7 @@ pub fn refine(
     cancel: &AtomicBool,
 ) -> Result<Refined, LiftError> {
     let n = start.len();
-    let mut start_lengths = [subject.shoulder_width_m; LENGTHS];
-    start_lengths[..BONE_COUNT].copy_from_slice(&subject.bone_length_m);
+    let start_lengths = subject_lengths(subject);
     let dt = if fps.is_finite() && fps > 0.0 {
         1.0 / fps
     } else {
@@ -297,18 +321,7 @@ pub fn refine(
         accel_sigma_m: params.acceleration_sigma_mps2 * dt * dt,
     };
     let m = problem.unknowns();
-    let mut x = DVector::zeros(m);
-    for (t, frame) in start.iter().enumerate() {
-        for j in Joint::ALL {
-            let c = Problem::col(t, j);
-            x[c] = frame[j].x;
-            x[c + 1] = frame[j].y;
-            x[c + 2] = frame[j].z;
-        }
-    }
-    for k in 0..LENGTHS {
-        x[n * PER_FRAME + k] = start_lengths[k];
-    }
+    let mut x = Problem::pack(start, &start_lengths);
     let cost_before = problem.cost(&x);
     let reprojection_px_before = problem.reprojection_rms(&x);
     let mut cost = cost_before;
@@ -413,8 +426,7 @@ mod tests {
             .map(|f| f.map(|_, p| cam.project(p).unwrap() + nalgebra::Vector2::new(1.5, -0.5)))
             .collect();
         let weights = vec![PerJoint::from_fn(|j| 0.3 + 0.04 * j.index() as f64); n];
-        let mut start_lengths = [subject.shoulder_width_m; LENGTHS];
-        start_lengths[..BONE_COUNT].copy_from_slice(&subject.bone_length_m);
+        let start_lengths = subject_lengths(&subject);
         let problem = Problem {
             cam: &cam,
             images: &images,
@@ -424,18 +436,7 @@ mod tests {
             accel_sigma_m: 20.0 / 900.0,
         };
         let m = problem.unknowns();
-        let mut x = DVector::zeros(m);
-        for (t, f) in start.iter().enumerate() {
-            for j in Joint::ALL {
-                let c = Problem::col(t, j);
-                x[c] = f[j].x;
-                x[c + 1] = f[j].y;
-                x[c + 2] = f[j].z;
-            }
-        }
-        for k in 0..LENGTHS {
-            x[n * PER_FRAME + k] = start_lengths[k] * 1.05;
-        }
+        let x = Problem::pack(&start, &start_lengths.map(|l| l * 1.05));
         let collect = |x: &DVector<f64>| {
             let mut rows = Vec::new();
             problem.rows(x, |r| rows.push(r));

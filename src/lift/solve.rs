@@ -28,8 +28,8 @@ pub struct LiftParams {
     pub refine: bool,
     /// A key-triangle calibration fits when its residual is below this RMS, pixels (default 1).
     pub calibration_tolerance_px: f64,
-    /// A frame's key triangle is re-calibrated when eq. 11 leaves more than this RMS residual,
-    /// metres (default 0.005).
+    /// A calibrated key-triangle pose is made exact by eqs. 10–11 when they then hold within this
+    /// RMS residual, metres (default 0.005).
     pub propagation_tolerance_m: f64,
     /// The per-frame solve works on tracks smoothed over time by a Gaussian of this many
     /// seconds (default 0 = raw tracks). Measured on the synthetic suite, 0.066 s (two frames

@@ -2,6 +2,7 @@
 //! per-joint visibility; the camera intrinsics; the true bone lengths. The real sample's
 //! reference uses the same layout (without bone lengths).
 
+use crate::camera::PinholeCamera;
 use crate::formats::{FormatError, write_atomically};
 use crate::skeleton::{Joint, PerJoint};
 use nalgebra::{Point2, Point3};
@@ -100,6 +101,19 @@ impl GroundTruth {
         })?;
         text.push('\n');
         write_atomically(path, text.as_bytes())
+    }
+}
+
+impl GroundTruth {
+    /// The camera the clip was filmed (or rendered) with.
+    pub fn camera(&self) -> PinholeCamera {
+        PinholeCamera {
+            focal_px: self.focal_px,
+            cx: self.cx,
+            cy: self.cy,
+            width: self.width,
+            height: self.height,
+        }
     }
 }
 

@@ -96,6 +96,23 @@ pub struct TrackJob {
     pub previous: Option<Tracks2d>,
 }
 
+impl TrackJob {
+    /// A whole-video job from the marks of one frame (no corrections, no earlier result).
+    pub fn from_marks(
+        marks: &crate::formats::Marks,
+        params: TrackerParams,
+        threads: usize,
+    ) -> TrackJob {
+        TrackJob {
+            keys: KeyFrames::from_marks(marks),
+            params,
+            threads,
+            from: None,
+            previous: None,
+        }
+    }
+}
+
 /// Progress of a tracking run.
 #[derive(Debug, Clone)]
 pub struct TrackProgress {
