@@ -18,15 +18,8 @@ fi
 mkdir -p "$out"
 "$bin" info "$sample/video.mp4"
 "$bin" info "$sample/video.mp4" --json > "$out/info.json"
-set +e
 "$bin" run "$sample/video.mp4" --marks "$sample/marks.json" --out-dir "$out"
-code=$?
-set -e
-if [ "$code" -eq 2 ] && [ -f "$out/skeleton3d.json" ] && [ ! -f "$out/motion.bvh" ]; then
-  echo
-  echo "Tracked and lifted the sample: $out/tracks2d.json, $out/skeleton3d.json. BVH export is"
-  echo "not built yet in this version, so the pipeline stops there. Also written: $out/info.json"
-  exit 0
-fi
-if [ "$code" -ne 0 ]; then exit "$code"; fi
-echo "Results: $out/tracks2d.json, $out/skeleton3d.json, $out/motion.bvh"
+echo
+echo "Results in $out/: tracks2d.json/.csv (2D), skeleton3d.json (3D, camera space),"
+echo "motion.bvh (load in Blender: File > Import > Motion Capture (.bvh), scale 0.01 for metres),"
+echo "joints3d.csv and motion.trc (world metres, Y up), info.json"

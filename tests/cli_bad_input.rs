@@ -218,6 +218,97 @@ fn lift_writes_a_skeleton_and_refuses_a_bad_focal_length() {
     assert_eq!(s.frames.len(), gt.frames.len());
     assert_eq!(s.camera.focal_px, 600.0);
     assert!(stderr.contains("lifted 60 frames"), "{stderr}");
+
+    // lift --bvh, then export of the same skeleton to every format.
+    let bvh = dir.path().join("lifted.bvh");
+    let (code, stderr) = run(&["lift", tp, "-o", outs, "--bvh", bvh.to_str().unwrap()]);
+    assert_eq!(code, 0, "{stderr}");
+    let read = videomocap::bvh::Bvh::load(&bvh).unwrap();
+    assert_eq!(read.frame_count(), 60);
+    let p = |name: &str| dir.path().join(name).to_str().unwrap().to_owned();
+    let out = Command::cargo_bin("videomocap")
+        .unwrap()
+        .args([
+            "--json",
+            "export",
+            outs,
+            "--bvh",
+            &p("m.bvh"),
+            "--csv",
+            &p("j.csv"),
+            "--trc",
+            &p("m.trc"),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["frames"].as_u64(), Some(60));
+    assert!(v["bvh_round_trip_mm"].as_f64().unwrap() < 1.0);
+    assert_eq!(
+        std::fs::read_to_string(p("j.csv")).unwrap().lines().count(),
+        1 + 60 * 16
+    );
+    assert!(
+        std::fs::read_to_string(p("m.trc"))
+            .unwrap()
+            .starts_with("PathFileType\t4")
+    );
+    let (code, stderr) = run(&["export", tp, "--csv", &p("t.csv")]);
+    assert_eq!(code, 0, "{stderr}");
+    let csv = std::fs::read_to_string(p("t.csv")).unwrap();
+    assert!(
+        csv.starts_with(
+            "frame,time_s,joint,x_px,y_px,confidence,interpolated\n0,0.000000,head_top,"
+        )
+    );
+    // What export cannot do is refused with the file named.
+    assert_bad(&["export", outs], &["nothing to write"]);
+    assert_bad(&["export", tp, "--bvh", &p("x.bvh")], &[tp, "skeleton3d"]);
+    let mut old = videomocap::formats::Skeleton3d::load(Path::new(outs)).unwrap();
+    old.fps = None;
+    let old_path = p("old.json");
+    old.save(Path::new(&old_path)).unwrap();
+    assert_bad(
+        &["export", &old_path, "--bvh", &p("x.bvh")],
+        &[&old_path, "--fps"],
+    );
+    assert!(!Path::new(&p("x.bvh")).exists());
+    let (code, stderr) = run(&["export", &old_path, "--bvh", &p("x.bvh"), "--fps", "30"]);
+    assert_eq!(code, 0, "{stderr}");
+}
+
+#[test]
+fn run_tracks_lifts_and_exports_the_synthetic_sample() {
+    let dir = tempfile::tempdir().unwrap();
+    let sample = Path::new(env!("CARGO_MANIFEST_DIR")).join("sample_videos/synth_walk_oblique");
+    let video = sample.join("video.mp4");
+    let marks = sample.join("marks.json");
+    let (code, stderr) = run(&[
+        "run",
+        video.to_str().unwrap(),
+        "--marks",
+        marks.to_str().unwrap(),
+        "--out-dir",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    for f in [
+        "tracks2d.json",
+        "tracks2d.csv",
+        "skeleton3d.json",
+        "motion.bvh",
+        "joints3d.csv",
+        "motion.trc",
+    ] {
+        assert!(dir.path().join(f).exists(), "{f} missing; {stderr}");
+    }
+    let read = videomocap::bvh::Bvh::load(&dir.path().join("motion.bvh")).unwrap();
+    assert_eq!(read.frame_count(), 60);
+    assert!(
+        stderr.contains("BVH read back: every joint within 0.0"),
+        "{stderr}"
+    );
 }
 
 #[test]

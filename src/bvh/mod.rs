@@ -1,7 +1,7 @@
 //! Biovision BVH motion files: a reader (any channel order, End Sites, one root) with forward
 //! kinematics, and the table-driven mapping of a rig's joints onto the 16-joint model.
 //!
-//! Shared by `synth` (motion capture drives the synthetic clips) and, later, the round-trip tests
+//! Shared by `synth` (motion capture drives the synthetic clips) and the round-trip checks
 //! of the BVH writer in `export`.
 
 mod mapping;

@@ -11,6 +11,8 @@ Examples:
   videomocap run clip.mp4 --marks marks.json --out-dir out/ --height-m 1.75
   videomocap track clip.mp4 --marks marks.json -o tracks2d.json
   videomocap lift tracks2d.json -o skeleton3d.json --fov-deg 60 --height-m 1.80
+  videomocap export skeleton3d.json --bvh motion.bvh --csv joints3d.csv --trc motion.trc
+  videomocap export tracks2d.json --csv tracks2d.csv
   videomocap synth --motion walk --view side --frames 150 -o synth_walk/
   videomocap synth --motion tests/data/cmu_02_01_walk.bvh --view oblique -o walk/
   videomocap bench lift
@@ -56,7 +58,7 @@ pub enum Command {
     Track(TrackArgs),
     /// Reconstruct the 3D skeleton from 2D tracks.
     Lift(LiftArgs),
-    /// Export a 3D skeleton to BVH and CSV.
+    /// Export a skeleton3d to BVH, CSV or TRC, or tracks2d to CSV.
     Export(ExportArgs),
     /// Every step: track, lift and export into one directory.
     Run(RunArgs),
@@ -129,14 +131,21 @@ pub struct LiftArgs {
 /// `export`.
 #[derive(Debug, Args)]
 pub struct ExportArgs {
-    /// skeleton3d.json from `lift`.
-    pub skeleton: PathBuf,
-    /// Where to write the BVH.
+    /// skeleton3d.json (from `lift`) or tracks2d.json (from `track`).
+    pub input: PathBuf,
+    /// Write a BVH here (skeleton3d input; centimetres, Y up).
     #[arg(long)]
-    pub bvh: PathBuf,
-    /// Also write a CSV of 3D joint positions here.
+    pub bvh: Option<PathBuf>,
+    /// Write a CSV here: the 3D joints (world metres, Y up) for a skeleton3d, the 2D tracks for a
+    /// tracks2d.
     #[arg(long)]
     pub csv: Option<PathBuf>,
+    /// Write an OpenSim marker file (.trc) here (skeleton3d input).
+    #[arg(long)]
+    pub trc: Option<PathBuf>,
+    /// Frames per second, for skeleton3d files that do not record it (or to override it).
+    #[arg(long)]
+    pub fps: Option<f64>,
 }
 
 /// `run`.
@@ -147,7 +156,8 @@ pub struct RunArgs {
     /// The 16 joints marked on one frame (marks.json).
     #[arg(long)]
     pub marks: PathBuf,
-    /// Directory for tracks2d.json, skeleton3d.json and motion.bvh.
+    /// Directory for tracks2d.json, skeleton3d.json, motion.bvh, joints3d.csv, tracks2d.csv and
+    /// motion.trc.
     #[arg(long)]
     pub out_dir: PathBuf,
     #[command(flatten)]

@@ -167,11 +167,13 @@ pub fn run(a: &LiftArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     out.skeleton.save(&a.output).map_err(ExitError::failed)?;
     report(&out, global);
     say(global, &format!("wrote {}", a.output.display()));
-    if a.bvh.is_some() {
-        return Err(ExitError::bad_input(anyhow!(
-            "BVH export is not built yet in this version of videomocap; {} was written",
-            a.output.display()
-        )));
+    if let Some(bvh) = &a.bvh {
+        let outputs = super::export::Outputs3d {
+            bvh: Some(bvh.clone()),
+            ..Default::default()
+        };
+        let written = super::export::write_3d(&out.skeleton, &a.output, None, &outputs)?;
+        super::export::report_3d(&written, global);
     }
     Ok(())
 }

@@ -5,9 +5,11 @@ pub mod args;
 mod bench;
 mod bench_lift;
 mod bench_track;
+mod export;
 mod info;
 mod lift;
 mod pending;
+mod run;
 mod synth;
 mod track;
 
@@ -54,8 +56,8 @@ pub fn run(command: Command, global: &GlobalArgs) -> Result<(), ExitError> {
         Command::Bench(a) => bench::run(&a, global),
         Command::Track(a) => track::run(&a, global),
         Command::Lift(a) => lift::run(&a, global),
-        Command::Export(a) => pending::export(&a),
-        Command::Run(a) => pending::run_all(&a, global),
+        Command::Export(a) => export::run(&a, global),
+        Command::Run(a) => run::run(&a, global),
         Command::Volume(a) => pending::volume(&a),
         Command::Gui { .. } => Err(ExitError::bad_input(anyhow::anyhow!(
             "the desktop app is opened by main, not by the CLI"

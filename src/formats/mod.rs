@@ -17,6 +17,38 @@ use crate::skeleton::{JOINT_COUNT, Joint};
 use serde::Deserialize;
 use std::path::Path;
 
+/// A tracks2d or a skeleton3d file, told apart by its `format` tag (or, in files without one,
+/// by its fields).
+#[derive(Debug, Clone, PartialEq)]
+pub enum AnyFile {
+    Tracks2d(Tracks2d),
+    Skeleton3d(Skeleton3d),
+}
+
+/// Reads a tracks2d or skeleton3d file, whichever it is.
+pub fn load_any(path: &Path) -> Result<AnyFile, FormatError> {
+    #[derive(Deserialize)]
+    struct Peek {
+        #[serde(default)]
+        format: Option<String>,
+        #[serde(default)]
+        camera: Option<serde_json::Value>,
+    }
+    let text = read_text(path)?;
+    let peek: Peek = parse_json(&text, path)?;
+    match peek.format.as_deref() {
+        Some(TRACKS2D_FORMAT) => Tracks2d::parse(&text, path).map(AnyFile::Tracks2d),
+        Some(SKELETON3D_FORMAT) => Skeleton3d::parse(&text, path).map(AnyFile::Skeleton3d),
+        Some(other) => Err(FormatError::WrongFormat {
+            path: path.to_owned(),
+            found: other.to_owned(),
+            expected: "videomocap.tracks2d or videomocap.skeleton3d",
+        }),
+        None if peek.camera.is_some() => Skeleton3d::parse(&text, path).map(AnyFile::Skeleton3d),
+        None => Tracks2d::parse(&text, path).map(AnyFile::Tracks2d),
+    }
+}
+
 /// The version of every format this build writes and reads.
 pub const FORMAT_VERSION: u32 = 1;
 

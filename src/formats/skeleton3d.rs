@@ -32,6 +32,9 @@ pub struct Frame3d {
 pub struct Skeleton3d {
     /// The camera the points are expressed in.
     pub camera: PinholeCamera,
+    /// Frame rate of the source video (frames per second); `None` in files written before it was
+    /// recorded, in which case exports ask for it.
+    pub fps: Option<f64>,
     /// Length of each bone in metres, keyed `"parent-child"`.
     pub bone_lengths_m: BTreeMap<String, f64>,
     /// Frames in increasing index order.
@@ -53,6 +56,8 @@ struct SkeletonFile {
     #[serde(default)]
     version: Option<u32>,
     camera: PinholeCamera,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    fps: Option<f64>,
     joints: Vec<String>,
     bone_lengths_m: BTreeMap<String, f64>,
     frames: Vec<FrameFile>,
@@ -81,6 +86,14 @@ impl Skeleton3d {
                     "camera focal_px must be positive and finite and cx, cy finite (got {}, {}, {})",
                     cam.focal_px, cam.cx, cam.cy
                 ),
+            });
+        }
+        if let Some(fps) = raw.fps
+            && !(fps.is_finite() && fps > 0.0)
+        {
+            return Err(FormatError::Invalid {
+                path: path.to_owned(),
+                problem: format!("fps must be positive and finite (got {fps})"),
             });
         }
         for (key, &len) in &raw.bone_lengths_m {
@@ -133,6 +146,7 @@ impl Skeleton3d {
         }
         Ok(Skeleton3d {
             camera: cam,
+            fps: raw.fps,
             bone_lengths_m: raw.bone_lengths_m,
             frames,
         })
@@ -144,6 +158,7 @@ impl Skeleton3d {
             format: Some(SKELETON3D_FORMAT.to_owned()),
             version: Some(FORMAT_VERSION),
             camera: self.camera,
+            fps: self.fps,
             joints: joint_names(),
             bone_lengths_m: self.bone_lengths_m.clone(),
             frames: self
@@ -167,6 +182,7 @@ mod tests {
     fn sample() -> Skeleton3d {
         Skeleton3d {
             camera: PinholeCamera::centred(1000.0, 640, 480),
+            fps: Some(30.0),
             bone_lengths_m: [("left_knee-left_ankle".to_owned(), 0.42)].into(),
             frames: vec![Frame3d {
                 index: 0,

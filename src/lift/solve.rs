@@ -457,6 +457,7 @@ fn skeleton(
 ) -> Skeleton3d {
     Skeleton3d {
         camera: job.camera,
+        fps: Some(job.tracks.source.fps),
         bone_lengths_m: Bone::ALL
             .iter()
             .zip(bone_lengths)
