@@ -16,5 +16,6 @@ pub mod video;
 
 pub mod export;
 pub mod lift;
+pub mod project;
 pub mod track;
 pub mod volume;

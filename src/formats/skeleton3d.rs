@@ -154,7 +154,22 @@ impl Skeleton3d {
 
     /// Saves atomically, joints in model order.
     pub fn save(&self, path: &Path) -> Result<(), FormatError> {
-        let file = SkeletonFile {
+        save_json(&self.file(), path)
+    }
+
+    /// The file's JSON (to embed in a project file).
+    pub fn to_json_value(&self) -> serde_json::Value {
+        // Serialising plain numbers, strings and maps cannot fail.
+        serde_json::to_value(self.file()).unwrap_or(serde_json::Value::Null)
+    }
+
+    /// Reads the JSON of [`Self::to_json_value`] (or of a file); `path` names it in errors.
+    pub fn from_json_value(value: serde_json::Value, path: &Path) -> Result<Self, FormatError> {
+        Self::parse(&value.to_string(), path)
+    }
+
+    fn file(&self) -> SkeletonFile {
+        SkeletonFile {
             format: Some(SKELETON3D_FORMAT.to_owned()),
             version: Some(FORMAT_VERSION),
             camera: self.camera,
@@ -170,8 +185,7 @@ impl Skeleton3d {
                     flags: f.flags.clone(),
                 })
                 .collect(),
-        };
-        save_json(&file, path)
+        }
     }
 }
 

@@ -183,7 +183,22 @@ impl Tracks2d {
 
     /// Saves atomically, joints in model order.
     pub fn save(&self, path: &Path) -> Result<(), FormatError> {
-        let file = TracksFile {
+        save_json(&self.file(), path)
+    }
+
+    /// The file's JSON (to embed in a project file).
+    pub fn to_json_value(&self) -> serde_json::Value {
+        // Serialising plain numbers, strings and maps cannot fail.
+        serde_json::to_value(self.file()).unwrap_or(serde_json::Value::Null)
+    }
+
+    /// Reads the JSON of [`Self::to_json_value`] (or of a file); `path` names it in errors.
+    pub fn from_json_value(value: serde_json::Value, path: &Path) -> Result<Self, FormatError> {
+        Self::parse(&value.to_string(), path)
+    }
+
+    fn file(&self) -> TracksFile {
+        TracksFile {
             format: Some(TRACKS2D_FORMAT.to_owned()),
             version: Some(FORMAT_VERSION),
             source: self.source.clone(),
@@ -203,8 +218,7 @@ impl Tracks2d {
                         .collect(),
                 })
                 .collect(),
-        };
-        save_json(&file, path)
+        }
     }
 }
 

@@ -1,82 +1,634 @@
-//! The main window: menu, frame view with the marks drawn, timeline scrubber, status bar.
+//! The main window: menus, the frame view with marking and correction, the timeline with
+//! reliability strips, the 3D viewport, parameters, background jobs with progress, export,
+//! projects with undo, autosave and recovery.
 
-use super::frame_loader::FrameLoader;
-use egui::{Color32, Pos2, Rect, Stroke, Vec2};
+use super::autosave::Autosaver;
+use super::dialogs::{Dialogs, RfdDialogs};
+use super::frame_loader::{FrameLoader, LoaderEvent};
+use super::frame_view::{FrameView, Overlay, PointState, ViewEvent};
+use super::jobs::{Job, JobEvent};
+use super::timeline::{self, Strips};
+use super::view3d::{Orbit, Scene};
+use nalgebra::{Point2, Point3};
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use videomocap::formats::Marks;
-use videomocap::skeleton::Bone;
-use videomocap::video::{OpenOptions, Video};
+use std::sync::Arc;
+use videomocap::export::{self, WorldSkeleton};
+use videomocap::formats::{FrameTracks, Marks, PointSource};
+use videomocap::lift::Root;
+use videomocap::lift::focal::default_focal;
+use videomocap::project::{History, Project};
+use videomocap::skeleton::{BONE_COUNT, Bone, Joint, PerJoint};
+use videomocap::track::{TrackJob, TrackerParams, WeakSpan};
+use videomocap::video::VideoInfo;
 
-/// State of the viewer.
-pub struct ViewerApp {
+/// How the app is set up (tests swap the dialogs and the autosave directory).
+pub struct Config {
+    /// File dialogs.
+    pub dialogs: Box<dyn Dialogs>,
+    /// Where the recovery file lives (`None`: no autosave).
+    pub autosave_dir: Option<PathBuf>,
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Config {
+            dialogs: Box::new(RfdDialogs),
+            autosave_dir: super::autosave::default_dir(),
+        }
+    }
+}
+
+/// Things the export menu can write.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExportKind {
+    Bvh,
+    TracksJson,
+    SkeletonJson,
+    TracksCsv,
+    JointsCsv,
+    Trc,
+    Marks,
+}
+
+impl ExportKind {
+    const ALL: [ExportKind; 7] = [
+        ExportKind::Bvh,
+        ExportKind::TracksJson,
+        ExportKind::SkeletonJson,
+        ExportKind::TracksCsv,
+        ExportKind::JointsCsv,
+        ExportKind::Trc,
+        ExportKind::Marks,
+    ];
+
+    fn label(self) -> &'static str {
+        match self {
+            ExportKind::Bvh => "BVH (Blender, motion builders)…",
+            ExportKind::TracksJson => "2D tracks (tracks2d.json)…",
+            ExportKind::SkeletonJson => "3D skeleton (skeleton3d.json)…",
+            ExportKind::TracksCsv => "2D tracks CSV…",
+            ExportKind::JointsCsv => "3D joints CSV…",
+            ExportKind::Trc => "OpenSim markers (.trc)…",
+            ExportKind::Marks => "Marks (marks.json)…",
+        }
+    }
+
+    fn file(self) -> (&'static str, &'static str) {
+        match self {
+            ExportKind::Bvh => ("motion.bvh", "bvh"),
+            ExportKind::TracksJson => ("tracks2d.json", "json"),
+            ExportKind::SkeletonJson => ("skeleton3d.json", "json"),
+            ExportKind::TracksCsv => ("tracks2d.csv", "csv"),
+            ExportKind::JointsCsv => ("joints3d.csv", "csv"),
+            ExportKind::Trc => ("motion.trc", "trc"),
+            ExportKind::Marks => ("marks.json", "json"),
+        }
+    }
+}
+
+/// A running job and the keys it started from (its result is dropped if they changed since).
+struct Running {
+    job: Job,
+    keys: videomocap::track::KeyFrames,
+    overrides: videomocap::lift::DepthOverrides,
+}
+
+/// The desktop app.
+pub struct App {
+    ctx: egui::Context,
+    config: Config,
     loader: Option<FrameLoader>,
-    /// Frame the user asked for.
+    project: Option<Project>,
+    project_path: Option<PathBuf>,
+    history: History<Project>,
+    autosaver: Option<Autosaver>,
+    /// A recovery file found at start, waiting for the user's answer.
+    recovery: Option<PathBuf>,
     current: usize,
-    /// Frame the texture shows.
     shown: Option<usize>,
     texture: Option<egui::TextureHandle>,
-    marks: Option<Marks>,
+    view: FrameView,
+    orbit: Orbit,
+    /// Index into [`Joint::ALL`] of the joint the marking guide asks for.
+    marking: Option<usize>,
+    move_limb: bool,
+    running: Option<Running>,
+    /// Frames tracked so far by the running job (drawn as they arrive).
+    partial: BTreeMap<usize, FrameTracks>,
+    spans: Vec<WeakSpan>,
+    strips: Option<Strips>,
+    choices: Vec<[Root; BONE_COUNT]>,
+    world: Option<WorldSkeleton>,
+    playing: bool,
+    play_time: f64,
+    space_dragged: bool,
+    show_help: bool,
+    recent: Vec<PathBuf>,
     status: String,
 }
 
-impl ViewerApp {
-    /// A window, opening `video` if given.
-    pub fn new(ctx: &egui::Context, video: Option<PathBuf>) -> ViewerApp {
-        let mut app = ViewerApp {
+impl App {
+    /// A window with the desktop's dialogs and autosave, opening `path` (a video, an image
+    /// folder or a project) if given.
+    pub fn new(ctx: &egui::Context, path: Option<PathBuf>) -> App {
+        App::with_config(ctx, path, Config::default())
+    }
+
+    /// A window with the given dialogs and autosave directory.
+    pub fn with_config(ctx: &egui::Context, path: Option<PathBuf>, config: Config) -> App {
+        let autosaver = config.autosave_dir.as_deref().map(Autosaver::new);
+        let recovery = autosaver
+            .as_ref()
+            .map(|a| a.path().to_owned())
+            .filter(|p| p.is_file());
+        let mut app = App {
+            ctx: ctx.clone(),
+            config,
             loader: None,
+            project: None,
+            project_path: None,
+            history: History::new(200),
+            autosaver,
+            recovery,
             current: 0,
             shown: None,
             texture: None,
-            marks: None,
-            status: "Open a video with File ▸ Open".to_owned(),
+            view: FrameView::default(),
+            orbit: Orbit::default(),
+            marking: None,
+            move_limb: false,
+            running: None,
+            partial: BTreeMap::new(),
+            spans: Vec::new(),
+            strips: None,
+            choices: Vec::new(),
+            world: None,
+            playing: false,
+            play_time: 0.0,
+            space_dragged: false,
+            show_help: false,
+            recent: Vec::new(),
+            status: "Open a video with File > Open video (or drop one here)".to_owned(),
         };
-        if let Some(path) = video {
-            app.open(ctx, &path);
+        if let Some(p) = path {
+            app.open_path(ctx, &p);
         }
         app
     }
 
-    /// Opens a video or image folder; marks.json beside it is loaded if present.
-    pub fn open(&mut self, ctx: &egui::Context, path: &Path) {
-        match Video::open(path, &OpenOptions::default()) {
-            Ok(video) => {
-                let info = video.info().clone();
-                self.marks = path
-                    .parent()
-                    .map(|d| d.join("marks.json"))
-                    .filter(|m| m.is_file())
-                    .and_then(|m| Marks::load(&m).ok())
-                    .filter(|m| m.check_in_frame(path, info.width, info.height).is_ok());
-                let loader = FrameLoader::spawn(video, ctx.clone());
-                self.current = self
-                    .marks
-                    .as_ref()
-                    .map_or(0, |m| m.frame.min(info.frame_count - 1));
-                loader.request(self.current);
-                self.loader = Some(loader);
-                self.shown = None;
-                self.texture = None;
-                self.status = format!(
-                    "{}   {}×{}   {:.2} fps   {} frames",
-                    info.path.file_name().unwrap_or_default().to_string_lossy(),
-                    info.width,
-                    info.height,
-                    info.fps,
-                    info.frame_count
-                );
-            }
-            Err(e) => self.status = format!("Cannot open: {e}"),
-        }
+    // ----- what tests and the menus use -----
+
+    /// The project being edited.
+    #[cfg(test)]
+    pub fn project(&self) -> Option<&Project> {
+        self.project.as_ref()
+    }
+
+    /// Metadata of the open video.
+    pub fn video_info(&self) -> Option<&VideoInfo> {
+        self.loader.as_ref().and_then(FrameLoader::info)
     }
 
     /// Number of frames of the open video (0 when none).
     pub fn frame_count(&self) -> usize {
-        self.loader.as_ref().map_or(0, |l| l.info().frame_count)
+        self.video_info().map_or(0, |i| i.frame_count)
     }
 
     /// The frame the user is on.
+    #[cfg(test)]
     pub fn current_frame(&self) -> usize {
         self.current
+    }
+
+    /// The status line.
+    #[cfg(test)]
+    pub fn status(&self) -> &str {
+        &self.status
+    }
+
+    /// The frame index the shown texture holds.
+    #[cfg(test)]
+    pub fn shown(&self) -> Option<usize> {
+        self.shown
+    }
+
+    /// Whether a tracking or lifting job runs.
+    pub fn busy(&self) -> bool {
+        self.running.is_some()
+    }
+
+    /// The joint the marking guide asks for, if marking.
+    pub fn asking(&self) -> Option<Joint> {
+        self.marking.map(|k| Joint::ALL[k])
+    }
+
+    /// The frame view's mapping (tests click through it).
+    #[cfg(test)]
+    pub fn frame_view(&self) -> &FrameView {
+        &self.view
+    }
+
+    /// The 3D view's orbit.
+    #[cfg(test)]
+    pub fn orbit(&self) -> Orbit {
+        self.orbit
+    }
+
+    /// Whether a recovery prompt is showing.
+    #[cfg(test)]
+    pub fn offers_recovery(&self) -> bool {
+        self.recovery.is_some()
+    }
+
+    /// The recovery file's path (when autosave is on).
+    #[cfg(test)]
+    pub fn autosave_path(&self) -> Option<PathBuf> {
+        self.autosaver.as_ref().map(|a| a.path().to_owned())
+    }
+
+    /// Waits until autosaves are written (tests).
+    #[cfg(test)]
+    pub fn flush_autosave(&mut self) {
+        if let Some(a) = &mut self.autosaver {
+            a.flush();
+        }
+    }
+
+    /// Opens a video, image folder or project file.
+    pub fn open_path(&mut self, ctx: &egui::Context, path: &Path) {
+        if path.is_file() && is_project(path) {
+            match Project::load(path) {
+                Ok(p) => {
+                    self.open_video(ctx, &p.video.clone());
+                    self.set_project(p);
+                    self.project_path = Some(path.to_owned());
+                    self.status = format!("Opened project {}", path.display());
+                }
+                Err(e) => self.status = format!("Cannot open project: {e}"),
+            }
+        } else {
+            self.open_video(ctx, path);
+        }
+        self.recent.retain(|p| p != path);
+        self.recent.insert(0, path.to_owned());
+        self.recent.truncate(8);
+    }
+
+    fn open_video(&mut self, ctx: &egui::Context, path: &Path) {
+        if let Some(r) = &self.running {
+            r.job.cancel();
+        }
+        self.running = None;
+        self.loader = Some(FrameLoader::open(path.to_owned(), ctx.clone()));
+        self.project = Some(Project::new(path.to_owned()));
+        self.project_path = None;
+        self.history.clear();
+        self.results_changed();
+        self.current = 0;
+        self.shown = None;
+        self.texture = None;
+        self.marking = None;
+        self.view.fit();
+        self.status = format!("Opening {}…", path.display());
+    }
+
+    fn set_project(&mut self, p: Project) {
+        self.project = Some(p);
+        self.history.clear();
+        self.results_changed();
+    }
+
+    /// Recomputes what is derived from the results (strips, the 3D world).
+    fn results_changed(&mut self) {
+        self.partial.clear();
+        let Some(p) = &self.project else {
+            self.strips = None;
+            self.world = None;
+            return;
+        };
+        self.strips = p
+            .tracks
+            .as_ref()
+            .map(|t| Strips::new(t, &self.spans, &p.keys, p.settings.tracker.weak_reliability));
+        self.world = p
+            .skeleton
+            .as_ref()
+            .and_then(|s| WorldSkeleton::new(s, None).ok());
+    }
+
+    /// Applies an edit to the project, with undo and autosave.
+    fn edit(&mut self, f: impl FnOnce(&mut Project)) {
+        let Some(p) = &mut self.project else { return };
+        self.history.record(p.clone());
+        f(p);
+        self.autosave();
+        self.results_changed();
+    }
+
+    fn autosave(&self) {
+        if let (Some(a), Some(p)) = (&self.autosaver, &self.project) {
+            a.save(p);
+        }
+    }
+
+    /// Undoes the last edit.
+    pub fn undo(&mut self) {
+        if let Some(p) = self.project.take() {
+            self.project = Some(match self.history.undo(p.clone()) {
+                Some(before) => {
+                    self.status = "Undone".to_owned();
+                    before
+                }
+                None => p,
+            });
+            self.autosave();
+            self.results_changed();
+        }
+    }
+
+    /// Redoes an undone edit.
+    pub fn redo(&mut self) {
+        if let Some(p) = self.project.take() {
+            self.project = Some(match self.history.redo(p.clone()) {
+                Some(after) => {
+                    self.status = "Redone".to_owned();
+                    after
+                }
+                None => p,
+            });
+            self.autosave();
+            self.results_changed();
+        }
+    }
+
+    /// Starts the marking guide on the current frame (asks for each joint in turn).
+    pub fn start_marking(&mut self) {
+        if self.project.is_some() {
+            self.marking = Some(0);
+            self.status = "Marking: click each joint in turn (Esc to stop)".to_owned();
+        }
+    }
+
+    /// Places (or moves) a joint on the current frame by hand; with "move the limb below" on,
+    /// the joints below it on its limb move by the same amount.
+    pub fn place(&mut self, joint: Joint, pos: Point2<f64>) {
+        let frame = self.current;
+        let shown = self.points(frame);
+        let move_limb = self.move_limb;
+        self.edit(|p| {
+            let old = shown[joint].map(|(q, _)| q);
+            p.keys.set(frame, joint, pos);
+            if move_limb && let Some(old) = old {
+                let delta = pos - old;
+                for j in descendants(joint) {
+                    if let Some((q, _)) = shown[j] {
+                        p.keys.set(frame, j, q + delta);
+                    }
+                }
+            }
+        });
+    }
+
+    fn click(&mut self, pos: Point2<f64>) {
+        let Some(k) = self.marking else { return };
+        self.place(Joint::ALL[k], pos);
+        if k + 1 < Joint::ALL.len() {
+            self.marking = Some(k + 1);
+        } else {
+            self.marking = None;
+            self.status =
+                "All 16 joints marked: Track (T) follows them through the video".to_owned();
+        }
+    }
+
+    fn moved(&mut self, joint: Joint, pos: Point2<f64>) {
+        self.place(joint, pos);
+        let has_tracks = self.project.as_ref().is_some_and(|p| p.tracks.is_some());
+        if has_tracks && self.marking.is_none() {
+            self.status = format!(
+                "{} corrected on frame {}: re-tracking from there",
+                joint.name(),
+                self.current
+            );
+            self.start_tracking(Some(self.current));
+        }
+    }
+
+    /// Tracks the whole video from the marks (`from = None`), or re-tracks from a corrected frame.
+    pub fn start_tracking(&mut self, from: Option<usize>) {
+        let Some(p) = &self.project else { return };
+        if p.marks().is_none() {
+            self.status = "Mark all 16 joints on one frame first (Edit > Mark joints)".to_owned();
+            return;
+        }
+        if let Some(r) = &self.running {
+            r.job.cancel();
+        }
+        let job = TrackJob {
+            keys: p.keys.clone(),
+            params: p.settings.tracker,
+            threads: 2,
+            from: from.filter(|_| p.tracks.is_some()),
+            previous: p.tracks.as_deref().cloned(),
+        };
+        let ctx = self.ctx_hint();
+        self.running = Some(Running {
+            job: Job::track(p.video.clone(), job, ctx),
+            keys: p.keys.clone(),
+            overrides: p.overrides.clone(),
+        });
+        self.partial.clear();
+    }
+
+    fn start_lift(&mut self) {
+        let (Some(p), Some(info)) = (&self.project, self.video_info()) else {
+            return;
+        };
+        let Some(tracks) = p.tracks.clone() else {
+            return;
+        };
+        let focal = p
+            .settings
+            .focal_px
+            .unwrap_or_else(|| default_focal(info.width, info.height));
+        let ctx = self.ctx_hint();
+        self.running = Some(Running {
+            job: Job::lift(tracks, focal, p.settings.height_m, p.overrides.clone(), ctx),
+            keys: p.keys.clone(),
+            overrides: p.overrides.clone(),
+        });
+    }
+
+    /// Cancels the running job.
+    pub fn cancel_job(&mut self) {
+        if let Some(r) = &self.running {
+            r.job.cancel();
+        }
+    }
+
+    /// Flips the depth choice of `bone` on the current frame and lifts again.
+    pub fn flip(&mut self, bone: Bone) {
+        let Some(k) = self
+            .project
+            .as_ref()
+            .and_then(|p| p.tracks.as_ref())
+            .and_then(|t| t.frames.iter().position(|f| f.index == self.current))
+        else {
+            return;
+        };
+        let Some(current) = self.choices.get(k).map(|c| c[bone.index()]) else {
+            return;
+        };
+        let frame = self.current;
+        self.edit(|p| {
+            p.overrides.insert((frame, bone), current.flipped());
+        });
+        self.status = format!("{} flipped on frame {frame}: lifting again", bone.key());
+        self.start_lift();
+    }
+
+    /// Writes one export to `path`.
+    pub fn export_to(&mut self, kind: ExportKind, path: &Path) {
+        self.status = match self.write_export(kind, path) {
+            Ok(()) => format!("Wrote {}", path.display()),
+            Err(e) => format!("Export failed: {e}"),
+        };
+    }
+
+    fn write_export(&self, kind: ExportKind, path: &Path) -> anyhow::Result<()> {
+        let p = self
+            .project
+            .as_ref()
+            .ok_or_else(|| anyhow::anyhow!("no video open"))?;
+        let need_tracks = || {
+            p.tracks
+                .as_deref()
+                .ok_or_else(|| anyhow::anyhow!("nothing tracked yet"))
+        };
+        let need_world = || {
+            self.world
+                .as_ref()
+                .ok_or_else(|| anyhow::anyhow!("no 3D skeleton yet"))
+        };
+        match kind {
+            ExportKind::Bvh => {
+                let b = export::bvh(need_world()?)?;
+                export::save_text(path, &b.text)?;
+            }
+            ExportKind::TracksJson => need_tracks()?.save(path)?,
+            ExportKind::SkeletonJson => p
+                .skeleton
+                .as_deref()
+                .ok_or_else(|| anyhow::anyhow!("no 3D skeleton yet"))?
+                .save(path)?,
+            ExportKind::TracksCsv => {
+                export::save_text(path, &export::tracks_csv(need_tracks()?))?;
+            }
+            ExportKind::JointsCsv => {
+                export::save_text(path, &export::skeleton_csv(need_world()?))?;
+            }
+            ExportKind::Trc => {
+                let name = path
+                    .file_name()
+                    .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+                export::save_text(path, &export::trc(need_world()?, &name))?;
+            }
+            ExportKind::Marks => p
+                .marks()
+                .ok_or_else(|| anyhow::anyhow!("not all 16 joints are marked on one frame"))?
+                .save(path)?,
+        }
+        Ok(())
+    }
+
+    fn export_dialog(&mut self, kind: ExportKind) {
+        let (name, ext) = kind.file();
+        if let Some(path) = self.config.dialogs.save_file("Export", name, ext) {
+            self.export_to(kind, &path);
+        }
+    }
+
+    /// Saves the project to `path` and clears the recovery file.
+    pub fn save_project_to(&mut self, path: &Path) {
+        let Some(p) = &self.project else { return };
+        match p.save(path) {
+            Ok(()) => {
+                self.project_path = Some(path.to_owned());
+                if let Some(a) = &mut self.autosaver {
+                    a.clear();
+                }
+                self.status = format!("Saved {}", path.display());
+            }
+            Err(e) => self.status = format!("Cannot save: {e}"),
+        }
+    }
+
+    fn save_project(&mut self, ask: bool) {
+        let path = match (&self.project_path, ask) {
+            (Some(p), false) => Some(p.clone()),
+            _ => self
+                .config
+                .dialogs
+                .save_file("Save project", "project.videomocap.json", "json"),
+        };
+        if let Some(path) = path {
+            self.save_project_to(&path);
+        }
+    }
+
+    /// Accepts or declines the recovery offered at start.
+    pub fn answer_recovery(&mut self, ctx: &egui::Context, recover: bool) {
+        let Some(path) = self.recovery.take() else {
+            return;
+        };
+        if recover {
+            match Project::load(&path) {
+                Ok(p) => {
+                    self.open_video(ctx, &p.video.clone());
+                    self.set_project(p);
+                    self.autosave();
+                    self.status = "Recovered the unsaved session".to_owned();
+                }
+                Err(e) => self.status = format!("Cannot recover: {e}"),
+            }
+        } else if let Some(a) = &mut self.autosaver {
+            a.clear();
+        }
+    }
+
+    fn ctx_hint(&self) -> egui::Context {
+        self.ctx.clone()
+    }
+
+    // ----- per-frame work -----
+
+    /// What to draw for a frame: keys win, then final tracks, then tracks arriving.
+    fn points(&self, frame: usize) -> PerJoint<Option<(Point2<f64>, PointState)>> {
+        let Some(p) = &self.project else {
+            return PerJoint::from_fn(|_| None);
+        };
+        let weak = p.settings.tracker.weak_reliability;
+        let tracked = p
+            .tracks
+            .as_ref()
+            .and_then(|t| t.frames.iter().find(|f| f.index == frame))
+            .or_else(|| self.partial.get(&frame));
+        let keys = p.keys.frames.get(&frame);
+        PerJoint::from_fn(|j| {
+            if let Some(k) = keys.and_then(|k| k[j]) {
+                return Some((k, PointState::Key));
+            }
+            let t = tracked?.points[j];
+            let state = if t.source == PointSource::Interpolated {
+                PointState::Interpolated
+            } else if t.confidence < weak {
+                PointState::Weak
+            } else {
+                PointState::Tracked
+            };
+            Some((t.pos, state))
+        })
     }
 
     fn go_to(&mut self, index: usize) {
@@ -93,14 +645,173 @@ impl ViewerApp {
         }
     }
 
+    fn receive(&mut self, ctx: &egui::Context) {
+        let events = self
+            .loader
+            .as_mut()
+            .map(FrameLoader::poll)
+            .unwrap_or_default();
+        for event in events {
+            match event {
+                LoaderEvent::Opened(Ok(info)) => {
+                    self.status = format!(
+                        "{}   {}×{}   {:.2} fps   {} frames",
+                        info.path.file_name().unwrap_or_default().to_string_lossy(),
+                        info.width,
+                        info.height,
+                        info.fps,
+                        info.frame_count
+                    );
+                    self.after_open(&info);
+                    if let Some(l) = &self.loader {
+                        l.request(self.current);
+                    }
+                }
+                LoaderEvent::Opened(Err(e)) => {
+                    self.status = format!("Cannot open: {e}");
+                    self.loader = None;
+                    self.project = None;
+                }
+                LoaderEvent::Frame(Ok(frame)) => {
+                    let size = [frame.image.width() as usize, frame.image.height() as usize];
+                    let image = egui::ColorImage::from_rgb(size, frame.image.as_raw());
+                    self.texture =
+                        Some(ctx.load_texture("frame", image, egui::TextureOptions::LINEAR));
+                    self.shown = Some(frame.index);
+                }
+                LoaderEvent::Frame(Err(e)) => self.status = format!("{e}"),
+            }
+        }
+        let events = self
+            .running
+            .as_mut()
+            .map(|r| r.job.poll())
+            .unwrap_or_default();
+        for event in events {
+            match event {
+                JobEvent::Progress { frame: Some(f), .. } => {
+                    self.partial.insert(f.index, f);
+                }
+                JobEvent::Progress { .. } => {}
+                JobEvent::Tracked(result) => self.tracked(result),
+                JobEvent::Lifted(result) => self.lifted(result),
+            }
+        }
+    }
+
+    /// A video opened: marks.json beside it is loaded when the project has no keys yet.
+    fn after_open(&mut self, info: &VideoInfo) {
+        let Some(p) = &self.project else { return };
+        if !p.keys.frames.is_empty() {
+            return;
+        }
+        let beside = info
+            .path
+            .parent()
+            .map(|d| d.join("marks.json"))
+            .filter(|m| m.is_file())
+            .and_then(|m| Marks::load(&m).ok())
+            .filter(|m| {
+                m.check_in_frame(&info.path, info.width, info.height)
+                    .is_ok()
+            });
+        if let Some(m) = beside {
+            self.current = m.frame.min(info.frame_count.saturating_sub(1));
+            if let Some(p) = &mut self.project {
+                p.keys = videomocap::track::KeyFrames::from_marks(&m);
+            }
+            self.status.push_str("   (marks.json loaded)");
+        }
+    }
+
+    fn tracked(&mut self, result: Result<videomocap::track::TrackOutput, String>) {
+        let Some(r) = self.running.take() else { return };
+        match result {
+            Ok(out) => {
+                let current = self.project.as_ref().map(|p| &p.keys);
+                if current != Some(&r.keys) {
+                    self.status = "Tracking finished for an older edit; result dropped".to_owned();
+                    return;
+                }
+                self.spans = out.spans;
+                let tracks = Arc::new(out.tracks);
+                if let Some(p) = &mut self.project {
+                    p.tracks = Some(tracks);
+                    p.skeleton = None;
+                }
+                self.autosave();
+                self.results_changed();
+                self.status = format!(
+                    "Tracked {} frames; {} weak spans",
+                    self.frame_count(),
+                    self.spans.len()
+                );
+                self.start_lift();
+            }
+            Err(e) => {
+                self.partial.clear();
+                self.status = format!("Tracking stopped: {e}");
+            }
+        }
+    }
+
+    fn lifted(&mut self, result: Result<videomocap::lift::LiftOutput, String>) {
+        let Some(r) = self.running.take() else { return };
+        match result {
+            Ok(out) => {
+                let same = self
+                    .project
+                    .as_ref()
+                    .is_some_and(|p| p.keys == r.keys && p.overrides == r.overrides);
+                if !same {
+                    self.status = "Lift finished for an older edit; result dropped".to_owned();
+                    return;
+                }
+                self.choices = out.choices;
+                if let Some(p) = &mut self.project {
+                    p.skeleton = Some(Arc::new(out.skeleton));
+                }
+                self.autosave();
+                self.results_changed();
+                let done = std::mem::take(&mut self.status);
+                self.status = format!("{done}; lifted to 3D");
+            }
+            Err(e) => self.status = format!("Lift stopped: {e}"),
+        }
+    }
+
     fn handle_keys(&mut self, ctx: &egui::Context) {
-        let (left, right, home, end, shift) = ctx.input(|i| {
+        let typing = ctx.egui_wants_keyboard_input();
+        if typing {
+            return;
+        }
+        let cmd = egui::Modifiers::COMMAND;
+        let (undo, redo, save) = ctx.input_mut(|i| {
+            let redo = i.consume_key(cmd | egui::Modifiers::SHIFT, egui::Key::Z);
+            let undo = i.consume_key(cmd, egui::Key::Z);
+            let save = i.consume_key(cmd, egui::Key::S);
+            (undo, redo, save)
+        });
+        if redo {
+            self.redo();
+        } else if undo {
+            self.undo();
+        }
+        if save {
+            self.save_project(false);
+        }
+        let (left, right, home, end, shift, f1, esc, m, t, space_up) = ctx.input(|i| {
             (
                 i.key_pressed(egui::Key::ArrowLeft),
                 i.key_pressed(egui::Key::ArrowRight),
                 i.key_pressed(egui::Key::Home),
                 i.key_pressed(egui::Key::End),
                 i.modifiers.shift,
+                i.key_pressed(egui::Key::F1),
+                i.key_pressed(egui::Key::Escape),
+                i.key_pressed(egui::Key::M),
+                i.key_pressed(egui::Key::T),
+                i.key_released(egui::Key::Space),
             )
         });
         let step = if shift { 10 } else { 1 };
@@ -116,100 +827,600 @@ impl ViewerApp {
         if end {
             self.go_to(self.frame_count().saturating_sub(1));
         }
-    }
-
-    fn receive_frames(&mut self, ctx: &egui::Context) {
-        let Some(loader) = &self.loader else { return };
-        match loader.poll() {
-            Some(Ok(frame)) => {
-                let size = [frame.image.width() as usize, frame.image.height() as usize];
-                let image = egui::ColorImage::from_rgb(size, frame.image.as_raw());
-                self.texture = Some(ctx.load_texture("frame", image, egui::TextureOptions::LINEAR));
-                self.shown = Some(frame.index);
+        if f1 {
+            self.show_help = !self.show_help;
+        }
+        if esc {
+            self.marking = None;
+            self.show_help = false;
+        }
+        if m {
+            self.start_marking();
+        }
+        if t && !self.busy() {
+            self.start_tracking(None);
+        }
+        // Space: a tap plays or pauses; held, it pans the frame view while dragging.
+        if ctx.input(|i| i.key_down(egui::Key::Space) && i.pointer.is_decidedly_dragging()) {
+            self.space_dragged = true;
+        }
+        if space_up {
+            if !self.space_dragged {
+                self.playing = !self.playing;
             }
-            Some(Err(e)) => self.status = format!("{e}"),
-            None => {}
+            self.space_dragged = false;
         }
     }
 
-    fn frame_view(&self, ui: &mut egui::Ui) {
-        let Some(texture) = &self.texture else {
-            ui.centered_and_justified(|ui| ui.label(&self.status));
+    fn play(&mut self, ctx: &egui::Context) {
+        if !self.playing {
             return;
-        };
-        let available = ui.available_rect_before_wrap();
-        let size = texture.size_vec2();
-        let scale = (available.width() / size.x).min(available.height() / size.y);
-        let shown = Rect::from_center_size(available.center(), size * scale);
-        ui.painter().image(
-            texture.id(),
-            shown,
-            Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)),
-            Color32::WHITE,
-        );
-        // ui_from_image: pixel centres at integers, so pixel (0,0) covers [-0.5, 0.5].
-        let ui_from_image = |x: f64, y: f64| {
-            shown.min + Vec2::new((x as f32 + 0.5) * scale, (y as f32 + 0.5) * scale)
-        };
-        if let Some(marks) = self.marks.as_ref().filter(|m| Some(m.frame) == self.shown) {
-            let painter = ui.painter();
-            for bone in Bone::ALL {
-                let a = marks.points[bone.parent];
-                let b = marks.points[bone.child];
-                painter.line_segment(
-                    [ui_from_image(a.x, a.y), ui_from_image(b.x, b.y)],
-                    Stroke::new(2.0, Color32::from_rgb(255, 220, 0)),
-                );
-            }
-            for (_, p) in marks.points.iter() {
-                painter.circle_filled(ui_from_image(p.x, p.y), 4.0, Color32::from_rgb(0, 200, 255));
-            }
         }
-        ui.allocate_rect(available, egui::Sense::hover());
+        let fps = self.video_info().map_or(30.0, |i| i.fps);
+        self.play_time += f64::from(ctx.input(|i| i.stable_dt));
+        let steps = (self.play_time * fps).floor();
+        if steps >= 1.0 {
+            self.play_time -= steps / fps;
+            let next = self.current + steps as usize;
+            if next >= self.frame_count() {
+                self.playing = false;
+            }
+            self.go_to(next);
+        }
+        ctx.request_repaint();
     }
-}
 
-impl eframe::App for ViewerApp {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
-        let ctx = ui.ctx().clone();
-        self.receive_frames(&ctx);
-        self.handle_keys(&ctx);
-        egui::Panel::top("menu").show(ui, |ui| {
-            ui.horizontal(|ui| {
-                ui.menu_button("File", |ui| {
-                    if ui.button("Open…").clicked() {
-                        ui.close();
-                        if let Some(path) = rfd::FileDialog::new().pick_file() {
-                            self.open(&ctx, &path);
+    // ----- panels -----
+
+    fn menu(&mut self, ui: &mut egui::Ui, ctx: &egui::Context) {
+        egui::MenuBar::new().ui(ui, |ui| {
+            ui.menu_button("File", |ui| {
+                if ui.button("Open video…").clicked() {
+                    ui.close();
+                    if let Some(p) = self.config.dialogs.open_file("Open video", &[]) {
+                        self.open_path(ctx, &p);
+                    }
+                }
+                if ui.button("Open image folder…").clicked() {
+                    ui.close();
+                    if let Some(p) = self.config.dialogs.open_folder("Open image folder") {
+                        self.open_path(ctx, &p);
+                    }
+                }
+                if ui.button("Open project…").clicked() {
+                    ui.close();
+                    if let Some(p) = self.config.dialogs.open_file("Open project", &["json"]) {
+                        self.open_path(ctx, &p);
+                    }
+                }
+                ui.menu_button("Recent", |ui| {
+                    for p in self.recent.clone() {
+                        if ui.button(p.display().to_string()).clicked() {
+                            ui.close();
+                            self.open_path(ctx, &p);
                         }
                     }
                 });
+                ui.separator();
+                if ui.button("Save project (Ctrl+S)").clicked() {
+                    ui.close();
+                    self.save_project(false);
+                }
+                if ui.button("Save project as…").clicked() {
+                    ui.close();
+                    self.save_project(true);
+                }
+                if ui.button("Load marks…").clicked() {
+                    ui.close();
+                    if let Some(path) = self.config.dialogs.open_file("Load marks", &["json"]) {
+                        match Marks::load(&path) {
+                            Ok(m) => self.edit(|p| {
+                                for (j, q) in m.points.iter() {
+                                    p.keys.set(m.frame, j, *q);
+                                }
+                            }),
+                            Err(e) => self.status = format!("Cannot load marks: {e}"),
+                        }
+                    }
+                }
+            });
+            ui.menu_button("Edit", |ui| {
+                if ui
+                    .add_enabled(self.history.can_undo(), egui::Button::new("Undo (Ctrl+Z)"))
+                    .clicked()
+                {
+                    ui.close();
+                    self.undo();
+                }
+                if ui
+                    .add_enabled(
+                        self.history.can_redo(),
+                        egui::Button::new("Redo (Ctrl+Shift+Z)"),
+                    )
+                    .clicked()
+                {
+                    ui.close();
+                    self.redo();
+                }
+                if ui.button("Mark joints (M)").clicked() {
+                    ui.close();
+                    self.start_marking();
+                }
+                ui.checkbox(
+                    &mut self.move_limb,
+                    "Dragging a joint moves the limb below it",
+                );
+            });
+            ui.menu_button("Track", |ui| {
+                if ui
+                    .add_enabled(!self.busy(), egui::Button::new("Track and lift (T)"))
+                    .clicked()
+                {
+                    ui.close();
+                    self.start_tracking(None);
+                }
+                if ui
+                    .add_enabled(!self.busy(), egui::Button::new("Lift to 3D again"))
+                    .clicked()
+                {
+                    ui.close();
+                    self.start_lift();
+                }
+            });
+            ui.menu_button("Export", |ui| {
+                for kind in ExportKind::ALL {
+                    if ui.button(kind.label()).clicked() {
+                        ui.close();
+                        self.export_dialog(kind);
+                    }
+                }
+            });
+            ui.menu_button("Help", |ui| {
+                if ui.button("Shortcuts (F1)").clicked() {
+                    ui.close();
+                    self.show_help = true;
+                }
             });
         });
-        egui::Panel::bottom("status").show(ui, |ui| {
-            ui.label(&self.status);
+    }
+
+    fn side_panel(&mut self, ui: &mut egui::Ui) {
+        if let Some(k) = self.marking {
+            ui.heading("Marking");
+            let j = Joint::ALL[k];
+            ui.label(format!("{} of 16: {}", k + 1, j.name()));
+            ui.label(egui::RichText::new(j.definition()).italics());
+            body_diagram(ui, j);
+            ui.horizontal(|ui| {
+                if ui.button("Skip").clicked() {
+                    self.marking = (k + 1 < Joint::ALL.len()).then_some(k + 1);
+                }
+                if ui.button("Done (Esc)").clicked() {
+                    self.marking = None;
+                }
+            });
+            ui.separator();
+        }
+        ui.heading("Parameters");
+        if let Some(before) = self.project.as_ref().map(|p| p.settings) {
+            let mut settings = before;
+            let info = self.video_info().cloned();
+            let default_f = info
+                .as_ref()
+                .map_or(1000.0, |i| default_focal(i.width, i.height));
+            let mut given = settings.focal_px.is_some();
+            let mut f = settings.focal_px.unwrap_or(default_f);
+            ui.checkbox(&mut given, "Focal length known")
+                .on_hover_text("Off: 60° across the image's longer side (a typical phone or webcam). On: give the focal length in pixels (from calibration, or focal mm × image width px / sensor width mm).");
+            ui.add_enabled(
+                given,
+                egui::DragValue::new(&mut f)
+                    .range(50.0..=20000.0)
+                    .suffix(" px"),
+            )
+            .on_hover_text(format!("Focal length in pixels; default {default_f:.0} px"));
+            settings.focal_px = given.then_some(f);
+            ui.add(egui::Slider::new(&mut settings.height_m, 1.0..=2.3).text("subject height (m)"))
+                .on_hover_text("The subject's stature: scales every bone length (default 1.70 m). The 3D skeleton's size and depth follow it.");
+            ui.collapsing("Tracker", |ui| {
+                let t = &mut settings.tracker;
+                let d = TrackerParams::default();
+                ui.add(egui::Slider::new(&mut t.weak_reliability, 0.0..=1.0).text("weak below"))
+                    .on_hover_text(format!("Reliability under which a joint counts as weak (orange) and may be interpolated; default {}", d.weak_reliability));
+                ui.add(egui::Slider::new(&mut t.max_gap_s, 0.0..=2.0).text("interpolate up to (s)"))
+                    .on_hover_text(format!("Longest weak run filled by interpolation between reliable frames; default {} s", d.max_gap_s));
+                ui.add(egui::Slider::new(&mut t.working_stature_px, 100.0..=800.0).text("working size (px)"))
+                    .on_hover_text(format!("Frames are shrunk so the person is about this tall while tracking (faster, smoother); default {} px", d.working_stature_px));
+                ui.add(egui::Slider::new(&mut t.limb_range_deg, 5.0..=90.0).text("limb search (°)"))
+                    .on_hover_text(format!("How far a limb may turn between frames in the search; default {}°", d.limb_range_deg));
+                if ui.button("Defaults").clicked() {
+                    *t = d;
+                }
+            });
+            if settings != before {
+                self.edit(|p| p.settings = settings);
+            }
+        }
+        ui.separator();
+        ui.heading("Weak spans");
+        egui::ScrollArea::vertical()
+            .max_height(220.0)
+            .show(ui, |ui| {
+                if self.spans.is_empty() {
+                    ui.label("none");
+                }
+                let mut jump = None;
+                for s in &self.spans {
+                    let text = format!(
+                        "{} {}–{} ({:?}, {:.2})",
+                        s.joint, s.start, s.end, s.kind, s.min_reliability
+                    );
+                    if ui.link(text).clicked() {
+                        jump = Some(s.start);
+                    }
+                }
+                if let Some(f) = jump {
+                    self.go_to(f);
+                }
+            });
+    }
+
+    fn progress_panel(&mut self, ui: &mut egui::Ui) {
+        let Some(r) = &self.running else { return };
+        let (share, per_s, left) = r.job.rate();
+        let mut cancel = false;
+        ui.horizontal(|ui| {
+            ui.label(format!("{} ({})", r.job.what, r.job.stage));
+            let text = match left {
+                Some(s) => format!(
+                    "{}/{} · {per_s:.1}/s · {s:.0} s left",
+                    r.job.done, r.job.total
+                ),
+                None => format!("{}/{}", r.job.done, r.job.total),
+            };
+            ui.add(
+                egui::ProgressBar::new(share)
+                    .desired_width((ui.available_width() - 90.0).max(100.0))
+                    .text(text),
+            );
+            cancel = ui.button("Cancel").clicked();
         });
+        if cancel {
+            self.cancel_job();
+        }
+    }
+
+    fn scene(&self) -> Scene {
+        let Some(world) = &self.world else {
+            return Scene {
+                joints: None,
+                camera: None,
+                flippable: Vec::new(),
+            };
+        };
+        let joints = world
+            .indices
+            .iter()
+            .position(|&i| i == self.current)
+            .map(|k| world.frames[k]);
+        let camera = self
+            .project
+            .as_ref()
+            .and_then(|p| p.skeleton.as_ref())
+            .map(|s| {
+                let cam = &s.camera;
+                let corner = |x: f64, y: f64| {
+                    let depth = 0.5;
+                    world.world.to_world(&Point3::new(
+                        (x - cam.cx) / cam.focal_px * depth,
+                        (y - cam.cy) / cam.focal_px * depth,
+                        depth,
+                    ))
+                };
+                let (w, h) = (f64::from(cam.width), f64::from(cam.height));
+                (
+                    world.world.to_world(&Point3::origin()),
+                    [
+                        corner(0.0, 0.0),
+                        corner(w, 0.0),
+                        corner(w, h),
+                        corner(0.0, h),
+                    ],
+                )
+            });
+        let key = videomocap::lift::calibrate::KEY_JOINTS;
+        Scene {
+            joints,
+            camera,
+            flippable: Bone::ALL
+                .into_iter()
+                .filter(|b| !(key.contains(&b.parent) && key.contains(&b.child)))
+                .collect(),
+        }
+    }
+
+    fn dialogs(&mut self, ctx: &egui::Context) {
+        if self.recovery.is_some() {
+            let mut answer = None;
+            egui::Window::new("Recover unsaved work?")
+                .collapsible(false)
+                .resizable(false)
+                .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
+                .show(ctx, |ui| {
+                    ui.label("videomocap did not close cleanly last time. Recover the autosaved session?");
+                    ui.horizontal(|ui| {
+                        if ui.button("Recover").clicked() {
+                            answer = Some(true);
+                        }
+                        if ui.button("Discard").clicked() {
+                            answer = Some(false);
+                        }
+                    });
+                });
+            if let Some(a) = answer {
+                self.answer_recovery(ctx, a);
+            }
+        }
+        if self.show_help {
+            egui::Window::new("Shortcuts")
+                .open(&mut self.show_help)
+                .show(ctx, |ui| {
+                    egui::Grid::new("keys").show(ui, |ui| {
+                        for (k, what) in SHORTCUTS {
+                            ui.label(egui::RichText::new(*k).strong());
+                            ui.label(*what);
+                            ui.end_row();
+                        }
+                    });
+                });
+        }
+    }
+}
+
+const SHORTCUTS: &[(&str, &str)] = &[
+    ("Left / Right", "previous / next frame"),
+    ("Shift + Left / Right", "ten frames back / forward"),
+    ("Home / End", "first / last frame"),
+    ("Space", "play / pause (hold and drag: pan)"),
+    ("Wheel", "zoom at the cursor (frame and 3D view)"),
+    ("Middle drag", "pan"),
+    ("M", "mark the 16 joints on this frame"),
+    ("Esc", "stop marking, close this window"),
+    ("Drag a joint", "correct it: key frame, re-track from here"),
+    ("T", "track and lift"),
+    ("Ctrl+Z / Ctrl+Shift+Z", "undo / redo"),
+    ("Ctrl+S", "save the project"),
+    ("Click a limb (3D)", "flip its depth on this frame"),
+    ("F1", "this help"),
+];
+
+/// Joints below `joint` on its limb (the bone tree's descendants).
+fn descendants(joint: Joint) -> Vec<Joint> {
+    let mut out = Vec::new();
+    let mut frontier = vec![joint];
+    while let Some(j) = frontier.pop() {
+        for b in Bone::ALL {
+            if b.parent == j {
+                out.push(b.child);
+                frontier.push(b.child);
+            }
+        }
+    }
+    out
+}
+
+/// Whether a file is a project (its `format` tag).
+fn is_project(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e == "json")
+        && std::fs::read_to_string(path)
+            .is_ok_and(|t| t.contains(videomocap::project::PROJECT_FORMAT))
+}
+
+/// A small front view of the body with `asking` highlighted.
+fn body_diagram(ui: &mut egui::Ui, asking: Joint) {
+    let (rect, _) = ui.allocate_exact_size(egui::vec2(120.0, 170.0), egui::Sense::hover());
+    let painter = ui.painter_at(rect);
+    // Front view: the subject's left on the image's right.
+    let at = |j: Joint| -> egui::Pos2 {
+        let (x, y) = match j {
+            Joint::HeadTop => (0.0, 0.0),
+            Joint::Neck => (0.0, 0.16),
+            Joint::Chest => (0.0, 0.27),
+            Joint::Pelvis => (0.0, 0.48),
+            Joint::LeftShoulder => (0.2, 0.19),
+            Joint::LeftElbow => (0.26, 0.35),
+            Joint::LeftWrist => (0.3, 0.5),
+            Joint::RightShoulder => (-0.2, 0.19),
+            Joint::RightElbow => (-0.26, 0.35),
+            Joint::RightWrist => (-0.3, 0.5),
+            Joint::LeftHip => (0.1, 0.48),
+            Joint::LeftKnee => (0.11, 0.72),
+            Joint::LeftAnkle => (0.12, 0.95),
+            Joint::RightHip => (-0.1, 0.48),
+            Joint::RightKnee => (-0.11, 0.72),
+            Joint::RightAnkle => (-0.12, 0.95),
+        };
+        egui::pos2(rect.center().x + x * 160.0, rect.top() + 5.0 + y * 160.0)
+    };
+    for b in Bone::ALL {
+        painter.line_segment(
+            [at(b.parent), at(b.child)],
+            egui::Stroke::new(2.0, egui::Color32::GRAY),
+        );
+    }
+    for j in Joint::ALL {
+        let (r, c) = if j == asking {
+            (6.0, egui::Color32::YELLOW)
+        } else {
+            (3.0, egui::Color32::LIGHT_GRAY)
+        };
+        painter.circle_filled(at(j), r, c);
+    }
+}
+
+impl eframe::App for App {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let ctx = ui.ctx().clone();
+        // Files dropped on the window open like File ▸ Open.
+        let dropped: Vec<PathBuf> = ctx.input(|i| {
+            i.raw
+                .dropped_files
+                .iter()
+                .map(|f| f.path().to_owned())
+                .filter(|p| !p.as_os_str().is_empty())
+                .collect()
+        });
+        if let Some(p) = dropped.first() {
+            self.open_path(&ctx, p);
+        }
+        self.receive(&ctx);
+        self.handle_keys(&ctx);
+        self.play(&ctx);
+        egui::Panel::top("menu").show(ui, |ui| self.menu(ui, &ctx));
+        egui::Panel::bottom("status").show(ui, |ui| {
+            ui.horizontal(|ui| {
+                ui.label(&self.status);
+            });
+        });
+        if self.running.is_some() {
+            egui::Panel::bottom("progress").show(ui, |ui| self.progress_panel(ui));
+        }
         let n = self.frame_count();
         if n > 0 {
+            let fps = self.video_info().map_or(30.0, |i| i.fps);
+            let mut jump = None;
             egui::Panel::bottom("timeline").show(ui, |ui| {
                 ui.horizontal(|ui| {
-                    let mut index = self.current;
-                    ui.spacing_mut().slider_width = (ui.available_width() - 160.0).max(100.0);
-                    ui.add(egui::Slider::new(&mut index, 0..=n - 1).text("frame"));
-                    self.go_to(index);
-                    let fps = self.loader.as_ref().map_or(1.0, |l| l.info().fps);
-                    ui.label(format!("{:.2} s", self.current_frame() as f64 / fps));
+                    let label = if self.playing { "Pause" } else { "Play" };
+                    if ui
+                        .button(label)
+                        .on_hover_text("play / pause (Space)")
+                        .clicked()
+                    {
+                        self.playing = !self.playing;
+                    }
+                    ui.vertical(|ui| {
+                        let keys = self
+                            .project
+                            .as_ref()
+                            .map(|p| p.keys.clone())
+                            .unwrap_or_default();
+                        jump =
+                            timeline::show(ui, self.current, n, fps, self.strips.as_ref(), &keys);
+                    });
                 });
             });
+            if let Some(f) = jump {
+                self.go_to(f);
+            }
         }
-        egui::CentralPanel::default().show(ui, |ui| self.frame_view(ui));
+        egui::Panel::left("side")
+            .resizable(true)
+            .default_size(240.0)
+            .show(ui, |ui| self.side_panel(ui));
+        let scene = self.scene();
+        let mut flip = None;
+        egui::Panel::right("3d")
+            .resizable(true)
+            .default_size(380.0)
+            .show(ui, |ui| {
+                ui.horizontal(|ui| {
+                    ui.label("3D");
+                    if ui.button("Reset view").clicked() {
+                        self.orbit = Orbit::default();
+                    }
+                });
+                flip = self.orbit.show(ui, &scene);
+            });
+        if let Some(b) = flip {
+            self.flip(b);
+        }
+        let overlay = Overlay {
+            points: self.points(self.current),
+            asking: self.asking(),
+        };
+        let mut event = None;
+        egui::CentralPanel::default().show(ui, |ui| match &self.texture {
+            Some(texture) => event = self.view.show(ui, texture, &overlay),
+            None => {
+                ui.centered_and_justified(|ui| ui.label(&self.status));
+            }
+        });
+        match event {
+            Some(ViewEvent::Click(p)) => self.click(p),
+            Some(ViewEvent::Moved(j, p)) => self.moved(j, p),
+            None => {}
+        }
+        self.dialogs(&ctx);
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::gui::dialogs::PreparedDialogs;
     use egui_kittest::Harness;
+    use egui_kittest::kittest::Queryable;
+
+    fn wait(h: &mut Harness<'_, App>, what: &str, done: impl Fn(&App) -> bool) {
+        for _ in 0..6000 {
+            h.step();
+            if done(h.state()) {
+                return;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        panic!(
+            "timed out waiting for {what}; status: {}",
+            h.state().status()
+        );
+    }
+
+    fn click(h: &mut Harness<'_, App>, pos: egui::Pos2) {
+        h.hover_at(pos);
+        h.step();
+        h.drag_at(pos);
+        h.step();
+        h.drop_at(pos);
+        h.step();
+        h.step();
+    }
+
+    fn drag(h: &mut Harness<'_, App>, from: egui::Pos2, to: egui::Pos2) {
+        h.hover_at(from);
+        h.step();
+        h.drag_at(from);
+        h.step();
+        for k in 1..=6 {
+            h.hover_at(from + (to - from) * (k as f32 / 6.0));
+            h.step();
+        }
+        h.drop_at(to);
+        h.step();
+        h.step();
+    }
+
+    fn screen(h: &Harness<'_, App>, p: Point2<f64>) -> egui::Pos2 {
+        h.state()
+            .frame_view()
+            .transform()
+            .expect("frame drawn")
+            .to_screen(p)
+    }
+
+    fn harness(
+        video: Option<PathBuf>,
+        dialogs: &PreparedDialogs,
+        state: &Path,
+    ) -> Harness<'static, App> {
+        let config = Config {
+            dialogs: Box::new(dialogs.clone()),
+            autosave_dir: Some(state.to_owned()),
+        };
+        Harness::builder()
+            .with_size(egui::vec2(1400.0, 860.0))
+            .build_eframe(move |cc| App::with_config(&cc.egui_ctx, video, config))
+    }
 
     #[test]
     fn arrow_keys_step_through_frames_and_stop_at_the_ends() {
@@ -219,18 +1430,141 @@ mod tests {
                 .save(dir.path().join(format!("f{i}.png")))
                 .unwrap();
         }
-        let path = dir.path().to_owned();
-        let mut harness = Harness::new_eframe(|cc| ViewerApp::new(&cc.egui_ctx, Some(path)));
-        harness.run();
-        assert_eq!(harness.state().frame_count(), 12);
-        harness.key_press(egui::Key::ArrowRight);
-        harness.run();
-        assert_eq!(harness.state().current_frame(), 1);
-        harness.key_press_modifiers(egui::Modifiers::SHIFT, egui::Key::ArrowRight);
-        harness.run();
-        assert_eq!(harness.state().current_frame(), 11);
-        harness.key_press(egui::Key::Home);
-        harness.run();
-        assert_eq!(harness.state().current_frame(), 0);
+        let dialogs = PreparedDialogs::default();
+        let mut h = harness(
+            Some(dir.path().to_owned()),
+            &dialogs,
+            &dir.path().join("state"),
+        );
+        wait(&mut h, "the folder to open", |a| a.frame_count() == 12);
+        h.key_press(egui::Key::ArrowRight);
+        h.step();
+        assert_eq!(h.state().current_frame(), 1);
+        h.key_press_modifiers(egui::Modifiers::SHIFT, egui::Key::ArrowRight);
+        h.step();
+        assert_eq!(h.state().current_frame(), 11);
+        h.key_press(egui::Key::Home);
+        h.step();
+        assert_eq!(h.state().current_frame(), 0);
+    }
+
+    /// The whole session a user has: open a clip, mark 16 joints by clicking, drag one, undo,
+    /// track and lift, scrub, orbit the 3D view, export a BVH, and after the app dies, recover
+    /// the work from the autosave.
+    #[test]
+    fn mark_drag_undo_track_scrub_orbit_export_and_recover() {
+        let dir = tempfile::tempdir().unwrap();
+        let sample = Path::new(env!("CARGO_MANIFEST_DIR")).join("sample_videos/synth_walk_oblique");
+        let video = dir.path().join("clip.mp4");
+        std::fs::copy(sample.join("video.mp4"), &video).unwrap();
+        let truth = Marks::load(&sample.join("marks.json")).unwrap();
+        let state = dir.path().join("state");
+        let dialogs = PreparedDialogs::default();
+        let mut h = harness(Some(video.clone()), &dialogs, &state);
+        wait(&mut h, "the clip to open", |a| {
+            a.frame_count() == 60 && a.shown() == Some(0)
+        });
+        assert!(
+            h.state().project().unwrap().keys.frames.is_empty(),
+            "no marks beside the copy"
+        );
+
+        // Mark: the guide asks for each joint in turn; click where it is.
+        h.key_press(egui::Key::M);
+        h.step();
+        for j in Joint::ALL {
+            assert_eq!(h.state().asking(), Some(j));
+            let pos = screen(&h, truth.points[j]);
+            click(&mut h, pos);
+        }
+        assert_eq!(h.state().asking(), None, "the guide ends after 16 joints");
+        let marks = h.state().project().unwrap().marks().expect("all 16 marked");
+        for j in Joint::ALL {
+            assert!((marks.points[j] - truth.points[j]).norm() < 0.5, "{j:?}");
+        }
+
+        // Drag the left wrist 30 screen points right, then undo.
+        let wrist = truth.points[Joint::LeftWrist];
+        let from = screen(&h, wrist);
+        drag(&mut h, from, from + egui::vec2(30.0, 0.0));
+        let moved = h.state().project().unwrap().keys.frames[&0][Joint::LeftWrist].unwrap();
+        assert!(
+            moved.x - wrist.x > 5.0,
+            "dragged to {moved:?} from {wrist:?}"
+        );
+        h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+        h.step();
+        let back = h.state().project().unwrap().keys.frames[&0][Joint::LeftWrist].unwrap();
+        assert!(
+            (back - marks.points[Joint::LeftWrist]).norm() < 1e-9,
+            "undo puts it back"
+        );
+
+        // Track (and lift) in the background.
+        h.key_press(egui::Key::T);
+        h.step();
+        assert!(h.state().busy());
+        wait(&mut h, "tracking and lifting", |a| {
+            !a.busy() && a.project().is_some_and(|p| p.skeleton.is_some())
+        });
+        assert_eq!(
+            h.state()
+                .project()
+                .unwrap()
+                .tracks
+                .as_ref()
+                .unwrap()
+                .frames
+                .len(),
+            60
+        );
+
+        // Scrub.
+        for _ in 0..3 {
+            h.key_press(egui::Key::ArrowRight);
+            h.step();
+        }
+        assert_eq!(h.state().current_frame(), 3);
+        wait(&mut h, "frame 3", |a| a.shown() == Some(3));
+
+        // Orbit the 3D view by dragging in it (the right-hand panel).
+        let before = h.state().orbit();
+        drag(&mut h, egui::pos2(1200.0, 400.0), egui::pos2(1260.0, 420.0));
+        assert!(
+            (h.state().orbit().yaw - before.yaw).abs() > 0.1,
+            "the view turned"
+        );
+
+        // Export a BVH through the menu (the dialog answers with a path).
+        let bvh = dir.path().join("out.bvh");
+        dialogs.answers.borrow_mut().push_back(bvh.clone());
+        h.get_by_label("Export").click();
+        h.run_steps(3);
+        h.get_by_label(ExportKind::Bvh.label()).click();
+        h.run_steps(3);
+        assert!(
+            h.state().status().contains("Wrote"),
+            "{}",
+            h.state().status()
+        );
+        let read = videomocap::bvh::Bvh::load(&bvh).unwrap();
+        assert_eq!(read.frame_count(), 60);
+
+        // The app dies without saving: the autosave holds the work, and the next start offers it.
+        h.state_mut().flush_autosave();
+        let autosave = h.state().autosave_path().unwrap();
+        assert!(autosave.is_file());
+        let expected = h.state().project().unwrap().clone();
+        drop(h);
+        let mut h = harness(None, &dialogs, &state);
+        h.step();
+        assert!(h.state().offers_recovery());
+        h.get_by_label("Recover").click();
+        h.run_steps(2);
+        wait(&mut h, "the recovered clip", |a| a.frame_count() == 60);
+        let p = h.state().project().unwrap();
+        assert_eq!(p.keys, expected.keys);
+        assert_eq!(p.tracks, expected.tracks);
+        assert!(p.skeleton.is_some());
     }
 }

@@ -1,14 +1,19 @@
-//! The desktop app (eframe/egui): the only place that uses egui. It calls the library and
-//! never the CLI. This first version opens a video, scrubs it with frames decoded on a worker
-//! thread, and draws the marks of the first frame; marking, tracking, 3D and export arrive with
-//! their issues.
+//! The desktop app (eframe/egui): the only place that uses egui and rfd. It calls the library
+//! and never the CLI: every computation (tracking, lifting, exports, projects) is a library call,
+//! heavy ones on worker threads.
 
 mod app;
+mod autosave;
+mod dialogs;
 mod frame_loader;
+mod frame_view;
+mod jobs;
+mod timeline;
+mod view3d;
 
 use std::path::PathBuf;
 
-/// Opens the main window, optionally on a video or image folder.
+/// Opens the main window, optionally on a video, an image folder or a project file.
 pub fn run(video: Option<PathBuf>) -> anyhow::Result<()> {
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
@@ -19,7 +24,7 @@ pub fn run(video: Option<PathBuf>) -> anyhow::Result<()> {
     eframe::run_native(
         "videomocap",
         options,
-        Box::new(move |cc| Ok(Box::new(app::ViewerApp::new(&cc.egui_ctx, video)))),
+        Box::new(move |cc| Ok(Box::new(app::App::new(&cc.egui_ctx, video)))),
     )
     .map_err(|e| anyhow::anyhow!("the desktop app could not start: {e}"))
 }

@@ -1,0 +1,118 @@
+//! The timeline: a scrubber with frame number and time, key frames marked, and one thin strip
+//! per joint coloured by state (tracked, weak, interpolated, lost) for every frame; clicking a
+//! strip jumps there.
+
+use super::frame_view::PointState;
+use egui::{Color32, Rect, Sense, Stroke, Vec2};
+use videomocap::formats::{PointSource, Tracks2d};
+use videomocap::skeleton::{JOINT_COUNT, Joint};
+use videomocap::track::{KeyFrames, SpanKind, WeakSpan};
+
+/// Colour of frames in a weak span that was left weak (the joint is probably lost there).
+pub const LOST: Color32 = Color32::from_rgb(220, 50, 50);
+
+/// Per joint, runs of frames with one colour: `(first, last, colour)`.
+#[derive(Debug, Clone, Default)]
+pub struct Strips {
+    runs: Vec<Vec<(usize, usize, Color32)>>,
+}
+
+impl Strips {
+    /// Strips from tracks, the weak spans and the key frames.
+    pub fn new(tracks: &Tracks2d, spans: &[WeakSpan], keys: &KeyFrames, weak: f32) -> Strips {
+        let runs = Joint::ALL
+            .iter()
+            .map(|&j| {
+                let mut runs: Vec<(usize, usize, Color32)> = Vec::new();
+                for (k, f) in tracks.frames.iter().enumerate() {
+                    let p = f.points[j];
+                    let lost = spans.iter().any(|s| {
+                        s.joint == j.name()
+                            && s.kind == SpanKind::Weak
+                            && (s.start..=s.end).contains(&f.index)
+                    });
+                    let colour = if keys.is_key(f.index, j) {
+                        PointState::Key.colour()
+                    } else if lost {
+                        LOST
+                    } else if p.source == PointSource::Interpolated {
+                        PointState::Interpolated.colour()
+                    } else if p.confidence < weak {
+                        PointState::Weak.colour()
+                    } else {
+                        PointState::Tracked.colour()
+                    };
+                    match runs.last_mut() {
+                        Some(last) if last.2 == colour && last.1 + 1 == k => last.1 = k,
+                        _ => runs.push((k, k, colour)),
+                    }
+                }
+                runs
+            })
+            .collect();
+        Strips { runs }
+    }
+}
+
+/// Draws the timeline; returns a frame to jump to.
+pub fn show(
+    ui: &mut egui::Ui,
+    current: usize,
+    frames: usize,
+    fps: f64,
+    strips: Option<&Strips>,
+    keys: &KeyFrames,
+) -> Option<usize> {
+    let mut jump = None;
+    ui.horizontal(|ui| {
+        let mut index = current;
+        ui.spacing_mut().slider_width = (ui.available_width() - 190.0).max(100.0);
+        let slider = egui::Slider::new(&mut index, 0..=frames.saturating_sub(1)).text("frame");
+        if ui.add(slider).changed() {
+            jump = Some(index);
+        }
+        ui.label(format!("{:.3} s", current as f64 / fps.max(1e-9)));
+    });
+    let strip_h = 4.0;
+    let width = ui.available_width();
+    let height = strip_h * JOINT_COUNT as f32 + 6.0;
+    let (rect, response) = ui.allocate_exact_size(Vec2::new(width, height), Sense::click());
+    let painter = ui.painter_at(rect);
+    painter.rect_filled(rect, 0.0, Color32::from_gray(30));
+    let x_of = |k: f32| rect.left() + k / frames.max(1) as f32 * rect.width();
+    if let Some(strips) = strips {
+        for (row, runs) in strips.runs.iter().enumerate() {
+            let top = rect.top() + 6.0 + row as f32 * strip_h;
+            for &(a, b, colour) in runs {
+                let r = Rect::from_min_max(
+                    egui::pos2(x_of(a as f32), top),
+                    egui::pos2(
+                        x_of(b as f32 + 1.0).max(x_of(a as f32) + 1.0),
+                        top + strip_h - 1.0,
+                    ),
+                );
+                painter.rect_filled(r, 0.0, colour);
+            }
+        }
+    }
+    for &f in keys.frames.keys() {
+        let x = x_of(f as f32 + 0.5);
+        painter.line_segment(
+            [egui::pos2(x, rect.top()), egui::pos2(x, rect.top() + 5.0)],
+            Stroke::new(2.0, Color32::WHITE),
+        );
+    }
+    let x = x_of(current as f32 + 0.5);
+    painter.line_segment(
+        [egui::pos2(x, rect.top()), egui::pos2(x, rect.bottom())],
+        Stroke::new(1.0, Color32::YELLOW),
+    );
+    if response.clicked()
+        && let Some(pos) = response.interact_pointer_pos()
+    {
+        let k = ((pos.x - rect.left()) / rect.width() * frames as f32).floor();
+        jump = Some((k.max(0.0) as usize).min(frames.saturating_sub(1)));
+    }
+    response.on_hover_text("one strip per joint, top to bottom in model order: white key frame, green tracked, orange weak, blue interpolated, red lost; click to jump");
+    jump
+}

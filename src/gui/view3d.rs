@@ -1,0 +1,165 @@
+//! The 3D viewport: the current frame's skeleton in the exports' Y-up world, a ground grid and
+//! the camera's frustum; orbit by dragging, zoom with the wheel, pan with the middle or right
+//! button; clicking a limb asks to flip its depth choice.
+
+use super::frame_view::side_colour;
+use egui::{Color32, Pos2, Rect, Sense, Stroke, Vec2};
+use nalgebra::{Point3, Vector3};
+use videomocap::skeleton::{Bone, PerJoint};
+
+/// What the viewport shows.
+pub struct Scene {
+    /// The skeleton of the current frame, world metres.
+    pub joints: Option<PerJoint<Point3<f64>>>,
+    /// The camera's centre and its image corners at 0.5 m depth, world metres.
+    pub camera: Option<(Point3<f64>, [Point3<f64>; 4])>,
+    /// Bones that can be flipped (drawn thicker on hover).
+    pub flippable: Vec<Bone>,
+}
+
+/// An orbiting view around a target point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Orbit {
+    /// Turn about the vertical, radians.
+    pub yaw: f32,
+    /// Tilt above the horizon, radians.
+    pub pitch: f32,
+    /// Distance to the target, metres.
+    pub distance: f32,
+    /// The point looked at.
+    pub target: Vector3<f32>,
+}
+
+impl Default for Orbit {
+    fn default() -> Self {
+        Orbit {
+            yaw: 0.5,
+            pitch: 0.25,
+            distance: 4.5,
+            target: Vector3::new(0.0, 0.9, 0.0),
+        }
+    }
+}
+
+impl Orbit {
+    fn basis(&self) -> (Vector3<f32>, Vector3<f32>, Vector3<f32>, Vector3<f32>) {
+        let back = Vector3::new(
+            self.pitch.cos() * self.yaw.sin(),
+            self.pitch.sin(),
+            self.pitch.cos() * self.yaw.cos(),
+        );
+        let eye = self.target + back * self.distance;
+        let forward = -back;
+        let right = forward.cross(&Vector3::y()).normalize();
+        let up = right.cross(&forward);
+        (eye, right, up, forward)
+    }
+
+    /// Screen position of a world point (`None` behind the eye).
+    pub fn project(&self, rect: Rect, p: &Point3<f64>) -> Option<Pos2> {
+        let (eye, right, up, forward) = self.basis();
+        let d = Vector3::new(p.x as f32, p.y as f32, p.z as f32) - eye;
+        let z = d.dot(&forward);
+        if z < 0.05 {
+            return None;
+        }
+        let f = rect.height() * 1.2;
+        Some(rect.center() + Vec2::new(d.dot(&right) / z * f, -d.dot(&up) / z * f))
+    }
+
+    /// Draws the scene; returns a bone the user clicked.
+    pub fn show(&mut self, ui: &mut egui::Ui, scene: &Scene) -> Option<Bone> {
+        let rect = ui.available_rect_before_wrap();
+        let response = ui.allocate_rect(rect, Sense::click_and_drag());
+        if response.dragged_by(egui::PointerButton::Primary) {
+            let d = response.drag_delta();
+            self.yaw -= d.x * 0.01;
+            self.pitch = (self.pitch + d.y * 0.01).clamp(-1.5, 1.5);
+        }
+        if response.dragged_by(egui::PointerButton::Middle)
+            || response.dragged_by(egui::PointerButton::Secondary)
+        {
+            let (_, right, up, _) = self.basis();
+            let d = response.drag_delta() * self.distance / (rect.height() * 1.2);
+            self.target += -right * d.x + up * d.y;
+        }
+        if response.hovered() {
+            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+            self.distance = (self.distance * (-scroll * 0.002).exp()).clamp(0.5, 50.0);
+        }
+        let painter = ui.painter_at(rect);
+        painter.rect_filled(rect, 0.0, Color32::from_gray(24));
+        let line = |a: &Point3<f64>, b: &Point3<f64>, stroke: Stroke| {
+            if let (Some(p), Some(q)) = (self.project(rect, a), self.project(rect, b)) {
+                painter.line_segment([p, q], stroke);
+            }
+        };
+        let grid = Stroke::new(1.0, Color32::from_gray(70));
+        for k in -6..=6 {
+            let v = f64::from(k) * 0.5;
+            line(&Point3::new(v, 0.0, -3.0), &Point3::new(v, 0.0, 3.0), grid);
+            line(&Point3::new(-3.0, 0.0, v), &Point3::new(3.0, 0.0, v), grid);
+        }
+        if let Some((c, corners)) = &scene.camera {
+            let s = Stroke::new(1.0, Color32::from_rgb(180, 180, 255));
+            for k in 0..4 {
+                line(c, &corners[k], s);
+                line(&corners[k], &corners[(k + 1) % 4], s);
+            }
+        }
+        let mut clicked = None;
+        if let Some(joints) = &scene.joints {
+            let hover = response.hover_pos();
+            let near_bone = |pos: Pos2| -> Option<Bone> {
+                scene
+                    .flippable
+                    .iter()
+                    .filter_map(|b| {
+                        let p = self.project(rect, &joints[b.parent])?;
+                        let q = self.project(rect, &joints[b.child])?;
+                        let d = distance_to_segment(pos, p, q);
+                        (d < 8.0).then_some((*b, d))
+                    })
+                    .min_by(|a, b| a.1.total_cmp(&b.1))
+                    .map(|(b, _)| b)
+            };
+            let hovered = hover.and_then(near_bone);
+            for b in Bone::ALL {
+                let width = if hovered == Some(b) { 5.0 } else { 2.5 };
+                line(
+                    &joints[b.parent],
+                    &joints[b.child],
+                    Stroke::new(width, side_colour(b.child)),
+                );
+            }
+            for (_, p) in joints.iter() {
+                if let Some(s) = self.project(rect, p) {
+                    painter.circle_filled(s, 3.0, Color32::WHITE);
+                }
+            }
+            if hovered.is_some() {
+                response
+                    .clone()
+                    .on_hover_text("click to flip this limb's depth on this frame");
+            }
+            if response.clicked() {
+                clicked = response.interact_pointer_pos().and_then(near_bone);
+            }
+        } else {
+            painter.text(
+                rect.center(),
+                egui::Align2::CENTER_CENTER,
+                "no 3D skeleton yet: mark, then Track",
+                egui::FontId::proportional(14.0),
+                Color32::GRAY,
+            );
+        }
+        clicked
+    }
+}
+
+fn distance_to_segment(p: Pos2, a: Pos2, b: Pos2) -> f32 {
+    let ab = b - a;
+    let t = ((p - a).dot(ab) / ab.length_sq().max(1e-6)).clamp(0.0, 1.0);
+    p.distance(a + ab * t)
+}

@@ -1,0 +1,315 @@
+//! A project: the video, every joint placed by hand (marks and corrections), the settings, the
+//! depth choices the user flipped, and the results (tracks, 3D skeleton). The desktop app edits
+//! one; it is saved atomically as `videomocap.project` JSON (documented in `docs/formats.md`) and
+//! autosaved beside the work. [`History`] gives undo and redo over whole projects.
+
+mod history;
+
+pub use history::History;
+
+use crate::formats::{FORMAT_VERSION, FormatError, Skeleton3d, Tracks2d, write_atomically};
+use crate::lift::{DepthOverrides, Root};
+use crate::skeleton::{Bone, Joint};
+use crate::track::{KeyFrames, TrackerParams};
+use nalgebra::Point2;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// The `format` tag of project files.
+pub const PROJECT_FORMAT: &str = "videomocap.project";
+
+/// Default stature of the subject when none is given, metres.
+pub const DEFAULT_HEIGHT_M: f64 = 1.70;
+
+/// Settings a project keeps with it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Settings {
+    /// Tracker settings.
+    pub tracker: TrackerParams,
+    /// Focal length in pixels; `None` = the default (60° across the longer image side).
+    pub focal_px: Option<f64>,
+    /// The subject's stature, metres (scales the bone lengths).
+    pub height_m: f64,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            tracker: TrackerParams::default(),
+            focal_px: None,
+            height_m: DEFAULT_HEIGHT_M,
+        }
+    }
+}
+
+/// Everything the user made for one video. Cheap to clone (results are shared), so undo keeps
+/// whole projects.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Project {
+    /// The video or image folder.
+    pub video: PathBuf,
+    /// Joints placed by hand, per frame.
+    pub keys: KeyFrames,
+    /// Settings.
+    pub settings: Settings,
+    /// Depth choices forced by the user (clicking a limb in the 3D view).
+    pub overrides: DepthOverrides,
+    /// The tracks, once tracked.
+    pub tracks: Option<Arc<Tracks2d>>,
+    /// The 3D skeleton, once lifted.
+    pub skeleton: Option<Arc<Skeleton3d>>,
+}
+
+impl Project {
+    /// An empty project on a video.
+    pub fn new(video: PathBuf) -> Project {
+        Project {
+            video,
+            keys: KeyFrames::default(),
+            settings: Settings::default(),
+            overrides: DepthOverrides::default(),
+            tracks: None,
+            skeleton: None,
+        }
+    }
+
+    /// The first frame with all 16 joints placed (the marks), if any.
+    pub fn marks(&self) -> Option<crate::formats::Marks> {
+        self.keys.frames.iter().find_map(|(&frame, joints)| {
+            let all: Option<Vec<Point2<f64>>> = joints.0.iter().copied().collect();
+            all.map(|v| crate::formats::Marks {
+                frame,
+                points: crate::skeleton::PerJoint::from_fn(|j| v[j.index()]),
+            })
+        })
+    }
+
+    /// Reads a project file.
+    pub fn load(path: &Path) -> Result<Project, FormatError> {
+        let text = std::fs::read_to_string(path).map_err(|source| FormatError::Io {
+            path: path.to_owned(),
+            source,
+        })?;
+        Project::parse(&text, path)
+    }
+
+    /// Parses project JSON; `path` names the file in errors.
+    pub fn parse(text: &str, path: &Path) -> Result<Project, FormatError> {
+        let raw: ProjectFile = serde_json::from_str(text).map_err(|source| FormatError::Json {
+            path: path.to_owned(),
+            source,
+        })?;
+        let invalid = |problem: String| FormatError::Invalid {
+            path: path.to_owned(),
+            problem,
+        };
+        if raw.format != PROJECT_FORMAT {
+            return Err(FormatError::WrongFormat {
+                path: path.to_owned(),
+                found: raw.format,
+                expected: PROJECT_FORMAT,
+            });
+        }
+        if raw.version != FORMAT_VERSION {
+            return Err(FormatError::UnsupportedVersion {
+                path: path.to_owned(),
+                version: raw.version,
+                supported: FORMAT_VERSION,
+            });
+        }
+        let mut keys = KeyFrames::default();
+        for k in raw.keys {
+            for (name, [x, y]) in k.joints {
+                let joint = Joint::from_name(&name).ok_or_else(|| FormatError::UnknownJoint {
+                    path: path.to_owned(),
+                    name: name.clone(),
+                })?;
+                if !(x.is_finite() && y.is_finite()) {
+                    return Err(FormatError::NonFinite {
+                        path: path.to_owned(),
+                        joint,
+                        frame: Some(k.frame),
+                    });
+                }
+                keys.set(k.frame, joint, Point2::new(x, y));
+            }
+        }
+        let mut overrides = DepthOverrides::default();
+        for o in raw.depth_overrides {
+            let bone = Bone::from_key(&o.bone).ok_or_else(|| {
+                invalid(format!("unknown bone \"{}\" in depth_overrides", o.bone))
+            })?;
+            let root = match o.root.as_str() {
+                "near" => Root::Near,
+                "far" => Root::Far,
+                other => {
+                    return Err(invalid(format!(
+                        "depth override root must be \"near\" or \"far\", not \"{other}\""
+                    )));
+                }
+            };
+            overrides.insert((o.frame, bone), root);
+        }
+        let height = raw.settings.height_m;
+        if !(height.is_finite() && (0.5..=2.8).contains(&height)) {
+            return Err(invalid(format!(
+                "settings.height_m must be between 0.5 and 2.8 m (got {height})"
+            )));
+        }
+        if let Some(f) = raw.settings.focal_px
+            && !(f.is_finite() && f > 0.0)
+        {
+            return Err(invalid(format!(
+                "settings.focal_px must be positive (got {f})"
+            )));
+        }
+        let tracks = raw
+            .tracks
+            .map(|v| Tracks2d::from_json_value(v, path).map(Arc::new))
+            .transpose()?;
+        let skeleton = raw
+            .skeleton
+            .map(|v| Skeleton3d::from_json_value(v, path).map(Arc::new))
+            .transpose()?;
+        Ok(Project {
+            video: raw.video,
+            keys,
+            settings: raw.settings,
+            overrides,
+            tracks,
+            skeleton,
+        })
+    }
+
+    /// The project as JSON text.
+    pub fn to_json(&self) -> String {
+        let file = ProjectFile {
+            format: PROJECT_FORMAT.to_owned(),
+            version: FORMAT_VERSION,
+            video: self.video.clone(),
+            settings: self.settings,
+            keys: self
+                .keys
+                .frames
+                .iter()
+                .map(|(&frame, joints)| KeyFile {
+                    frame,
+                    joints: joints
+                        .iter()
+                        .filter_map(|(j, p)| p.map(|p| (j.name().to_owned(), [p.x, p.y])))
+                        .collect(),
+                })
+                .collect(),
+            depth_overrides: self
+                .overrides
+                .iter()
+                .map(|(&(frame, bone), root)| OverrideFile {
+                    frame,
+                    bone: bone.key(),
+                    root: match root {
+                        Root::Near => "near",
+                        Root::Far => "far",
+                    }
+                    .to_owned(),
+                })
+                .collect(),
+            tracks: self.tracks.as_ref().map(|t| t.to_json_value()),
+            skeleton: self.skeleton.as_ref().map(|s| s.to_json_value()),
+        };
+        // Plain numbers, strings, maps: serialising cannot fail.
+        let mut text = serde_json::to_string_pretty(&file).unwrap_or_default();
+        text.push('\n');
+        text
+    }
+
+    /// Saves atomically (temporary file, fsync, rename): a crash leaves the old or the new file.
+    pub fn save(&self, path: &Path) -> Result<(), FormatError> {
+        write_atomically(path, self.to_json().as_bytes())
+    }
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ProjectFile {
+    format: String,
+    version: u32,
+    video: PathBuf,
+    #[serde(default)]
+    settings: Settings,
+    #[serde(default)]
+    keys: Vec<KeyFile>,
+    #[serde(default)]
+    depth_overrides: Vec<OverrideFile>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    tracks: Option<serde_json::Value>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    skeleton: Option<serde_json::Value>,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct KeyFile {
+    frame: usize,
+    joints: BTreeMap<String, [f64; 2]>,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct OverrideFile {
+    frame: usize,
+    bone: String,
+    root: String,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_project_round_trips_through_its_file() {
+        let mut p = Project::new(PathBuf::from("clip.mp4"));
+        p.keys.set(0, Joint::Neck, Point2::new(10.5, 20.25));
+        p.keys.set(7, Joint::LeftWrist, Point2::new(1.0, 2.0));
+        p.overrides.insert(
+            (3, Bone::new(Joint::LeftElbow, Joint::LeftWrist)),
+            Root::Far,
+        );
+        p.settings.height_m = 1.82;
+        p.settings.focal_px = Some(900.0);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.json");
+        p.save(&path).unwrap();
+        assert_eq!(Project::load(&path).unwrap(), p);
+    }
+
+    #[test]
+    fn bad_projects_are_named() {
+        let path = Path::new("bad.videomocap");
+        let base = Project::new(PathBuf::from("clip.mp4")).to_json();
+        let cases = [
+            (base.replace("1.7", "9.0"), "height_m"),
+            (
+                base.replace("videomocap.project", "videomocap.tracks2d"),
+                "videomocap.tracks2d",
+            ),
+            (
+                base.replace(
+                    "\"keys\": []",
+                    "\"keys\": [{\"frame\": 1, \"joints\": {\"nose\": [1, 2]}}]",
+                ),
+                "nose",
+            ),
+            ("{".to_owned(), "bad.videomocap"),
+        ];
+        for (text, needle) in cases {
+            let err = Project::parse(&text, path).unwrap_err().to_string();
+            assert!(
+                err.contains(needle) && err.contains("bad.videomocap"),
+                "{err}"
+            );
+        }
+    }
+}
