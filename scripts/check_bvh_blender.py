@@ -8,26 +8,16 @@ patched before importing. The importer turns the BVH's Y-up world into Blender's
 import builtins
 import csv
 import math
+import os
 import sys
 
 import bpy
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bvh_rig import JOINTS  # noqa: E402
+
 _open = builtins.open
 builtins.open = lambda f, m="r", *a, **k: _open(f, m.replace("U", ""), *a, **k)
-
-# Model joint → (bone, use the bone's tail) — see src/export/rig.rs.
-JOINTS = {
-    "pelvis": ("Hips", False), "chest": ("Chest", False), "neck": ("Neck", False),
-    "head_top": ("Head", True),
-    "left_shoulder": ("LeftArm", False), "left_elbow": ("LeftForeArm", False),
-    "left_wrist": ("LeftForeArm", True),
-    "right_shoulder": ("RightArm", False), "right_elbow": ("RightForeArm", False),
-    "right_wrist": ("RightForeArm", True),
-    "left_hip": ("LeftUpLeg", False), "left_knee": ("LeftLeg", False),
-    "left_ankle": ("LeftLeg", True),
-    "right_hip": ("RightUpLeg", False), "right_knee": ("RightLeg", False),
-    "right_ankle": ("RightLeg", True),
-}
 
 
 def main():

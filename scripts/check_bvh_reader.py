@@ -10,19 +10,8 @@ import sys
 
 from bvh import Bvh
 
-# Where each model joint sits in the BVH: (joint name, End Site?) — see src/export/rig.rs.
-JOINTS = {
-    "pelvis": ("Hips", False), "chest": ("Chest", False), "neck": ("Neck", False),
-    "head_top": ("Head", True),
-    "left_shoulder": ("LeftArm", False), "left_elbow": ("LeftForeArm", False),
-    "left_wrist": ("LeftForeArm", True),
-    "right_shoulder": ("RightArm", False), "right_elbow": ("RightForeArm", False),
-    "right_wrist": ("RightForeArm", True),
-    "left_hip": ("LeftUpLeg", False), "left_knee": ("LeftLeg", False),
-    "left_ankle": ("LeftLeg", True),
-    "right_hip": ("RightUpLeg", False), "right_knee": ("RightLeg", False),
-    "right_ankle": ("RightLeg", True),
-}
+from bvh_rig import JOINTS
+
 CM_PER_M = 100.0
 
 

@@ -53,7 +53,7 @@ pub fn load_any(path: &Path) -> Result<AnyFile, FormatError> {
 pub const FORMAT_VERSION: u32 = 1;
 
 /// Reads a whole file as text, naming it in the error.
-fn read_text(path: &Path) -> Result<String, FormatError> {
+pub(crate) fn read_text(path: &Path) -> Result<String, FormatError> {
     std::fs::read_to_string(path).map_err(|source| FormatError::Io {
         path: path.to_owned(),
         source,
@@ -61,7 +61,10 @@ fn read_text(path: &Path) -> Result<String, FormatError> {
 }
 
 /// Parses JSON, naming the file and the line in the error.
-fn parse_json<T: for<'de> Deserialize<'de>>(text: &str, path: &Path) -> Result<T, FormatError> {
+pub(crate) fn parse_json<T: for<'de> Deserialize<'de>>(
+    text: &str,
+    path: &Path,
+) -> Result<T, FormatError> {
     serde_json::from_str(text).map_err(|source| FormatError::Json {
         path: path.to_owned(),
         source,

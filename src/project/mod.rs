@@ -7,7 +7,9 @@ mod history;
 
 pub use history::History;
 
-use crate::formats::{FORMAT_VERSION, FormatError, Skeleton3d, Tracks2d, write_atomically};
+use crate::formats::{
+    FORMAT_VERSION, FormatError, Skeleton3d, Tracks2d, parse_json, read_text, write_atomically,
+};
 use crate::lift::{DepthOverrides, Root};
 use crate::skeleton::{Bone, Joint};
 use crate::track::{KeyFrames, TrackerParams};
@@ -89,19 +91,12 @@ impl Project {
 
     /// Reads a project file.
     pub fn load(path: &Path) -> Result<Project, FormatError> {
-        let text = std::fs::read_to_string(path).map_err(|source| FormatError::Io {
-            path: path.to_owned(),
-            source,
-        })?;
-        Project::parse(&text, path)
+        Project::parse(&read_text(path)?, path)
     }
 
     /// Parses project JSON; `path` names the file in errors.
     pub fn parse(text: &str, path: &Path) -> Result<Project, FormatError> {
-        let raw: ProjectFile = serde_json::from_str(text).map_err(|source| FormatError::Json {
-            path: path.to_owned(),
-            source,
-        })?;
+        let raw: ProjectFile = parse_json(text, path)?;
         let invalid = |problem: String| FormatError::Invalid {
             path: path.to_owned(),
             problem,
