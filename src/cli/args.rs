@@ -232,13 +232,18 @@ pub struct SynthArgs {
 #[derive(Debug, Args)]
 pub struct BenchArgs {
     /// What to measure: all (decode and synth), decode, synth, track (tracking accuracy on
-    /// the synthetic suite and the real sample, and tracking speed; takes a few minutes), or
-    /// lift (3D accuracy from true, noisy and tracked 2D, focal estimate, speed).
+    /// the synthetic suite and the real sample, and tracking speed; takes a few minutes), lift
+    /// (3D accuracy from true, noisy and tracked 2D, focal estimate, speed), or scrub (the
+    /// desktop app's frame access on a long 1080p clip: open time, random seeks, scrubbing,
+    /// peak memory).
     #[arg(default_value = "all")]
     pub what: String,
     /// Frames per measured clip (decode).
     #[arg(long, default_value_t = 300)]
     pub frames: usize,
+    /// Length of the 1080p clip `bench scrub` makes, minutes.
+    #[arg(long, default_value_t = 20.0)]
+    pub minutes: f64,
     /// Where the synthetic tracking suite is rendered (once) and kept.
     #[arg(long, default_value = "out/bench-suite")]
     pub suite_dir: PathBuf,

@@ -25,6 +25,9 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     if a.what == "lift" {
         return super::bench_lift::run(a, global);
     }
+    if a.what == "scrub" {
+        return super::bench_scrub::run(a, global);
+    }
     let dir = tempfile::tempdir().map_err(ExitError::failed)?;
     let mut rows: Vec<[String; 4]> = Vec::new();
     if matches!(a.what.as_str(), "all" | "decode") {

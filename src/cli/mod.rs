@@ -4,6 +4,7 @@
 pub mod args;
 mod bench;
 mod bench_lift;
+mod bench_scrub;
 mod bench_track;
 mod export;
 mod info;

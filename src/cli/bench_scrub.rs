@@ -1,0 +1,150 @@
+//! `videomocap bench scrub`: what the desktop app's frame access costs on a long 1080p clip made
+//! with `ffmpeg -f lavfi`: opening (the frame index), random seeks, stepping through frames,
+//! revisiting cached frames (decode cache plus the RGB → RGBA copy the texture upload needs),
+//! and the process's peak memory. The app does the same calls on its frame-loader thread.
+
+use super::args::{BenchArgs, GlobalArgs};
+use super::{ExitError, say};
+use rand::{Rng, SeedableRng};
+use std::time::Instant;
+use videomocap::video::{OpenOptions, Video};
+
+pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+    let dir = std::path::Path::new("out/bench-scrub");
+    std::fs::create_dir_all(dir).map_err(ExitError::failed)?;
+    let frames = (a.minutes * 60.0 * 30.0).round().max(2.0) as usize;
+    let file = dir.join(format!("long_1080p_{frames}.mp4"));
+    if !file.is_file() {
+        say(
+            global,
+            &format!(
+                "making a 1920×1080 H.264 clip of {frames} frames ({} min, kept in {}) …",
+                a.minutes,
+                dir.display()
+            ),
+        );
+        make_long_clip(&file, frames).map_err(ExitError::failed)?;
+    }
+    let rss_before = peak_rss_mib();
+    let t0 = Instant::now();
+    let mut video = Video::open(&file, &OpenOptions::default()).map_err(ExitError::failed)?;
+    let open_s = t0.elapsed().as_secs_f64();
+    let n = video.info().frame_count;
+    let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+    let mut seeks: Vec<f64> = Vec::new();
+    for _ in 0..40 {
+        let k = rng.random_range(0..n);
+        let t = Instant::now();
+        video.frame(k).map_err(ExitError::failed)?;
+        seeks.push(t.elapsed().as_secs_f64() * 1000.0);
+    }
+    seeks.sort_by(f64::total_cmp);
+    let start = n / 2;
+    let t = Instant::now();
+    for k in start..start + 120 {
+        video.frame(k).map_err(ExitError::failed)?;
+    }
+    let step_fps = 120.0 / t.elapsed().as_secs_f64();
+    // Revisit the same 120 frames five times, as scrubbing back and forth does.
+    let t = Instant::now();
+    let mut sink = 0usize;
+    for _ in 0..5 {
+        for k in start..start + 120 {
+            let f = video.frame(k).map_err(ExitError::failed)?;
+            let rgba: Vec<u8> = f
+                .image
+                .as_raw()
+                .chunks_exact(3)
+                .flat_map(|p| [p[0], p[1], p[2], 255])
+                .collect();
+            sink += rgba.len();
+        }
+    }
+    let cached_fps = 600.0 / t.elapsed().as_secs_f64();
+    let pct = |q: f64| seeks[((seeks.len() - 1) as f64 * q).round() as usize];
+    let rows = [
+        (
+            "clip",
+            format!("1920×1080, {n} frames ({:.1} min)", n as f64 / 30.0 / 60.0),
+        ),
+        ("open (reads the frame index)", format!("{open_s:.2} s")),
+        ("random seek, median", format!("{:.0} ms", pct(0.5))),
+        (
+            "random seek, 95th percentile",
+            format!("{:.0} ms", pct(0.95)),
+        ),
+        ("random seek, worst of 40", format!("{:.0} ms", pct(1.0))),
+        (
+            "step forward one frame at a time",
+            format!("{step_fps:.0} frames/s"),
+        ),
+        (
+            "revisit cached frames incl. RGBA copy",
+            format!("{cached_fps:.0} frames/s"),
+        ),
+        (
+            "peak memory (VmHWM) before open",
+            format!("{rss_before:.0} MiB"),
+        ),
+        (
+            "peak memory (VmHWM) after all",
+            format!("{:.0} MiB", peak_rss_mib()),
+        ),
+    ];
+    println!("{:<40} value", "measure");
+    for (k, v) in rows {
+        println!("{k:<40} {v}");
+    }
+    if sink == 0 {
+        println!("(no frames)");
+    }
+    Ok(())
+}
+
+/// A 1080p test pattern at 30 fps, encoded fast (no added noise: the point is the length).
+fn make_long_clip(path: &std::path::Path, frames: usize) -> anyhow::Result<()> {
+    use anyhow::Context;
+    let status = std::process::Command::new("ffmpeg")
+        .args([
+            "-hide_banner",
+            "-loglevel",
+            "error",
+            "-y",
+            "-f",
+            "lavfi",
+            "-i",
+        ])
+        .arg("testsrc2=size=1920x1080:rate=30")
+        .arg("-frames:v")
+        .arg(frames.to_string())
+        .args([
+            "-c:v",
+            "libx264",
+            "-preset",
+            "ultrafast",
+            "-pix_fmt",
+            "yuv420p",
+            "-g",
+            "250",
+        ])
+        .arg(path)
+        .status()
+        .context("bench needs the ffmpeg command (apt-get install ffmpeg)")?;
+    if !status.success() {
+        anyhow::bail!("ffmpeg could not make {}", path.display());
+    }
+    Ok(())
+}
+
+/// The process's peak resident memory, MiB (Linux; 0 elsewhere).
+fn peak_rss_mib() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|kb| kb.parse::<f64>().ok())
+        })
+        .map_or(0.0, |kb| kb / 1024.0)
+}
