@@ -257,7 +257,7 @@ impl App {
 
     /// Opens a video, image folder or project file.
     pub fn open_path(&mut self, ctx: &egui::Context, path: &Path) {
-        if path.is_file() && is_project(path) {
+        if path.is_file() && path.extension().is_some_and(|e| e == "json") {
             match Project::load(path) {
                 Ok(p) => {
                     self.open_video(ctx, &p.video.clone());
@@ -432,7 +432,7 @@ impl App {
             from: from.filter(|_| p.tracks.is_some()),
             previous: p.tracks.as_deref().cloned(),
         };
-        let ctx = self.ctx_hint();
+        let ctx = self.ctx.clone();
         self.running = Some(Running {
             job: Job::track(p.video.clone(), job, ctx),
             keys: p.keys.clone(),
@@ -452,7 +452,7 @@ impl App {
             .settings
             .focal_px
             .unwrap_or_else(|| default_focal(info.width, info.height));
-        let ctx = self.ctx_hint();
+        let ctx = self.ctx.clone();
         self.running = Some(Running {
             job: Job::lift(tracks, focal, p.settings.height_m, p.overrides.clone(), ctx),
             keys: p.keys.clone(),
@@ -473,7 +473,11 @@ impl App {
             .project
             .as_ref()
             .and_then(|p| p.tracks.as_ref())
-            .and_then(|t| t.frames.iter().position(|f| f.index == self.current))
+            .and_then(|t| {
+                t.frames
+                    .binary_search_by_key(&self.current, |f| f.index)
+                    .ok()
+            })
         else {
             return;
         };
@@ -597,10 +601,6 @@ impl App {
         }
     }
 
-    fn ctx_hint(&self) -> egui::Context {
-        self.ctx.clone()
-    }
-
     // ----- per-frame work -----
 
     /// What to draw for a frame: keys win, then final tracks, then tracks arriving.
@@ -612,7 +612,12 @@ impl App {
         let tracked = p
             .tracks
             .as_ref()
-            .and_then(|t| t.frames.iter().find(|f| f.index == frame))
+            .and_then(|t| {
+                t.frames
+                    .binary_search_by_key(&frame, |f| f.index)
+                    .ok()
+                    .map(|k| &t.frames[k])
+            })
             .or_else(|| self.partial.get(&frame));
         let keys = p.keys.frames.get(&frame);
         PerJoint::from_fn(|j| {
@@ -1100,8 +1105,8 @@ impl App {
         };
         let joints = world
             .indices
-            .iter()
-            .position(|&i| i == self.current)
+            .binary_search(&self.current)
+            .ok()
             .map(|k| world.frames[k]);
         let camera = self
             .project
@@ -1209,13 +1214,6 @@ fn descendants(joint: Joint) -> Vec<Joint> {
     out
 }
 
-/// Whether a file is a project (its `format` tag).
-fn is_project(path: &Path) -> bool {
-    path.extension().is_some_and(|e| e == "json")
-        && std::fs::read_to_string(path)
-            .is_ok_and(|t| t.contains(videomocap::project::PROJECT_FORMAT))
-}
-
 /// A small front view of the body with `asking` highlighted.
 fn body_diagram(ui: &mut egui::Ui, asking: Joint) {
     let (rect, _) = ui.allocate_exact_size(egui::vec2(120.0, 170.0), egui::Sense::hover());
@@ -1300,13 +1298,9 @@ impl eframe::App for App {
                         self.playing = !self.playing;
                     }
                     ui.vertical(|ui| {
-                        let keys = self
-                            .project
-                            .as_ref()
-                            .map(|p| p.keys.clone())
-                            .unwrap_or_default();
-                        jump =
-                            timeline::show(ui, self.current, n, fps, self.strips.as_ref(), &keys);
+                        let no_keys = videomocap::track::KeyFrames::default();
+                        let keys = self.project.as_ref().map_or(&no_keys, |p| &p.keys);
+                        jump = timeline::show(ui, self.current, n, fps, self.strips.as_ref(), keys);
                     });
                 });
             });
