@@ -72,7 +72,7 @@ pub(crate) fn parse_json<T: for<'de> Deserialize<'de>>(
 }
 
 /// Checks the optional `format` and `version` fields of a file.
-fn check_header(
+pub(crate) fn check_header(
     path: &Path,
     expected: &'static str,
     format: Option<&str>,

@@ -1,2 +1,162 @@
-//! The second pipeline (Chu, Jenkins, Mataric): point volumes → Isomap → nonlinear spherical
-//! shells → skeleton curve → rigid bodies → joint angles. Not built yet: its issue brings it.
+//! The second pipeline (Chu, Jenkins, Mataric, "Converting Sequences of Human Volumes into
+//! Kinematic Motion"): point volumes → Isomap → nonlinear spherical shells → skeleton curve →
+//! rigid bodies → joint positions, labelled consistently over the sequence and handed to the
+//! shared export (local frames, joint angles, BVH).
+//!
+//! Data flows `cloud`/`carve` → `isomap` → `shells` → `curve` → `bodies` (one frame, [`process_frame`])
+//! → `sequence` (all frames, [`assemble`]).
+
+pub mod bodies;
+pub mod carve;
+pub mod cloud;
+pub mod curve;
+pub mod isomap;
+pub mod sequence;
+pub mod shells;
+pub mod voxel;
+
+pub use bodies::{BodyFit, BodyParams, Part};
+pub use cloud::{PointCloud, list_frames, read_cloud};
+pub use curve::{CurveParams, SkeletonCurve};
+pub use isomap::{IsomapParams, Neighbourhood};
+pub use sequence::{Assembled, assemble};
+pub use shells::ShellParams;
+pub use voxel::VoxelGrid;
+
+use crate::formats::FormatError;
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use nalgebra::Point3;
+use std::num::NonZero;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// A volume input could not be read or is not valid; every variant names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum VolumeError {
+    #[error("{path}: cannot read: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: {problem}")]
+    Invalid { path: PathBuf, problem: String },
+    #[error(transparent)]
+    Format(#[from] FormatError),
+}
+
+/// Why one frame gave no pose (the sequence goes on: the frame is interpolated or skipped).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FrameProblem {
+    #[error("{0} points; at least {1} are needed")]
+    TooFewPoints(usize, usize),
+    #[error(transparent)]
+    Isomap(#[from] isomap::IsomapProblem),
+    #[error(transparent)]
+    Curve(#[from] curve::CurveProblem),
+}
+
+/// Every setting of the pipeline, with the paper's values as defaults.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VolumeParams {
+    /// Neighbourhood radius as a multiple of the point spacing (the median nearest-neighbour
+    /// distance): 1.8 takes the 26 neighbours of a voxel, the paper's ε of about one voxel
+    /// diagonal.
+    pub radius_spacings: f64,
+    /// Landmarks for landmark Isomap.
+    pub landmarks: usize,
+    /// Shells and clustering.
+    pub shells: ShellParams,
+    /// Tree refinement.
+    pub curve: CurveParams,
+    /// Body fitting.
+    pub bodies: BodyParams,
+    /// Frames with fewer points are skipped.
+    pub min_points: usize,
+}
+
+impl Default for VolumeParams {
+    fn default() -> Self {
+        VolumeParams {
+            radius_spacings: 1.8,
+            landmarks: 12,
+            shells: ShellParams::default(),
+            curve: CurveParams::default(),
+            bodies: BodyParams::default(),
+            min_points: 100,
+        }
+    }
+}
+
+/// One frame's result: the points used, the skeleton curve, the bodies and the time taken.
+#[derive(Debug, Clone)]
+pub struct FrameResult {
+    /// Input positions of the points kept (the largest connected component).
+    pub points: Vec<Point3<f64>>,
+    /// The skeleton curve in input space (indices into `points`).
+    pub curve: SkeletonCurve,
+    /// The fitted bodies and joint positions.
+    pub fit: BodyFit,
+    /// Seconds spent in Isomap (graph, geodesics, MDS) and in everything else.
+    pub seconds: [f64; 2],
+}
+
+/// The median distance from a point to its nearest neighbour (the voxel size of voxel data).
+pub fn point_spacing(points: &[Point3<f64>]) -> f64 {
+    if points.len() < 2 {
+        return 0.0;
+    }
+    let coords: Vec<[f64; 3]> = points.iter().map(|p| [p.x, p.y, p.z]).collect();
+    let tree: ImmutableKdTree<f64, 3> = ImmutableKdTree::new_from_slice(&coords);
+    let step = (coords.len() / 500).max(1);
+    let two = NonZero::new(2).unwrap_or(NonZero::<usize>::MIN);
+    let mut d: Vec<f64> = coords
+        .iter()
+        .step_by(step)
+        .filter_map(|q| {
+            tree.nearest_n::<SquaredEuclidean>(q, two)
+                .get(1)
+                .map(|n| n.distance.sqrt())
+        })
+        .collect();
+    d.sort_by(f64::total_cmp);
+    d.get(d.len() / 2).copied().unwrap_or(0.0)
+}
+
+/// The volume-to-posture procedure on one frame.
+pub fn process_frame(
+    points: &[Point3<f64>],
+    params: &VolumeParams,
+) -> Result<FrameResult, FrameProblem> {
+    if points.len() < params.min_points {
+        return Err(FrameProblem::TooFewPoints(points.len(), params.min_points));
+    }
+    let start = Instant::now();
+    let spacing = point_spacing(points);
+    let iso = IsomapParams {
+        neighbourhood: Neighbourhood::Radius(spacing * params.radius_spacings),
+        landmarks: params.landmarks,
+    };
+    let embedding = isomap::embed(points, &iso)?;
+    let isomap_s = start.elapsed().as_secs_f64();
+    let kept: Vec<Point3<f64>> = embedding.kept.iter().map(|&i| points[i]).collect();
+    let full = {
+        let mut d: Vec<u32> = embedding.degree.clone();
+        d.sort_unstable();
+        d.get(d.len() * 95 / 100).copied().unwrap_or(0)
+    };
+    let surface: Vec<bool> = embedding
+        .degree
+        .iter()
+        .map(|&d| f64::from(d) < 0.8 * f64::from(full))
+        .collect();
+    let tree = shells::build(&embedding.coords, &params.shells);
+    let curve = curve::skeleton_curve(tree, &embedding.coords, &kept, &params.curve)?;
+    let fit = bodies::fit(&curve, &kept, &surface, &params.bodies);
+    let total = start.elapsed().as_secs_f64();
+    Ok(FrameResult {
+        points: kept,
+        curve,
+        fit,
+        seconds: [isomap_s, total - isomap_s],
+    })
+}

@@ -1,0 +1,299 @@
+//! The skeleton curve (paper §3): the shell tree refined by `Adjust_Tree_Nodes` (small branches
+//! merged or clipped down to five leaves, the root chain merged, the chest and pelvis chains
+//! merged into single branch nodes), its five limbs named (§4: the shortest is the head, the two
+//! nearest it the arms), and every node carried back to input space by a radial-basis weighted
+//! average of its points.
+
+use super::shells::ShellTree;
+use nalgebra::{Point3, Vector3};
+
+/// Refinement settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CurveParams {
+    /// A branch this many nodes deep or fewer is "small" (noise, fingers, toes).
+    pub small_branch_nodes: usize,
+}
+
+impl Default for CurveParams {
+    fn default() -> Self {
+        CurveParams {
+            small_branch_nodes: 3,
+        }
+    }
+}
+
+/// What the skeleton curve of one frame is made of.
+#[derive(Debug, Clone)]
+pub struct SkeletonCurve {
+    /// Curve points in input space, one per live node.
+    pub points: Vec<Point3<f64>>,
+    /// Parent of each curve point (`None` for the root).
+    pub parents: Vec<Option<usize>>,
+    /// Embedded-point indices held by each curve point.
+    pub members: Vec<Vec<usize>>,
+    /// The root (middle of the torso).
+    pub root: usize,
+    /// The five limbs: curve points from the first one after the branch node out to the leaf.
+    pub head: Vec<usize>,
+    /// The two arms (arm1, arm2 in the order found; labels are made consistent later).
+    pub arms: [Vec<usize>; 2],
+    /// The two legs.
+    pub legs: [Vec<usize>; 2],
+    /// Branch node the head and arms leave from (chest), and the legs' (pelvis); either may be
+    /// the root.
+    pub chest: usize,
+    /// See `chest`.
+    pub pelvis: usize,
+}
+
+/// Why a frame has no usable skeleton curve.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CurveProblem {
+    #[error("the skeleton curve has {0} leaves after refinement; a body has 5 (head, 2 arms, 2 legs)")]
+    WrongLeafCount(usize),
+}
+
+fn depth(t: &ShellTree, k: usize) -> usize {
+    1 + t.nodes[k]
+        .children
+        .iter()
+        .map(|&c| depth(t, c))
+        .max()
+        .unwrap_or(0)
+}
+
+fn leaves_below(t: &ShellTree, k: usize) -> usize {
+    if t.nodes[k].children.is_empty() {
+        1
+    } else {
+        t.nodes[k].children.iter().map(|&c| leaves_below(t, c)).sum()
+    }
+}
+
+fn subtree(t: &ShellTree, k: usize, out: &mut Vec<usize>) {
+    out.push(k);
+    for &c in &t.nodes[k].children {
+        subtree(t, c, out);
+    }
+}
+
+/// Moves `from`'s points into `into` and hands its children to `into`.
+fn merge_node(t: &mut ShellTree, from: usize, into: usize) {
+    let members = std::mem::take(&mut t.nodes[from].members);
+    t.nodes[into].members.extend(members);
+    let children = std::mem::take(&mut t.nodes[from].children);
+    for &c in &children {
+        t.nodes[c].parent = Some(into);
+    }
+    if let Some(p) = t.nodes[from].parent.take() {
+        t.nodes[p].children.retain(|&c| c != from);
+    }
+    t.nodes[into].children.extend(children);
+    t.nodes[into].alive = true;
+    t.nodes[from].alive = false;
+}
+
+/// Removes the subtree at `c`; its points go to its parent (they are still body points).
+fn clip_subtree(t: &mut ShellTree, c: usize) {
+    let Some(parent) = t.nodes[c].parent else {
+        return;
+    };
+    let mut all = Vec::new();
+    subtree(t, c, &mut all);
+    for k in all {
+        let members = std::mem::take(&mut t.nodes[k].members);
+        t.nodes[parent].members.extend(members);
+        t.nodes[k].alive = false;
+        t.nodes[k].children.clear();
+    }
+    t.nodes[parent].children.retain(|&x| x != c);
+    t.nodes[c].parent = None;
+}
+
+fn live_leaves(t: &ShellTree) -> usize {
+    leaves_below(t, t.root)
+}
+
+/// `Adjust_Tree_Nodes`: prunes the tree in place.
+pub fn adjust_tree_nodes(t: &mut ShellTree, params: &CurveParams) {
+    let small = params.small_branch_nodes;
+    // 1. Clip noise branches and merge the leaves of palms and feet. The paper does this at
+    //    every node with more than two children; we apply the same two operations, smallest
+    //    first, at any branching node while more than five leaves remain (a limb tip that splits
+    //    in two is as common in voxel data as a splayed hand).
+    while live_leaves(t) > 5 {
+        let mut order = Vec::new();
+        subtree(t, t.root, &mut order);
+        let mut merged = false;
+        for &n in order.iter().rev() {
+            let kids = t.nodes[n].children.clone();
+            if kids.len() >= 2 && kids.iter().all(|&c| depth(t, c) <= small) {
+                // Merge all children of n into one node (a leaf).
+                let first = kids[0];
+                for &c in &kids {
+                    let mut all = Vec::new();
+                    subtree(t, c, &mut all);
+                    for k in all.into_iter().rev() {
+                        if k != first {
+                            merge_node(t, k, first);
+                        }
+                    }
+                }
+                t.nodes[first].children.clear();
+                merged = true;
+                break;
+            }
+        }
+        if merged {
+            continue;
+        }
+        // Clip the smallest branch that has a sibling.
+        let candidate = order
+            .iter()
+            .filter(|&&n| t.nodes[n].children.len() >= 2)
+            .flat_map(|&n| t.nodes[n].children.clone())
+            .map(|c| (depth(t, c), t.nodes[c].members.len(), c))
+            .filter(|(d, _, _)| *d <= small)
+            .min();
+        match candidate {
+            Some((_, _, c)) => clip_subtree(t, c),
+            None => break,
+        }
+    }
+    // 2. Merge root clusters until the first branch.
+    while t.nodes[t.root].children.len() == 1 {
+        let c = t.nodes[t.root].children[0];
+        merge_node(t, c, t.root);
+    }
+    // 3. Merge the chest and pelvis: every descendant of the root that is an ancestor of two or
+    //    more leaves joins its topmost such ancestor (the branch node under the root).
+    for c in t.nodes[t.root].children.clone() {
+        if leaves_below(t, c) < 2 {
+            continue;
+        }
+        loop {
+            let mut all = Vec::new();
+            subtree(t, c, &mut all);
+            let Some(k) = all
+                .into_iter()
+                .find(|&k| k != c && leaves_below(t, k) >= 2)
+            else {
+                break;
+            };
+            merge_node(t, k, c);
+        }
+    }
+}
+
+/// Weighted average of the input positions of `members`, weights a Gaussian of the embedded
+/// distance to the members' embedded centroid (σ = half a shell): the radial-basis interpolation
+/// of curve points back to input space [Bishop 1995].
+fn interpolate(
+    members: &[usize],
+    coords: &[Vector3<f64>],
+    input: &[Point3<f64>],
+    sigma: f64,
+) -> Point3<f64> {
+    if members.is_empty() {
+        return Point3::origin();
+    }
+    let c = members.iter().map(|&i| coords[i]).sum::<Vector3<f64>>() / members.len() as f64;
+    let (mut acc, mut wsum) = (Vector3::zeros(), 0.0);
+    for &i in members {
+        let w = (-(coords[i] - c).norm_squared() / (2.0 * sigma * sigma)).exp();
+        acc += input[i].coords * w;
+        wsum += w;
+    }
+    if wsum > 1e-12 {
+        Point3::from(acc / wsum)
+    } else {
+        Point3::from(members.iter().map(|&i| input[i].coords).sum::<Vector3<f64>>() / members.len() as f64)
+    }
+}
+
+/// Refines the tree and names its limbs. `coords` are the embedded points, `input` their input
+/// positions (same indexing).
+pub fn skeleton_curve(
+    mut tree: ShellTree,
+    coords: &[Vector3<f64>],
+    input: &[Point3<f64>],
+    params: &CurveParams,
+) -> Result<SkeletonCurve, CurveProblem> {
+    adjust_tree_nodes(&mut tree, params);
+    let leaves = live_leaves(&tree);
+    if leaves != 5 {
+        return Err(CurveProblem::WrongLeafCount(leaves));
+    }
+    // Live nodes → curve points.
+    let mut order = Vec::new();
+    subtree(&tree, tree.root, &mut order);
+    let mut index = vec![usize::MAX; tree.nodes.len()];
+    for (i, &k) in order.iter().enumerate() {
+        index[k] = i;
+    }
+    let sigma = tree.shell_width * 0.5;
+    let points: Vec<Point3<f64>> = order
+        .iter()
+        .map(|&k| interpolate(&tree.nodes[k].members, coords, input, sigma))
+        .collect();
+    let parents: Vec<Option<usize>> = order
+        .iter()
+        .map(|&k| tree.nodes[k].parent.map(|p| index[p]))
+        .collect();
+    let members: Vec<Vec<usize>> = order.iter().map(|&k| tree.nodes[k].members.clone()).collect();
+    // Limbs: from each leaf up to (not including) the first node with two or more leaves below
+    // it (or the root).
+    let mut limbs: Vec<(Vec<usize>, usize)> = Vec::new(); // (chain outwards, attachment)
+    for &k in &order {
+        if !tree.nodes[k].children.is_empty() {
+            continue;
+        }
+        let mut chain = vec![index[k]];
+        let mut cur = k;
+        let attach = loop {
+            match tree.nodes[cur].parent {
+                Some(p) if p != tree.root && leaves_below(&tree, p) < 2 => {
+                    chain.push(index[p]);
+                    cur = p;
+                }
+                Some(p) => break index[p],
+                None => break index[cur],
+            }
+        };
+        chain.reverse();
+        limbs.push((chain, attach));
+    }
+    let length = |(chain, attach): &(Vec<usize>, usize)| {
+        let mut prev = points[*attach];
+        chain.iter().fold(0.0, |acc, &i| {
+            let d = (points[i] - prev).norm();
+            prev = points[i];
+            acc + d
+        })
+    };
+    let head_at = (0..limbs.len())
+        .min_by(|&a, &b| length(&limbs[a]).total_cmp(&length(&limbs[b])))
+        .unwrap_or(0);
+    let head = limbs.remove(head_at);
+    let head_start = points[head.0[0]];
+    limbs.sort_by(|a, b| {
+        let da = (points[a.0[0]] - head_start).norm();
+        let db = (points[b.0[0]] - head_start).norm();
+        da.total_cmp(&db)
+    });
+    // limbs: two arms then two legs (invariant: exactly four remain, checked by the leaf count).
+    let [arm1, arm2, leg1, leg2]: [(Vec<usize>, usize); 4] = limbs
+        .try_into()
+        .map_err(|l: Vec<_>| CurveProblem::WrongLeafCount(l.len() + 1))?;
+    Ok(SkeletonCurve {
+        root: index[tree.root],
+        chest: head.1,
+        pelvis: leg1.1,
+        head: head.0,
+        arms: [arm1.0, arm2.0],
+        legs: [leg1.0, leg2.0],
+        points,
+        parents,
+        members,
+    })
+}
