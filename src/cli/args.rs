@@ -167,17 +167,21 @@ pub struct RunArgs {
 /// `volume`.
 #[derive(Debug, Args)]
 pub struct VolumeArgs {
-    /// Directory of per-frame point clouds (PLY, XYZ) or voxel grids.
+    /// Directory of per-frame point clouds (PLY, XYZ) or voxel grids (.voxels.json), in
+    /// natural name order.
     pub input: PathBuf,
-    /// Output directory.
+    /// Output directory: skeleton3d.json, motion.bvh, joints3d.csv, motion.trc.
     #[arg(long)]
     pub out_dir: PathBuf,
+    /// Frames per second of the sequence.
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f64,
 }
 
 /// `synth`.
 #[derive(Debug, Args)]
 pub struct SynthArgs {
-    /// Motion: walk, wave, jumping-jacks, sit-down, bend, or a BVH file.
+    /// Motion: walk, wave, jumping-jacks, sit-down, bend, march, or a BVH file.
     #[arg(long, default_value = "walk")]
     pub motion: String,
     /// Start time in the BVH, seconds.
@@ -223,6 +227,19 @@ pub struct SynthArgs {
     /// assets/backgrounds/pose2sim_room.jpg; default a procedural room.
     #[arg(long)]
     pub background: Option<PathBuf>,
+    /// Write point volumes instead of video: the body voxelised per frame (frame_NNNN.ply) and
+    /// truth.skeleton3d.json, for `videomocap volume`.
+    #[arg(long)]
+    pub volume: bool,
+    /// Voxel size for --volume, millimetres.
+    #[arg(long, default_value_t = 40.0)]
+    pub voxel_mm: f64,
+    /// Spurious voxels per frame for --volume (scattered near the body).
+    #[arg(long, default_value_t = 0)]
+    pub noise_voxels: usize,
+    /// Share of body voxels removed at random for --volume (holes), 0–1.
+    #[arg(long, default_value_t = 0.0)]
+    pub holes: f64,
     /// Output directory.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -235,7 +252,8 @@ pub struct BenchArgs {
     /// the synthetic suite and the real sample, and tracking speed; takes a few minutes), lift
     /// (3D accuracy from true, noisy and tracked 2D, focal estimate, speed), or scrub (the
     /// desktop app's frame access on a long 1080p clip: open time, random seeks, scrubbing,
-    /// peak memory).
+    /// peak memory), or volume (the point-volume pipeline: topology, joint error, labels, time
+    /// per frame at 3k/10k/30k points).
     #[arg(default_value = "all")]
     pub what: String,
     /// Frames per measured clip (decode).

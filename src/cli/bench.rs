@@ -25,6 +25,9 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     if a.what == "lift" {
         return super::bench_lift::run(a, global);
     }
+    if a.what == "volume" {
+        return super::bench_volume::run(a, global);
+    }
     if a.what == "scrub" {
         return super::bench_scrub::run(a, global);
     }

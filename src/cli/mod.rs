@@ -6,13 +6,14 @@ mod bench;
 mod bench_lift;
 mod bench_scrub;
 mod bench_track;
+mod bench_volume;
 mod export;
 mod info;
 mod lift;
-mod pending;
 mod run;
 mod synth;
 mod track;
+mod volume;
 
 use args::{Command, GlobalArgs};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -59,7 +60,7 @@ pub fn run(command: Command, global: &GlobalArgs) -> Result<(), ExitError> {
         Command::Lift(a) => lift::run(&a, global),
         Command::Export(a) => export::run(&a, global),
         Command::Run(a) => run::run(&a, global),
-        Command::Volume(a) => pending::volume(&a),
+        Command::Volume(a) => volume::run(&a, global),
         Command::Gui { .. } => Err(ExitError::bad_input(anyhow::anyhow!(
             "the desktop app is opened by main, not by the CLI"
         ))),

@@ -5,6 +5,7 @@
 //! measures live in [`pose3d`].
 
 pub mod pose3d;
+pub mod volume;
 
 use crate::formats::Tracks2d;
 use crate::skeleton::{Joint, PerJoint};

@@ -6,12 +6,14 @@
 mod ground_truth;
 mod motion;
 mod render;
+mod volume;
 
 pub use ground_truth::{GroundTruth, GroundTruthFrame};
 pub use motion::{
     Motion, ProceduralMotion, from_bvh, normalise_orientation, procedural, stature_of,
 };
 pub use render::{Rendered, SensorEffects, background, render_frame};
+pub use volume::{VoxelParams, truth as volume_truth, voxelise, write_volume_sequence};
 
 use crate::bvh::BvhError;
 use crate::camera::PinholeCamera;

@@ -32,6 +32,9 @@ pub enum ProceduralMotion {
     SitDown,
     /// Bending forward from the hips to touch the shins and back, one cycle per 3 s.
     Bend,
+    /// Marching on the spot: knees up to the waist, arms swinging a little away from the body,
+    /// one step per half second (the paper's first motion).
+    March,
 }
 
 impl ProceduralMotion {
@@ -43,6 +46,7 @@ impl ProceduralMotion {
             "jumping-jacks" | "jumping_jacks" => Some(Self::JumpingJacks),
             "sit-down" | "sit_down" | "sit" => Some(Self::SitDown),
             "bend" => Some(Self::Bend),
+            "march" => Some(Self::March),
             _ => None,
         }
     }
@@ -55,6 +59,7 @@ impl ProceduralMotion {
             Self::JumpingJacks => "jumping-jacks",
             Self::SitDown => "sit-down",
             Self::Bend => "bend",
+            Self::March => "march",
         }
     }
 }
@@ -279,6 +284,36 @@ pub fn procedural(
                     }; 2];
                     let p = pose(subject, Point3::origin(), arms, legs);
                     on_ground(pitch_upper_body(p, pitch), ankle_height)
+                }
+                ProceduralMotion::March => {
+                    let lift = |phase: f64| (phase.sin().max(0.0)).powf(0.8);
+                    let (a, b) = (lift(w), lift(w + PI));
+                    let legs = [
+                        LimbAngles {
+                            abduction: 0.05,
+                            flexion: 1.3 * a,
+                            bend: 0.1 + 1.6 * a,
+                        },
+                        LimbAngles {
+                            abduction: 0.05,
+                            flexion: 1.3 * b,
+                            bend: 0.1 + 1.6 * b,
+                        },
+                    ];
+                    let arms = [
+                        LimbAngles {
+                            abduction: 0.35,
+                            flexion: 0.6 * (w + PI).sin(),
+                            bend: 0.5 + 0.4 * b,
+                        },
+                        LimbAngles {
+                            abduction: 0.35,
+                            flexion: 0.6 * w.sin(),
+                            bend: 0.5 + 0.4 * a,
+                        },
+                    ];
+                    let pelvis = Point3::new(0.0, stand - 0.01, 0.0);
+                    pose(subject, pelvis, arms, legs)
                 }
                 ProceduralMotion::JumpingJacks => {
                     let phase = 0.5 - 0.5 * w.cos(); // 0 closed … 1 open

@@ -249,6 +249,42 @@ impl Body {
         }
     }
 
+    /// Whether `p` lies inside the body (for voxelising it: `synth --volume`).
+    pub fn contains(&self, p: &Point3<f64>) -> bool {
+        let p = v(p);
+        (self.head.to_unit * (p - self.head.centre)).norm_squared() <= 1.0
+            || self.cones.iter().any(|c| {
+                let (centre, r) = c.bounding_sphere();
+                (p - centre).norm_squared() <= r * r && c.sdf(&p) <= 0.0
+            })
+    }
+
+    /// An axis-aligned box holding the whole body: (lowest corner, highest corner).
+    pub fn bounds(&self) -> (Point3<f64>, Point3<f64>) {
+        let (mut lo, mut hi) = (
+            Vector3::repeat(f64::INFINITY),
+            Vector3::repeat(f64::NEG_INFINITY),
+        );
+        let head_r = 1.0
+            / self
+                .head
+                .to_unit
+                .row(0)
+                .norm()
+                .min(self.head.to_unit.row(1).norm())
+                .min(self.head.to_unit.row(2).norm());
+        let spheres = self
+            .cones
+            .iter()
+            .map(|c| c.bounding_sphere())
+            .chain(std::iter::once((self.head.centre, head_r)));
+        for (c, r) in spheres {
+            lo = lo.inf(&(c - Vector3::repeat(r)));
+            hi = hi.sup(&(c + Vector3::repeat(r)));
+        }
+        (Point3::from(lo), Point3::from(hi))
+    }
+
     /// First hit along the ray `t·dir` (from the camera centre) within `t < t_max`.
     fn cast(&self, dir: &Vector3<f64>, bounds: &[(usize, f64, f64)]) -> Option<(f64, Hit)> {
         let mut best: Option<(f64, Hit)> = None;

@@ -4,6 +4,7 @@
 //! that contains them.
 
 use super::curve::SkeletonCurve;
+use crate::skeleton::{Joint, SubjectModel};
 use nalgebra::{Point3, Vector3};
 
 /// Body fitting settings.
@@ -129,8 +130,8 @@ pub fn fit(
     let head_points = pts_of(&curve.head);
     // Head sphere (Fig. 6): centre = the merged head curve points, radius = the farthest head
     // point.
-    let head_centre = centroid(head_points.iter().map(|&i| input[i]))
-        .unwrap_or(curve.points[curve.head[0]]);
+    let head_centre =
+        centroid(head_points.iter().map(|&i| input[i])).unwrap_or(curve.points[curve.head[0]]);
     let head_radius = head_points
         .iter()
         .map(|&i| (input[i] - head_centre).norm())
@@ -150,12 +151,22 @@ pub fn fit(
         .unwrap_or(Vector3::y());
         let c = curve.points[curve.chest];
         let m = &curve.members[curve.chest];
-        chest = centroid(m.iter().map(|&i| input[i]).filter(|p| (p - c).dot(&up) >= 0.0))
-            .unwrap_or(c + up * 0.1);
-        pelvis = centroid(m.iter().map(|&i| input[i]).filter(|p| (p - c).dot(&up) < 0.0))
-            .unwrap_or(c - up * 0.1);
+        chest = centroid(
+            m.iter()
+                .map(|&i| input[i])
+                .filter(|p| (p - c).dot(&up) >= 0.0),
+        )
+        .unwrap_or(c + up * 0.1);
+        pelvis = centroid(
+            m.iter()
+                .map(|&i| input[i])
+                .filter(|p| (p - c).dot(&up) < 0.0),
+        )
+        .unwrap_or(c - up * 0.1);
     }
-    let u = (chest - pelvis).try_normalize(1e-12).unwrap_or(Vector3::y());
+    let u = (chest - pelvis)
+        .try_normalize(1e-12)
+        .unwrap_or(Vector3::y());
     let mut torso_nodes = vec![curve.root, curve.chest, curve.pelvis];
     torso_nodes.dedup();
     let torso_points = pts_of(&torso_nodes);
@@ -196,6 +207,20 @@ pub fn fit(
         let t = along(p);
         t >= bottom && t <= top && axis_distance(p, &pelvis, &u) <= radius
     };
+    // Shoulder level below the neck and half the shoulder and hip widths, from the
+    // proportions scaled to this trunk.
+    let m = SubjectModel::default();
+    let scale = top / (m.length_to(Joint::Chest) + m.length_to(Joint::Neck));
+    let half_widths = (
+        m.shoulder_width_m / 2.0 * scale,
+        m.length_to(Joint::LeftHip) * scale,
+    );
+    let shoulder_drop = {
+        let across = m.shoulder_width_m / 2.0;
+        let up = m.length_to(Joint::LeftShoulder);
+        let rise = (up * up - across * across).max(0.0).sqrt();
+        (m.length_to(Joint::Neck) - rise).max(0.0) * scale
+    };
     let in_head = |p: &Point3<f64>| (p - head_centre).norm() <= head_radius;
     let neck = torso.b;
     let head_axis = (head_centre - neck).try_normalize(1e-12).unwrap_or(u);
@@ -220,21 +245,84 @@ pub fn fit(
         let (chain, attach) = limb_chains[k];
         let mut path = vec![curve.points[attach]];
         path.extend(chain.iter().map(|&n| curve.points[n]));
-        let first_out = path
+        // The limb root is where the curve leaves the torso cylinder: between the last curve
+        // point inside it and the next one, found by bisection.
+        let last_in = path
             .iter()
             .rposition(|p| in_torso(p))
             .map_or(0, |i| i.min(path.len() - 2));
-        let root = path[first_out];
+        let (mut lo, mut hi) = (path[last_in], path[last_in + 1]);
+        if in_torso(&lo) {
+            for _ in 0..20 {
+                let mid = nalgebra::center(&lo, &hi);
+                if in_torso(&mid) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+        }
+        // Beyond the paper: the shoulder and hip joints lie inside the trunk, not where the
+        // curve leaves it. The joint is on the upper segment's axis (exit point → elbow or
+        // knee), where it crosses the shoulder level (the subject's proportions below the neck)
+        // or the pelvis level; when the segment lies nearly across the trunk (an arm held out
+        // in front, a thigh raised), the axis point nearest the trunk axis at that level.
+        let exit = lo;
         let leaf = path[path.len() - 1];
-        let between = &path[first_out + 1..path.len() - 1];
-        let reach = (leaf - root).norm();
-        let farthest = between
-            .iter()
-            .map(|p| (segment_distance(p, &root, &leaf), *p))
-            .max_by(|a, b| a.0.total_cmp(&b.0));
-        let split = farthest
+        let between = &path[last_in + 1..path.len() - 1];
+        // Split candidates lie in the middle 60 % of the root–leaf segment: the curve bends
+        // where it leaves the trunk too, and an elbow or knee is never there.
+        let farthest_from = |root: &Point3<f64>| {
+            let axis = leaf - root;
+            between
+                .iter()
+                .filter(|p| {
+                    let t = (*p - root).dot(&axis) / axis.norm_squared().max(1e-18);
+                    (0.2..=0.8).contains(&t)
+                })
+                .map(|p| (segment_distance(p, root, &leaf), *p))
+                .max_by(|a, b| a.0.total_cmp(&b.0))
+        };
+        let level = if k < 2 { top - shoulder_drop } else { 0.0 };
+        let centre = pelvis + u * level;
+        let reach = (leaf - exit).norm();
+        let split = farthest_from(&exit)
             .filter(|(d, _)| *d >= params.straight_fraction * reach)
             .map(|(_, p)| p);
+        // The upper segment's axis: through the elbow or knee (the leaf of a straight limb) and
+        // the first curve point outside the trunk (the exit point cuts the corner).
+        let toward = split.unwrap_or(leaf);
+        let from = between
+            .first()
+            .filter(|p| (toward - **p).norm() > 0.25 * (toward - exit).norm())
+            .copied()
+            .unwrap_or(exit);
+        let root = match (toward - from).try_normalize(1e-9) {
+            Some(d) if d.dot(&u).abs() >= 0.5 => {
+                toward + d * ((level - along(&toward)) / d.dot(&u))
+            }
+            Some(d) => {
+                // Nearest the trunk axis, but no nearer than half the shoulder (hip) width: a
+                // horizontal arm's axis passes through the trunk's middle.
+                let mut p = toward + d * (centre - toward).dot(&d);
+                let half = if k < 2 { half_widths.0 } else { half_widths.1 };
+                let off = |q: &Point3<f64>| axis_distance(q, &pelvis, &u);
+                if off(&p) < half {
+                    let (mut a, mut b) = (0.0, (toward - p).norm());
+                    for _ in 0..30 {
+                        let m = 0.5 * (a + b);
+                        if off(&(p + d * m)) < half {
+                            a = m;
+                        } else {
+                            b = m;
+                        }
+                    }
+                    p += d * b;
+                }
+                p
+            }
+            None => exit + u * (level - along(&exit)),
+        };
         let limb_points = pts_of(chain);
         // Separating plane at the split, bisecting the angle between the two axes.
         let knee = split.unwrap_or_else(|| nalgebra::center(&root, &leaf));

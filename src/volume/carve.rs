@@ -221,6 +221,9 @@ mod tests {
         }
         let ball = (4.0 / 3.0 * std::f64::consts::PI * radius.powi(3) / v.powi(3)) as usize;
         assert_eq!(missed, 0);
-        assert!(extra < ball / 2, "{extra} extra voxels for a ball of {ball}");
+        assert!(
+            extra < ball / 2,
+            "{extra} extra voxels for a ball of {ball}"
+        );
     }
 }

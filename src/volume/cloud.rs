@@ -73,7 +73,10 @@ pub fn read_cloud(path: &Path) -> Result<PointCloud, VolumeError> {
         CloudKind::Xyz => read_xyz(path)?,
         CloudKind::Voxels => VoxelGrid::load(path)?.centres(),
     };
-    if let Some(i) = points.iter().position(|p| !p.coords.iter().all(|c| c.is_finite())) {
+    if let Some(i) = points
+        .iter()
+        .position(|p| !p.coords.iter().all(|c| c.is_finite()))
+    {
         return Err(VolumeError::Invalid {
             path: path.to_owned(),
             problem: format!("point {i} has a coordinate that is not a finite number"),
@@ -155,7 +158,10 @@ fn read_xyz(path: &Path) -> Result<PointCloud, VolumeError> {
             Some(Ok(v)) => Ok(v),
             _ => Err(VolumeError::Invalid {
                 path: path.to_owned(),
-                problem: format!("line {}: expected three numbers x y z, got \"{line}\"", n + 1),
+                problem: format!(
+                    "line {}: expected three numbers x y z, got \"{line}\"",
+                    n + 1
+                ),
             }),
         };
         points.push(Point3::new(next()?, next()?, next()?));
@@ -230,8 +236,17 @@ mod tests {
         let e = read_cloud(&xyz).unwrap_err().to_string();
         assert!(e.contains("not a finite number"), "{e}");
         let ply = dir.path().join("bad.ply");
-        std::fs::write(&ply, "ply\nformat ascii 1.0\nelement vertex 3\nend_header\n").unwrap();
-        assert!(read_cloud(&ply).unwrap_err().to_string().contains("bad.ply"));
+        std::fs::write(
+            &ply,
+            "ply\nformat ascii 1.0\nelement vertex 3\nend_header\n",
+        )
+        .unwrap();
+        assert!(
+            read_cloud(&ply)
+                .unwrap_err()
+                .to_string()
+                .contains("bad.ply")
+        );
         let empty = tempfile::tempdir().unwrap();
         let e = list_frames(empty.path()).unwrap_err().to_string();
         assert!(e.contains("no point clouds"), "{e}");

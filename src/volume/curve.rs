@@ -49,7 +49,9 @@ pub struct SkeletonCurve {
 /// Why a frame has no usable skeleton curve.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CurveProblem {
-    #[error("the skeleton curve has {0} leaves after refinement; a body has 5 (head, 2 arms, 2 legs)")]
+    #[error(
+        "the skeleton curve has {0} leaves after refinement; a body has 5 (head, 2 arms, 2 legs)"
+    )]
     WrongLeafCount(usize),
 }
 
@@ -66,7 +68,11 @@ fn leaves_below(t: &ShellTree, k: usize) -> usize {
     if t.nodes[k].children.is_empty() {
         1
     } else {
-        t.nodes[k].children.iter().map(|&c| leaves_below(t, c)).sum()
+        t.nodes[k]
+            .children
+            .iter()
+            .map(|&c| leaves_below(t, c))
+            .sum()
     }
 }
 
@@ -117,17 +123,21 @@ fn live_leaves(t: &ShellTree) -> usize {
 /// `Adjust_Tree_Nodes`: prunes the tree in place.
 pub fn adjust_tree_nodes(t: &mut ShellTree, params: &CurveParams) {
     let small = params.small_branch_nodes;
-    // 1. Clip noise branches and merge the leaves of palms and feet. The paper does this at
-    //    every node with more than two children; we apply the same two operations, smallest
-    //    first, at any branching node while more than five leaves remain (a limb tip that splits
-    //    in two is as common in voxel data as a splayed hand).
-    while live_leaves(t) > 5 {
+    // 1. Clip noise branches and merge the leaves of palms and feet: wherever a node branches,
+    //    children whose subtrees are small are merged into one leaf when all of them are small,
+    //    and clipped otherwise (smallest first). The paper applies this at nodes with more than
+    //    two children; a limb tip that splits in two, or a one-shell bump on the trunk, is as
+    //    common in voxel data, so we apply it at every branching node: always to one-node
+    //    stubs, and to branches up to `small_branch_nodes` deep while more than five leaves
+    //    remain (a head near the embedding's centre can be only three shells long).
+    loop {
         let mut order = Vec::new();
         subtree(t, t.root, &mut order);
         let mut merged = false;
         for &n in order.iter().rev() {
             let kids = t.nodes[n].children.clone();
-            if kids.len() >= 2 && kids.iter().all(|&c| depth(t, c) <= small) {
+            let limit = if live_leaves(t) > 5 { small } else { 1 };
+            if kids.len() >= 2 && kids.iter().all(|&c| depth(t, c) <= limit) {
                 // Merge all children of n into one node (a leaf).
                 let first = kids[0];
                 for &c in &kids {
@@ -148,12 +158,13 @@ pub fn adjust_tree_nodes(t: &mut ShellTree, params: &CurveParams) {
             continue;
         }
         // Clip the smallest branch that has a sibling.
+        let limit = if live_leaves(t) > 5 { small } else { 1 };
         let candidate = order
             .iter()
             .filter(|&&n| t.nodes[n].children.len() >= 2)
             .flat_map(|&n| t.nodes[n].children.clone())
             .map(|c| (depth(t, c), t.nodes[c].members.len(), c))
-            .filter(|(d, _, _)| *d <= small)
+            .filter(|(d, _, _)| *d <= limit)
             .min();
         match candidate {
             Some((_, _, c)) => clip_subtree(t, c),
@@ -174,10 +185,7 @@ pub fn adjust_tree_nodes(t: &mut ShellTree, params: &CurveParams) {
         loop {
             let mut all = Vec::new();
             subtree(t, c, &mut all);
-            let Some(k) = all
-                .into_iter()
-                .find(|&k| k != c && leaves_below(t, k) >= 2)
-            else {
+            let Some(k) = all.into_iter().find(|&k| k != c && leaves_below(t, k) >= 2) else {
                 break;
             };
             merge_node(t, k, c);
@@ -207,7 +215,13 @@ fn interpolate(
     if wsum > 1e-12 {
         Point3::from(acc / wsum)
     } else {
-        Point3::from(members.iter().map(|&i| input[i].coords).sum::<Vector3<f64>>() / members.len() as f64)
+        Point3::from(
+            members
+                .iter()
+                .map(|&i| input[i].coords)
+                .sum::<Vector3<f64>>()
+                / members.len() as f64,
+        )
     }
 }
 
@@ -240,7 +254,10 @@ pub fn skeleton_curve(
         .iter()
         .map(|&k| tree.nodes[k].parent.map(|p| index[p]))
         .collect();
-    let members: Vec<Vec<usize>> = order.iter().map(|&k| tree.nodes[k].members.clone()).collect();
+    let members: Vec<Vec<usize>> = order
+        .iter()
+        .map(|&k| tree.nodes[k].members.clone())
+        .collect();
     // Limbs: from each leaf up to (not including) the first node with two or more leaves below
     // it (or the root).
     let mut limbs: Vec<(Vec<usize>, usize)> = Vec::new(); // (chain outwards, attachment)
@@ -271,14 +288,35 @@ pub fn skeleton_curve(
             acc + d
         })
     };
-    let head_at = (0..limbs.len())
-        .min_by(|&a, &b| length(&limbs[a]).total_cmp(&length(&limbs[b])))
-        .unwrap_or(0);
+    // §4: the shortest branch is the head and the two nearest it the arms. Beyond the paper:
+    // when three limbs leave one branch node (the chest), the head is the shortest of those
+    // three, which stays right when a raised arm is shorter than the legs but a leg is not.
+    let mut groups: Vec<(usize, Vec<usize>)> = Vec::new();
+    for (i, (_, attach)) in limbs.iter().enumerate() {
+        match groups.iter_mut().find(|(a, _)| a == attach) {
+            Some((_, g)) => g.push(i),
+            None => groups.push((*attach, vec![i])),
+        }
+    }
+    let shortest = |among: &[usize]| {
+        among
+            .iter()
+            .copied()
+            .min_by(|&a, &b| length(&limbs[a]).total_cmp(&length(&limbs[b])))
+            .unwrap_or(0)
+    };
+    let all: Vec<usize> = (0..limbs.len()).collect();
+    let head_at = match groups.iter().find(|(_, g)| g.len() == 3) {
+        Some((_, g)) => shortest(g),
+        None => shortest(&all),
+    };
     let head = limbs.remove(head_at);
     let head_start = points[head.0[0]];
+    let head_attach = head.1;
     limbs.sort_by(|a, b| {
-        let da = (points[a.0[0]] - head_start).norm();
-        let db = (points[b.0[0]] - head_start).norm();
+        // Limbs leaving the head's branch node first, then by distance from the head.
+        let da = (points[a.0[0]] - head_start).norm() + if a.1 == head_attach { 0.0 } else { 1e3 };
+        let db = (points[b.0[0]] - head_start).norm() + if b.1 == head_attach { 0.0 } else { 1e3 };
         da.total_cmp(&db)
     });
     // limbs: two arms then two legs (invariant: exactly four remain, checked by the leaf count).

@@ -145,7 +145,12 @@ fn largest_component(g: &Graph, n: usize) -> Vec<usize> {
 
 /// Geodesic distances from `source` to every node (Dijkstra with a binary heap; f32 keys are
 /// compared by their bits, which orders non-negative floats correctly).
-fn dijkstra(g: &Graph, source: usize, dist: &mut [f32], heap: &mut BinaryHeap<Reverse<(u32, u32)>>) {
+fn dijkstra(
+    g: &Graph,
+    source: usize,
+    dist: &mut [f32],
+    heap: &mut BinaryHeap<Reverse<(u32, u32)>>,
+) {
     dist.fill(f32::INFINITY);
     heap.clear();
     dist[source] = 0.0;
@@ -307,7 +312,10 @@ mod tests {
         let straight = (pts[0] - pts[pts.len() - 1]).norm();
         let embedded = (first - last).norm();
         assert!(straight < 0.25, "{straight}");
-        assert!((embedded - 1.2).abs() < 0.1, "embedded end-to-end {embedded}");
+        assert!(
+            (embedded - 1.2).abs() < 0.1,
+            "embedded end-to-end {embedded}"
+        );
         let mean = e.coords.iter().sum::<Vector3<f64>>() / e.coords.len() as f64;
         assert!(mean.norm() < 1e-9);
     }

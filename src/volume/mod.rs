@@ -26,8 +26,10 @@ pub use voxel::VoxelGrid;
 use crate::formats::FormatError;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use nalgebra::Point3;
+use rayon::prelude::*;
 use std::num::NonZero;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
 
 /// A volume input could not be read or is not valid; every variant names the file.
@@ -53,6 +55,8 @@ pub enum FrameProblem {
     Isomap(#[from] isomap::IsomapProblem),
     #[error(transparent)]
     Curve(#[from] curve::CurveProblem),
+    #[error("{0}")]
+    Unreadable(String),
 }
 
 /// Every setting of the pipeline, with the paper's values as defaults.
@@ -158,5 +162,87 @@ pub fn process_frame(
         curve,
         fit,
         seconds: [isomap_s, total - isomap_s],
+    })
+}
+
+/// A processed sequence: every frame's result (or why it has none) and the assembled motion.
+#[derive(Debug, Clone)]
+pub struct Processed {
+    /// The frame files, in order.
+    pub files: Vec<PathBuf>,
+    /// Per frame: its result, or the problem that left it without a pose.
+    pub results: Vec<Result<FrameResult, FrameProblem>>,
+    /// Labels, sides and the 16-joint skeleton.
+    pub assembled: Assembled,
+}
+
+/// Why a whole sequence gave nothing.
+#[derive(Debug, thiserror::Error)]
+pub enum SequenceError {
+    #[error(transparent)]
+    Input(#[from] VolumeError),
+    #[error("{dir}: none of the {frames} frames gave a pose (first problem: {first})")]
+    NoPose {
+        dir: PathBuf,
+        frames: usize,
+        first: String,
+    },
+    #[error("cancelled")]
+    Cancelled,
+}
+
+/// Runs the pipeline on every point cloud of `dir` (frames in parallel with rayon), calling
+/// `progress(done, total)` as frames finish; a frame that cannot be read or gives no pose is a
+/// warning, not an error, unless no frame gives a pose.
+pub fn process_directory(
+    dir: &Path,
+    params: &VolumeParams,
+    fps: f64,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    cancel: &AtomicBool,
+) -> Result<Processed, SequenceError> {
+    let files = list_frames(dir)?;
+    let done = AtomicUsize::new(0);
+    let results: Vec<Result<FrameResult, FrameProblem>> = files
+        .par_iter()
+        .map(|f| {
+            if cancel.load(Ordering::Relaxed) {
+                return Err(FrameProblem::Unreadable("cancelled".into()));
+            }
+            let r = read_cloud(f)
+                .map_err(|e| FrameProblem::Unreadable(e.to_string()))
+                .and_then(|points| process_frame(&points, params));
+            progress(done.fetch_add(1, Ordering::Relaxed) + 1, files.len());
+            r
+        })
+        .collect();
+    if cancel.load(Ordering::Relaxed) {
+        return Err(SequenceError::Cancelled);
+    }
+    if !results.iter().any(Result::is_ok) {
+        let first = results
+            .iter()
+            .find_map(|r| r.as_ref().err().map(ToString::to_string))
+            .unwrap_or_default();
+        return Err(SequenceError::NoPose {
+            dir: dir.to_owned(),
+            frames: files.len(),
+            first,
+        });
+    }
+    let names: Vec<String> = files
+        .iter()
+        .map(|f| {
+            f.file_name()
+                .unwrap_or_default()
+                .to_string_lossy()
+                .into_owned()
+        })
+        .collect();
+    let assembled = assemble(&results, &names, fps);
+    Ok(Processed {
+        files,
+        results,
+        assembled,
     })
 }

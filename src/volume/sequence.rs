@@ -140,11 +140,21 @@ pub fn assemble(
             default_fraction(k)
         }
     });
+    // The chest joint (sternum) sits on the trunk axis at the subject's proportion of the way
+    // from the neck to the pelvis; the chest branch node itself lies at the shoulders.
+    let chest_fraction = {
+        let neck_chest = model.length_to(Joint::Neck);
+        let chest_pelvis = model.length_to(Joint::Chest);
+        neck_chest / (neck_chest + chest_pelvis)
+    };
     let articulated = counts.map(|c| c as f64 / posed.max(1) as f64);
 
-    // 3. Sides, voted frame by frame: left = up × front.
+    // 3. Sides, voted frame by frame: left = up × front, where front is the way knees bend
+    //    (or, if no knee ever bends, the opposite of the way elbows bend). The arms then take
+    //    the side of the leg below them.
     let mut votes = [0i64; 2]; // arms, legs: > 0 means label 0 is the left one
     let mut sides_from = SidesFrom::Arbitrary;
+    let sign = |x: f64| if x > 0.0 { 1 } else { -1 };
     for pass in [SidesFrom::Knees, SidesFrom::Elbows] {
         for i in 0..results.len() {
             let (Some(l), Ok(f)) = (labelled(i), &results[i]) else {
@@ -153,7 +163,10 @@ pub fn assemble(
             let up = f.fit.torso.b - f.fit.torso.a;
             let fronts: Vec<Vector3<f64>> = match pass {
                 SidesFrom::Knees => [2, 3].iter().filter_map(|&k| bend(&l[k])).collect(),
-                _ => [0, 1].iter().filter_map(|&k| bend(&l[k]).map(|b| -b)).collect(),
+                _ => [0, 1]
+                    .iter()
+                    .filter_map(|&k| bend(&l[k]).map(|b| -b))
+                    .collect(),
             };
             let Some(front) = fronts
                 .iter()
@@ -164,8 +177,6 @@ pub fn assemble(
                 continue;
             };
             let left = up.cross(&front);
-            let sign = |x: f64| if x > 0.0 { 1 } else { -1 };
-            votes[0] += sign((l[0].root - l[1].root).dot(&left));
             votes[1] += sign((l[2].root - l[3].root).dot(&left));
             sides_from = pass;
         }
@@ -173,8 +184,14 @@ pub fn assemble(
             break;
         }
     }
-    let swap_arms = votes[0] < 0;
+    for i in 0..results.len() {
+        if let Some(l) = labelled(i) {
+            votes[0] += sign((l[0].root - l[1].root).dot(&(l[2].root - l[3].root)));
+        }
+    }
     let swap_legs = votes[1] < 0;
+    // Arm 0 is on leg 0's side when votes[0] > 0; it is the left arm when that leg is left.
+    let swap_arms = (votes[0] < 0) != swap_legs;
 
     // 4. The 16 joints.
     let pose = |i: usize| -> Option<PerJoint<Point3<f64>>> {
@@ -199,7 +216,7 @@ pub fn assemble(
         Some(PerJoint::from_fn(|j| match j {
             HeadTop => f.fit.head_top,
             Neck => f.fit.torso.b,
-            Chest => f.fit.chest,
+            Chest => f.fit.torso.b + (f.fit.pelvis - f.fit.torso.b) * chest_fraction,
             Pelvis => f.fit.pelvis,
             LeftShoulder => limbs[0].root,
             LeftElbow => mid(0),
@@ -243,17 +260,34 @@ pub fn assemble(
             });
         }
     }
-    let bone_lengths_m: BTreeMap<String, f64> = Bone::ALL
+    // Static lengths (§4's second pass): each bone's median length over the frames; every
+    // frame is rebuilt outwards from the pelvis keeping its bone directions, so that the
+    // skeleton is rigid (and its BVH reproduces it exactly).
+    let lengths: Vec<f64> = Bone::ALL
         .iter()
-        .filter_map(|b| {
+        .map(|b| {
             let mut v: Vec<f64> = frames
                 .iter()
                 .map(|f| (f.points[b.child] - f.points[b.parent]).norm())
                 .filter(|d| *d > 1e-9)
                 .collect();
             v.sort_by(f64::total_cmp);
-            v.get(v.len() / 2).map(|m| (b.key(), *m))
+            v.get(v.len() / 2).copied().unwrap_or(0.01)
         })
+        .collect();
+    for f in &mut frames {
+        let old = f.points.clone();
+        for (b, len) in Bone::ALL.iter().zip(&lengths) {
+            let dir = (old[b.child] - old[b.parent])
+                .try_normalize(1e-12)
+                .unwrap_or(Vector3::y());
+            f.points[b.child] = f.points[b.parent] + dir * *len;
+        }
+    }
+    let bone_lengths_m: BTreeMap<String, f64> = Bone::ALL
+        .iter()
+        .zip(&lengths)
+        .map(|(b, l)| (b.key(), l.max(1e-6)))
         .collect();
     let slots = order
         .iter()

@@ -83,50 +83,78 @@ pub fn build(coords: &[Vector3<f64>], params: &ShellParams) -> ShellTree {
         .iter()
         .map(|r| ((r / r_max * shells as f64) as usize).min(shells - 1))
         .collect();
-    let (mut lo, mut hi) = (Vector3::repeat(f64::INFINITY), Vector3::repeat(f64::NEG_INFINITY));
+    let (mut lo, mut hi) = (
+        Vector3::repeat(f64::INFINITY),
+        Vector3::repeat(f64::NEG_INFINITY),
+    );
     for c in coords {
         lo = lo.inf(c);
         hi = hi.sup(c);
     }
     let threshold = ((hi - lo).norm() * params.cluster_fraction).max(1e-12);
 
-    // Bounding-box clustering: points whose boxes of side `threshold` overlap (Chebyshev
-    // distance ≤ threshold) and that lie in the same shell join one cluster. A hash grid of
-    // cell `threshold` finds the candidates in the 27 surrounding cells.
+    // Bounding-box clustering (Cohen et al.'s boxes): the points of one shell inside one grid
+    // cell of side `threshold` are all within the threshold of each other and form a group with
+    // its bounding box; groups of the same shell in neighbouring cells join one cluster when
+    // their boxes are no farther apart than the threshold (Chebyshev gap). Groups of
+    // neighbouring shells that close link their clusters. Working on boxes instead of point
+    // pairs keeps this linear in the number of points.
     let cell = |c: &Vector3<f64>| {
-        (
+        [
             (c.x / threshold).floor() as i64,
             (c.y / threshold).floor() as i64,
             (c.z / threshold).floor() as i64,
-        )
+        ]
     };
-    let mut grid: HashMap<(i64, i64, i64), Vec<u32>> = HashMap::new();
-    for (i, c) in coords.iter().enumerate() {
-        grid.entry(cell(c)).or_default().push(i as u32);
+    struct Group {
+        key: [i64; 3],
+        shell: usize,
+        lo: Vector3<f64>,
+        hi: Vector3<f64>,
+        members: Vec<usize>,
     }
-    let near = |a: usize, b: usize| {
-        let d = coords[a] - coords[b];
-        d.x.abs() <= threshold && d.y.abs() <= threshold && d.z.abs() <= threshold
-    };
-    let mut sets = Sets((0..n as u32).collect());
-    let mut cross: Vec<(u32, u32)> = Vec::new();
+    let mut group_of: HashMap<([i64; 3], usize), usize> = HashMap::new();
+    let mut groups: Vec<Group> = Vec::new();
     for (i, c) in coords.iter().enumerate() {
-        let (cx, cy, cz) = cell(c);
+        let key = cell(c);
+        let g = *group_of.entry((key, shell_of[i])).or_insert_with(|| {
+            groups.push(Group {
+                key,
+                shell: shell_of[i],
+                lo: *c,
+                hi: *c,
+                members: Vec::new(),
+            });
+            groups.len() - 1
+        });
+        let gr = &mut groups[g];
+        gr.lo = gr.lo.inf(c);
+        gr.hi = gr.hi.sup(c);
+        gr.members.push(i);
+    }
+    let gap = |a: &Group, b: &Group| {
+        (0..3)
+            .map(|k| (b.lo[k] - a.hi[k]).max(a.lo[k] - b.hi[k]).max(0.0))
+            .fold(0.0, f64::max)
+    };
+    let mut sets = Sets((0..groups.len() as u32).collect());
+    let mut cross: Vec<(usize, usize)> = Vec::new();
+    for (a, ga) in groups.iter().enumerate() {
         for dz in -1..=1 {
             for dy in -1..=1 {
                 for dx in -1..=1 {
-                    let Some(list) = grid.get(&(cx + dx, cy + dy, cz + dz)) else {
-                        continue;
-                    };
-                    for &j in list {
-                        let j = j as usize;
-                        if j <= i || !near(i, j) {
+                    let key = [ga.key[0] + dx, ga.key[1] + dy, ga.key[2] + dz];
+                    for shell in ga.shell.saturating_sub(1)..=ga.shell + 1 {
+                        let Some(&b) = group_of.get(&(key, shell)) else {
+                            continue;
+                        };
+                        if b <= a || gap(ga, &groups[b]) > threshold {
                             continue;
                         }
-                        if shell_of[i] == shell_of[j] {
-                            sets.union(i, j);
-                        } else if shell_of[i].abs_diff(shell_of[j]) == 1 {
-                            cross.push((i as u32, j as u32));
+                        if shell == ga.shell {
+                            sets.union(a, b);
+                        } else {
+                            cross.push((a, b));
                         }
                     }
                 }
@@ -137,27 +165,27 @@ pub fn build(coords: &[Vector3<f64>], params: &ShellParams) -> ShellTree {
     // Clusters → nodes.
     let mut node_of_root: HashMap<usize, usize> = HashMap::new();
     let mut nodes: Vec<Node> = Vec::new();
-    let mut node_of = vec![0usize; n];
-    for i in 0..n {
-        let r = sets.find(i);
+    let mut node_of_group = vec![0usize; groups.len()];
+    for (g, group) in groups.iter().enumerate() {
+        let r = sets.find(g);
         let id = *node_of_root.entry(r).or_insert_with(|| {
             nodes.push(Node {
                 members: Vec::new(),
-                shell: shell_of[i],
+                shell: group.shell,
                 parent: None,
                 children: Vec::new(),
                 alive: false,
             });
             nodes.len() - 1
         });
-        nodes[id].members.push(i);
-        node_of[i] = id;
+        nodes[id].members.extend_from_slice(&group.members);
+        node_of_group[g] = id;
     }
     // Links between overlapping clusters of neighbouring shells (Fig. 4).
     let mut links: Vec<Vec<usize>> = vec![Vec::new(); nodes.len()];
     for (a, b) in cross {
-        let (na, nb) = (node_of[a as usize], node_of[b as usize]);
-        if !links[na].contains(&nb) {
+        let (na, nb) = (node_of_group[a], node_of_group[b]);
+        if na != nb && !links[na].contains(&nb) {
             links[na].push(nb);
             links[nb].push(na);
         }

@@ -225,6 +225,11 @@ mod tests {
             r#"{"origin_m":[0,0,0],"voxel_m":0.05,"dims":[100000,100000,100000],"occupied":[]}"#,
         )
         .unwrap();
-        assert!(VoxelGrid::load(&p).unwrap_err().to_string().contains("dims"));
+        assert!(
+            VoxelGrid::load(&p)
+                .unwrap_err()
+                .to_string()
+                .contains("dims")
+        );
     }
 }

@@ -1,0 +1,211 @@
+//! `videomocap bench volume`: the second pipeline on synthetic volume sequences (the paper's
+//! marching, waving and jumping jacks, plus real motion capture) at several voxel sizes —
+//! topology, joint error against the truth, label consistency — and the time per frame at
+//! N = 3k, 10k and 30k points on one core with Isomap's share.
+
+use super::args::{BenchArgs, GlobalArgs};
+use super::{ExitError, say};
+use rayon::prelude::*;
+use std::path::Path;
+use std::time::Instant;
+use videomocap::eval::volume::{VolumeScore, score_volume};
+use videomocap::skeleton::SubjectModel;
+use videomocap::synth::{
+    Motion, ProceduralMotion, VoxelParams, from_bvh, procedural, stature_of, volume_truth, voxelise,
+};
+use videomocap::volume::{VolumeParams, assemble, process_frame};
+
+/// Frames per sequence (the paper's sequences had about 50).
+const FRAMES: usize = 50;
+/// Frame rate of the sequences (the paper captured at about 10 Hz).
+const FPS: f64 = 15.0;
+
+fn motions() -> Result<Vec<(String, Motion, bool)>, ExitError> {
+    let subject = SubjectModel::default();
+    let mut out = Vec::new();
+    for kind in [
+        ProceduralMotion::March,
+        ProceduralMotion::Wave,
+        ProceduralMotion::JumpingJacks,
+    ] {
+        out.push((
+            kind.name().to_owned(),
+            procedural(kind, &subject, FRAMES, FPS),
+            true,
+        ));
+    }
+    out.push((
+        "walk (procedural)".to_owned(),
+        procedural(ProceduralMotion::Walk, &subject, FRAMES, FPS),
+        false,
+    ));
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    for (file, start, label) in [
+        ("cmu_02_01_walk.bvh", 0.5, "CMU 02_01 walk"),
+        ("cmu_02_03_run.bvh", 0.3, "CMU 02_03 run"),
+        ("cmu_06_03_dribble.bvh", 1.0, "CMU 06_03 dribble"),
+        ("cmu_60_02_dance.bvh", 2.0, "CMU 60_02 dance"),
+    ] {
+        let m = from_bvh(&data.join(file), start, FRAMES, FPS).map_err(ExitError::failed)?;
+        out.push((label.to_owned(), m, false));
+    }
+    Ok(out)
+}
+
+struct Row {
+    name: String,
+    voxel_mm: f64,
+    points: f64,
+    score: VolumeScore,
+    sides: String,
+}
+
+fn run_sequence(name: &str, motion: &Motion, voxel: VoxelParams, params: &VolumeParams) -> Row {
+    let stature = stature_of(motion);
+    let clouds: Vec<_> = motion
+        .frames
+        .par_iter()
+        .enumerate()
+        .map(|(i, j)| {
+            let mut rng =
+                <rand::rngs::StdRng as rand::SeedableRng>::seed_from_u64(voxel.seed + i as u64);
+            voxelise(j, stature, &voxel, &mut rng)
+        })
+        .collect();
+    let results: Vec<_> = clouds
+        .par_iter()
+        .map(|c| process_frame(c, params))
+        .collect();
+    let names: Vec<String> = (0..results.len()).map(|i| format!("frame {i}")).collect();
+    let assembled = assemble(&results, &names, motion.fps);
+    let ok = results.iter().filter(|r| r.is_ok()).count();
+    let score = score_volume(&volume_truth(motion), &assembled.skeleton, ok);
+    Row {
+        name: name.to_owned(),
+        voxel_mm: voxel.voxel_m * 1000.0,
+        points: clouds.iter().map(Vec::len).sum::<usize>() as f64 / clouds.len().max(1) as f64,
+        score,
+        sides: format!("{:?}", assembled.sides_from).to_lowercase(),
+    }
+}
+
+/// Runs the volume benchmark and prints its tables.
+pub fn run(_a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+    let params = VolumeParams::default();
+    let motions = motions()?;
+    let mut lines = Vec::new();
+    lines.push(format!(
+        "Volume pipeline accuracy ({FRAMES} frames per sequence at {FPS} fps; error: left/right matched once per sequence, and per frame)"
+    ));
+    lines.push(format!(
+        "{:<20} {:>6} {:>7} {:>9} {:>9} {:>9} {:>8} {:>10} {:>9}",
+        "sequence",
+        "voxel",
+        "points",
+        "topology",
+        "mean mm",
+        "voxels",
+        "frame mm",
+        "labels ok",
+        "sides"
+    ));
+    let mut paper = VolumeScore::default();
+    let mut paper_voxels = (0.0, 0usize);
+    let mut others = VolumeScore::default();
+    for voxel_m in [0.03, 0.04, 0.05] {
+        for (name, motion, is_paper) in &motions {
+            say(
+                global,
+                &format!("{name}, {:.0} mm voxels …", voxel_m * 1000.0),
+            );
+            let voxel = VoxelParams {
+                voxel_m,
+                ..VoxelParams::default()
+            };
+            let r = run_sequence(name, motion, voxel, &params);
+            let s = &r.score;
+            lines.push(format!(
+                "{:<20} {:>4.0}mm {:>7.0} {:>8.1}% {:>9.1} {:>9.2} {:>8.1} {:>9.1}% {:>9}",
+                r.name,
+                r.voxel_mm,
+                r.points,
+                100.0 * s.topology(),
+                s.mean_mm(),
+                s.mean_mm() / r.voxel_mm,
+                s.mean_frame_matched_mm(),
+                100.0 * s.consistency(),
+                r.sides
+            ));
+            if *is_paper {
+                paper.merge(s);
+                paper_voxels.0 += s.mean_mm() / r.voxel_mm;
+                paper_voxels.1 += 1;
+            } else {
+                others.merge(s);
+            }
+        }
+    }
+    lines.push(format!(
+        "paper's three motions, all voxel sizes: topology {:.1}%, mean {:.1} mm = {:.2} voxel sizes (mean over sequences), labels consistent {:.1}%",
+        100.0 * paper.topology(),
+        paper.mean_mm(),
+        paper_voxels.0 / paper_voxels.1.max(1) as f64,
+        100.0 * paper.consistency()
+    ));
+    lines.push(format!(
+        "other motions, all voxel sizes: topology {:.1}%, mean {:.1} mm, labels consistent {:.1}%",
+        100.0 * others.topology(),
+        others.mean_mm(),
+        100.0 * others.consistency()
+    ));
+    lines.push(String::new());
+
+    // Speed on one core: voxel sizes chosen so that a marching frame has about N points.
+    let march = &motions[0].1;
+    let stature = stature_of(march);
+    let mut rng = <rand::rngs::StdRng as rand::SeedableRng>::seed_from_u64(3);
+    let at_40 = voxelise(&march.frames[0], stature, &VoxelParams::default(), &mut rng).len();
+    lines.push("Speed on one core (marching, 10 frames each)".to_owned());
+    lines.push(format!(
+        "{:>8} {:>8} {:>12} {:>12} {:>10} {:>9}",
+        "N target", "voxel", "points", "ms / frame", "Isomap", "topology"
+    ));
+    for target in [3_000.0, 10_000.0, 30_000.0] {
+        let voxel_m = 0.04 * (at_40 as f64 / target).cbrt();
+        let voxel = VoxelParams {
+            voxel_m,
+            ..VoxelParams::default()
+        };
+        let clouds: Vec<_> = march
+            .frames
+            .iter()
+            .step_by(5)
+            .take(10)
+            .map(|j| voxelise(j, stature, &voxel, &mut rng))
+            .collect();
+        say(global, &format!("speed at N ≈ {target:.0} …"));
+        let (mut total, mut iso, mut ok) = (0.0, 0.0, 0);
+        for c in &clouds {
+            let t0 = Instant::now();
+            let r = process_frame(c, &params);
+            total += t0.elapsed().as_secs_f64();
+            if let Ok(r) = r {
+                iso += r.seconds[0];
+                ok += 1;
+            }
+        }
+        let n = clouds.len().max(1) as f64;
+        lines.push(format!(
+            "{:>8.0} {:>6.1}mm {:>12.0} {:>12.1} {:>9.0}% {:>6}/{}",
+            target,
+            voxel_m * 1000.0,
+            clouds.iter().map(Vec::len).sum::<usize>() as f64 / n,
+            1000.0 * total / n,
+            100.0 * iso / total.max(1e-12),
+            ok,
+            clouds.len()
+        ));
+    }
+    println!("{}", lines.join("\n"));
+    Ok(())
+}

@@ -1,0 +1,143 @@
+//! Accuracy of the volume pipeline against the true joints of a synthetic volume sequence:
+//! topology (share of frames whose skeleton curve had five limbs), joint position error in
+//! millimetres with left and right matched once per sequence (the paper labels limbs arm1/arm2,
+//! leg1/leg2, never left/right), the same per frame, and limb-label consistency (share of frames
+//! whose best per-frame matching equals the sequence's).
+
+use crate::formats::Skeleton3d;
+use crate::skeleton::{Joint, PerJoint};
+use nalgebra::Point3;
+use serde::Serialize;
+
+/// Scores of one sequence.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct VolumeScore {
+    /// Input frames.
+    pub frames: usize,
+    /// Frames whose skeleton curve had the right five-limb topology.
+    pub topology_ok: usize,
+    /// Joint samples scored (16 per output frame).
+    pub samples: usize,
+    /// Sum of joint errors with one left/right matching for the sequence, metres.
+    pub sum_m: f64,
+    /// Sum of joint errors with the best matching per frame, metres.
+    pub sum_frame_matched_m: f64,
+    /// Output frames whose best per-frame matching equals the sequence's.
+    pub consistent: usize,
+    /// Output frames scored.
+    pub scored_frames: usize,
+}
+
+impl VolumeScore {
+    /// Adds another sequence's counts.
+    pub fn merge(&mut self, o: &VolumeScore) {
+        self.frames += o.frames;
+        self.topology_ok += o.topology_ok;
+        self.samples += o.samples;
+        self.sum_m += o.sum_m;
+        self.sum_frame_matched_m += o.sum_frame_matched_m;
+        self.consistent += o.consistent;
+        self.scored_frames += o.scored_frames;
+    }
+    /// Share of frames with the right topology.
+    pub fn topology(&self) -> f64 {
+        self.topology_ok as f64 / self.frames.max(1) as f64
+    }
+    /// Mean joint error, millimetres (sequence matching).
+    pub fn mean_mm(&self) -> f64 {
+        1000.0 * self.sum_m / self.samples.max(1) as f64
+    }
+    /// Mean joint error, millimetres (per-frame matching).
+    pub fn mean_frame_matched_mm(&self) -> f64 {
+        1000.0 * self.sum_frame_matched_m / self.samples.max(1) as f64
+    }
+    /// Share of frames whose labels agree with the sequence's matching.
+    pub fn consistency(&self) -> f64 {
+        self.consistent as f64 / self.scored_frames.max(1) as f64
+    }
+}
+
+/// The joints with arms and/or legs swapped.
+fn swapped(p: &PerJoint<Point3<f64>>, arms: bool, legs: bool) -> PerJoint<Point3<f64>> {
+    use Joint::*;
+    PerJoint::from_fn(|j| {
+        let arm = matches!(
+            j,
+            LeftShoulder | LeftElbow | LeftWrist | RightShoulder | RightElbow | RightWrist
+        );
+        let leg = matches!(
+            j,
+            LeftHip | LeftKnee | LeftAnkle | RightHip | RightKnee | RightAnkle
+        );
+        if (arm && arms) || (leg && legs) {
+            p[j.mirrored()]
+        } else {
+            p[j]
+        }
+    })
+}
+
+fn frame_errors(a: &PerJoint<Point3<f64>>, b: &PerJoint<Point3<f64>>) -> [f64; 2] {
+    // [arms, legs] summed error, rest counted in both entries' caller
+    let mut e = [0.0; 2];
+    for (j, p) in a.iter() {
+        let d = (p - b[j]).norm();
+        if j.index() >= Joint::LeftHip.index() {
+            e[1] += d;
+        } else {
+            e[0] += d;
+        }
+    }
+    e
+}
+
+/// Scores `result` (the pipeline's skeleton) against `truth`; `topology_ok` counts frames that
+/// had a pose.
+pub fn score_volume(truth: &Skeleton3d, result: &Skeleton3d, topology_ok: usize) -> VolumeScore {
+    let mut s = VolumeScore {
+        frames: truth.frames.len(),
+        topology_ok,
+        ..Default::default()
+    };
+    let pairs: Vec<(&PerJoint<Point3<f64>>, &PerJoint<Point3<f64>>)> = result
+        .frames
+        .iter()
+        .filter_map(|f| {
+            truth
+                .frames
+                .iter()
+                .find(|t| t.index == f.index)
+                .map(|t| (&f.points, &t.points))
+        })
+        .collect();
+    // [no swap, swap] totals for arms and legs; "upper" holds head/trunk/arms, "lower" legs.
+    let mut totals = [[0.0; 2]; 2]; // [swap?][arms-part, legs-part]
+    let mut per_frame = Vec::new();
+    for (r, t) in &pairs {
+        let plain = frame_errors(r, t);
+        let both = frame_errors(&swapped(r, true, true), t);
+        for k in 0..2 {
+            totals[0][k] += plain[k];
+            totals[1][k] += both[k];
+        }
+        per_frame.push((plain, both));
+    }
+    let swap_arms = totals[1][0] < totals[0][0];
+    let swap_legs = totals[1][1] < totals[0][1];
+    for (plain, both) in per_frame {
+        let seq = [
+            if swap_arms { both[0] } else { plain[0] },
+            if swap_legs { both[1] } else { plain[1] },
+        ];
+        let best = [plain[0].min(both[0]), plain[1].min(both[1])];
+        s.sum_m += seq[0] + seq[1];
+        s.sum_frame_matched_m += best[0] + best[1];
+        s.samples += 16;
+        s.scored_frames += 1;
+        let agrees = (swap_arms == (both[0] < plain[0])) && (swap_legs == (both[1] < plain[1]));
+        if agrees {
+            s.consistent += 1;
+        }
+    }
+    s
+}
