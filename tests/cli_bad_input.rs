@@ -154,19 +154,6 @@ fn malformed_json_is_named() {
 }
 
 #[test]
-fn valid_inputs_to_a_step_not_built_yet_say_so_with_code_2() {
-    let dir = tempfile::tempdir().unwrap();
-    let (code, stderr) = run(&[
-        "volume",
-        dir.path().to_str().unwrap(),
-        "--out-dir",
-        dir.path().join("out").to_str().unwrap(),
-    ]);
-    assert_eq!(code, 2);
-    assert!(stderr.contains("not built yet"), "{stderr}");
-}
-
-#[test]
 fn info_prints_the_samples_portrait_size_and_json() {
     let video = sample_dir().join("video.mp4");
     let out = Command::cargo_bin("videomocap")

@@ -99,7 +99,8 @@ pub fn score_volume(truth: &Skeleton3d, result: &Skeleton3d, topology_ok: usize)
         topology_ok,
         ..Default::default()
     };
-    let pairs: Vec<(&PerJoint<Point3<f64>>, &PerJoint<Point3<f64>>)> = result
+    type Pose = PerJoint<Point3<f64>>;
+    let pairs: Vec<(&Pose, &Pose)> = result
         .frames
         .iter()
         .filter_map(|f| {

@@ -125,7 +125,7 @@ pub fn truth(motion: &Motion) -> Skeleton3d {
             .enumerate()
             .map(|(index, points)| Frame3d {
                 index,
-                points: points.clone(),
+                points: *points,
                 flags: Vec::new(),
             })
             .collect(),

@@ -249,7 +249,7 @@ pub fn fit(
         // point inside it and the next one, found by bisection.
         let last_in = path
             .iter()
-            .rposition(|p| in_torso(p))
+            .rposition(&in_torso)
             .map_or(0, |i| i.min(path.len() - 2));
         let (mut lo, mut hi) = (path[last_in], path[last_in + 1]);
         if in_torso(&lo) {

@@ -156,8 +156,8 @@ pub fn assemble(
     let mut sides_from = SidesFrom::Arbitrary;
     let sign = |x: f64| if x > 0.0 { 1 } else { -1 };
     for pass in [SidesFrom::Knees, SidesFrom::Elbows] {
-        for i in 0..results.len() {
-            let (Some(l), Ok(f)) = (labelled(i), &results[i]) else {
+        for (i, r) in results.iter().enumerate() {
+            let (Some(l), Ok(f)) = (labelled(i), r) else {
                 continue;
             };
             let up = f.fit.torso.b - f.fit.torso.a;
@@ -242,7 +242,7 @@ pub fn assemble(
                 before = i;
                 frames.push(Frame3d {
                     index: i,
-                    points: p.clone(),
+                    points: *p,
                     flags: Vec::new(),
                 });
                 continue;
@@ -276,7 +276,7 @@ pub fn assemble(
         })
         .collect();
     for f in &mut frames {
-        let old = f.points.clone();
+        let old = f.points;
         for (b, len) in Bone::ALL.iter().zip(&lengths) {
             let dir = (old[b.child] - old[b.parent])
                 .try_normalize(1e-12)

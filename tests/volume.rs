@@ -1,0 +1,209 @@
+//! The volume pipeline (Chu, Jenkins, Mataric) on synthetic volumes with known joints, bad
+//! frames, and the command line end to end.
+
+use assert_cmd::Command;
+use nalgebra::{Point3, Vector3};
+use rand::SeedableRng;
+use std::sync::atomic::AtomicBool;
+use videomocap::eval::volume::score_volume;
+use videomocap::formats::Skeleton3d;
+use videomocap::skeleton::SubjectModel;
+use videomocap::synth::{
+    ProceduralMotion, VoxelParams, procedural, stature_of, volume_truth, voxelise,
+};
+use videomocap::volume::cloud::write_ply;
+use videomocap::volume::{
+    FrameProblem, SequenceError, VolumeParams, assemble, process_directory, process_frame,
+};
+
+#[test]
+fn marching_at_40_mm_is_within_one_and_a_half_voxels() {
+    let motion = procedural(ProceduralMotion::March, &SubjectModel::default(), 16, 10.0);
+    let stature = stature_of(&motion);
+    let voxel = VoxelParams::default();
+    let mut rng = rand::rngs::StdRng::seed_from_u64(5);
+    let params = VolumeParams::default();
+    let results: Vec<_> = motion
+        .frames
+        .iter()
+        .map(|j| process_frame(&voxelise(j, stature, &voxel, &mut rng), &params))
+        .collect();
+    let names: Vec<String> = (0..results.len()).map(|i| i.to_string()).collect();
+    let a = assemble(&results, &names, motion.fps);
+    let ok = results.iter().filter(|r| r.is_ok()).count();
+    let s = score_volume(&volume_truth(&motion), &a.skeleton, ok);
+    assert!(s.topology() >= 0.95, "topology {}", s.topology());
+    assert!(s.mean_mm() <= 1.5 * 40.0, "mean error {} mm", s.mean_mm());
+    assert!(s.consistency() >= 0.95, "labels {}", s.consistency());
+    // Rigid: every bone keeps one length.
+    for f in &a.skeleton.frames {
+        for b in videomocap::skeleton::Bone::ALL {
+            let d = (f.points[b.child] - f.points[b.parent]).norm();
+            assert!((d - a.skeleton.bone_lengths_m[&b.key()]).abs() < 1e-9);
+        }
+    }
+}
+
+/// Writes a march sequence with bad frames in it; returns the directory.
+fn sequence_with_bad_frames() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    let motion = procedural(ProceduralMotion::March, &SubjectModel::default(), 8, 10.0);
+    let stature = stature_of(&motion);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(2);
+    for (i, j) in motion.frames.iter().enumerate() {
+        let mut pts = voxelise(j, stature, &VoxelParams::default(), &mut rng);
+        match i {
+            // A second person-sized blob far away: the largest component is kept.
+            2 => {
+                let far: Vec<Point3<f64>> = pts
+                    .iter()
+                    .take(200)
+                    .map(|p| p + Vector3::x() * 5.0)
+                    .collect();
+                pts.extend(far);
+            }
+            // Nearly empty.
+            3 => pts.truncate(5),
+            // A body without its left arm: four leaves.
+            5 => pts.retain(|p| p.x < 0.25),
+            _ => {}
+        }
+        if i != 4 {
+            write_ply(&dir.path().join(format!("f{i}.ply")), &pts).unwrap();
+        }
+    }
+    // A frame with a NaN coordinate, in XYZ text.
+    std::fs::write(dir.path().join("f4.xyz"), "0 0 0\n1 NaN 2\n").unwrap();
+    dir
+}
+
+#[test]
+fn bad_frames_are_warned_about_and_interpolated_never_a_panic() {
+    let dir = sequence_with_bad_frames();
+    let p = process_directory(
+        dir.path(),
+        &VolumeParams::default(),
+        10.0,
+        &|_, _| {},
+        &AtomicBool::new(false),
+    )
+    .unwrap();
+    assert_eq!(p.files.len(), 8);
+    assert!(p.results[2].is_ok(), "{:?}", p.results[2].as_ref().err());
+    assert!(matches!(
+        p.results[3],
+        Err(FrameProblem::TooFewPoints(5, _))
+    ));
+    assert!(
+        matches!(p.results[4], Err(FrameProblem::Unreadable(ref m)) if m.contains("f4.xyz") && m.contains("finite"))
+    );
+    assert!(
+        matches!(p.results[5], Err(FrameProblem::Curve(_))),
+        "{:?}",
+        p.results[5].as_ref().map(|_| ())
+    );
+    let w = p.assembled.warnings.join("\n");
+    assert!(
+        w.contains("frame 3 (f3.ply)") && w.contains("frame 4 (f4.xyz)"),
+        "{w}"
+    );
+    let frames = &p.assembled.skeleton.frames;
+    assert_eq!(frames.len(), 8);
+    for f in frames {
+        let bad = p.results[f.index].is_err();
+        assert_eq!(
+            f.flags.contains(&"interpolated".to_owned()),
+            bad,
+            "frame {}",
+            f.index
+        );
+    }
+}
+
+#[test]
+fn a_directory_where_no_frame_gives_a_pose_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("a.xyz"), "0 0 0\n1 1 1\n").unwrap();
+    let e = process_directory(
+        dir.path(),
+        &VolumeParams::default(),
+        10.0,
+        &|_, _| {},
+        &AtomicBool::new(false),
+    )
+    .unwrap_err();
+    assert!(matches!(e, SequenceError::NoPose { frames: 1, .. }), "{e}");
+}
+
+fn videomocap() -> Command {
+    Command::cargo_bin("videomocap").unwrap()
+}
+
+#[test]
+fn synth_volume_then_volume_writes_a_skeleton_and_a_bvh() {
+    let tmp = tempfile::tempdir().unwrap();
+    let vols = tmp.path().join("vols");
+    let out = tmp.path().join("out");
+    videomocap()
+        .args([
+            "synth",
+            "--motion",
+            "jumping-jacks",
+            "--frames",
+            "12",
+            "--fps",
+            "10",
+        ])
+        .args(["--volume", "--voxel-mm", "40", "--noise-voxels", "10", "-o"])
+        .arg(&vols)
+        .assert()
+        .success();
+    assert!(vols.join("frame_0011.ply").is_file());
+    let o = videomocap()
+        .args(["volume"])
+        .arg(&vols)
+        .args(["--fps", "10", "--out-dir"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(stderr.contains("five-limb"), "{stderr}");
+    let skel = Skeleton3d::load(&out.join("skeleton3d.json")).unwrap();
+    let truth = Skeleton3d::load(&vols.join("truth.skeleton3d.json")).unwrap();
+    let ok = skel.frames.iter().filter(|f| f.flags.is_empty()).count();
+    let s = score_volume(&truth, &skel, ok);
+    assert!(s.mean_mm() < 60.0, "{}", s.mean_mm());
+    assert!(
+        std::fs::read_to_string(out.join("motion.bvh"))
+            .unwrap()
+            .starts_with("HIERARCHY")
+    );
+}
+
+#[test]
+fn volume_refuses_a_file_and_an_empty_directory_by_name() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("cloud.ply");
+    std::fs::write(&file, "x").unwrap();
+    let o = videomocap()
+        .arg("volume")
+        .arg(&file)
+        .args(["--out-dir", "x"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("cloud.ply") && e.contains("directory"), "{e}");
+    let empty = tmp.path().join("empty");
+    std::fs::create_dir(&empty).unwrap();
+    let o = videomocap()
+        .arg("volume")
+        .arg(&empty)
+        .args(["--out-dir", "x"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("empty") && e.contains("no point clouds"), "{e}");
+}
