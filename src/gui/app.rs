@@ -9,6 +9,7 @@ use super::frame_view::{FrameView, Overlay, PointState, ViewEvent};
 use super::jobs::{Job, JobEvent};
 use super::timeline::{self, Strips};
 use super::view3d::{Orbit, Scene};
+use super::volume_view::VolumeView;
 use nalgebra::{Point2, Point3};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -126,6 +127,8 @@ pub struct App {
     show_help: bool,
     recent: Vec<PathBuf>,
     status: String,
+    /// Volume mode: a point-volume sequence instead of a video.
+    volume: Option<VolumeView>,
 }
 
 impl App {
@@ -170,6 +173,7 @@ impl App {
             show_help: false,
             recent: Vec::new(),
             status: "Open a video with File > Open video (or drop one here)".to_owned(),
+            volume: None,
         };
         if let Some(p) = path {
             app.open_path(ctx, &p);
@@ -190,9 +194,24 @@ impl App {
         self.loader.as_ref().and_then(FrameLoader::info)
     }
 
-    /// Number of frames of the open video (0 when none).
+    /// Number of frames of the open video or volume sequence (0 when none).
     pub fn frame_count(&self) -> usize {
-        self.video_info().map_or(0, |i| i.frame_count)
+        match &self.volume {
+            Some(v) => v.frame_count(),
+            None => self.video_info().map_or(0, |i| i.frame_count),
+        }
+    }
+
+    /// Volume mode's state, when a point-volume sequence is open.
+    #[cfg(test)]
+    pub fn volume(&self) -> Option<&VolumeView> {
+        self.volume.as_ref()
+    }
+
+    /// What the 3D viewport shows now.
+    #[cfg(test)]
+    pub fn current_scene(&self) -> Scene {
+        self.scene()
     }
 
     /// The frame the user is on.
@@ -255,9 +274,11 @@ impl App {
         }
     }
 
-    /// Opens a video, image folder or project file.
+    /// Opens a video, image folder, project file or a folder of point volumes.
     pub fn open_path(&mut self, ctx: &egui::Context, path: &Path) {
-        if path.is_file() && path.extension().is_some_and(|e| e == "json") {
+        if is_volume_dir(path) {
+            self.open_volume(ctx, path);
+        } else if path.is_file() && path.extension().is_some_and(|e| e == "json") {
             match Project::load(path) {
                 Ok(p) => {
                     self.open_video(ctx, &p.video.clone());
@@ -275,11 +296,36 @@ impl App {
         self.recent.truncate(8);
     }
 
+    /// Volume mode: processes the point volumes of `dir` on a worker thread.
+    fn open_volume(&mut self, ctx: &egui::Context, dir: &Path) {
+        if let Some(r) = &self.running {
+            r.job.cancel();
+        }
+        self.loader = None;
+        self.project = None;
+        self.project_path = None;
+        self.history.clear();
+        self.results_changed();
+        self.texture = None;
+        self.shown = None;
+        self.marking = None;
+        self.current = 0;
+        self.volume = Some(VolumeView::new(dir.to_owned()));
+        self.orbit = Orbit::default();
+        self.running = Some(Running {
+            job: Job::volume(dir.to_owned(), 30.0, ctx.clone()),
+            keys: Default::default(),
+            overrides: Default::default(),
+        });
+        self.status = format!("Processing point volumes in {}…", dir.display());
+    }
+
     fn open_video(&mut self, ctx: &egui::Context, path: &Path) {
         if let Some(r) = &self.running {
             r.job.cancel();
         }
         self.running = None;
+        self.volume = None;
         self.loader = Some(FrameLoader::open(path.to_owned(), ctx.clone()));
         self.project = Some(Project::new(path.to_owned()));
         self.project_path = None;
@@ -700,6 +746,24 @@ impl App {
                 JobEvent::Progress { .. } => {}
                 JobEvent::Tracked(result) => self.tracked(result),
                 JobEvent::Lifted(result) => self.lifted(result),
+                JobEvent::Volume(result) => {
+                    self.running = None;
+                    match (result, &mut self.volume) {
+                        (Ok(p), Some(v)) => {
+                            let ok = p.results.iter().filter(|r| r.is_ok()).count();
+                            self.status = format!(
+                                "{}   {} frames, {} with a five-limb skeleton curve, {} warnings",
+                                v.dir.display(),
+                                p.files.len(),
+                                ok,
+                                p.assembled.warnings.len()
+                            );
+                            v.set(p);
+                        }
+                        (Err(e), _) => self.status = format!("Cannot process the volumes: {e}"),
+                        (Ok(_), None) => {}
+                    }
+                }
             }
         }
     }
@@ -861,7 +925,10 @@ impl App {
         if !self.playing {
             return;
         }
-        let fps = self.video_info().map_or(30.0, |i| i.fps);
+        let fps = match &self.volume {
+            Some(v) => v.world.as_ref().map_or(30.0, |w| w.fps),
+            None => self.video_info().map_or(30.0, |i| i.fps),
+        };
         self.play_time += f64::from(ctx.input(|i| i.stable_dt));
         let steps = (self.play_time * fps).floor();
         if steps >= 1.0 {
@@ -889,6 +956,12 @@ impl App {
                 if ui.button("Open image folder…").clicked() {
                     ui.close();
                     if let Some(p) = self.config.dialogs.open_folder("Open image folder") {
+                        self.open_path(ctx, &p);
+                    }
+                }
+                if ui.button("Open point volumes…").clicked() {
+                    ui.close();
+                    if let Some(p) = self.config.dialogs.open_folder("Open point volumes") {
                         self.open_path(ctx, &p);
                     }
                 }
@@ -990,6 +1063,31 @@ impl App {
     }
 
     fn side_panel(&mut self, ui: &mut egui::Ui) {
+        if let Some(v) = &mut self.volume {
+            ui.heading("Point volumes");
+            ui.checkbox(&mut v.show_points, "points (coloured by body)");
+            ui.checkbox(&mut v.show_curve, "skeleton curve");
+            ui.checkbox(&mut v.show_bodies, "head sphere, torso and limb cylinders");
+            if let Some(p) = &v.processed {
+                ui.label(format!("left/right from: {:?}", p.assembled.sides_from));
+                if let Some(Err(e)) = p.results.get(self.current) {
+                    ui.colored_label(egui::Color32::from_rgb(240, 160, 60), e.to_string());
+                }
+                ui.separator();
+                ui.heading("Warnings");
+                egui::ScrollArea::vertical()
+                    .max_height(300.0)
+                    .show(ui, |ui| {
+                        if p.assembled.warnings.is_empty() {
+                            ui.label("none");
+                        }
+                        for w in &p.assembled.warnings {
+                            ui.label(w);
+                        }
+                    });
+            }
+            return;
+        }
         if let Some(k) = self.marking {
             ui.heading("Marking");
             let j = Joint::ALL[k];
@@ -1096,11 +1194,16 @@ impl App {
     }
 
     fn scene(&self) -> Scene {
+        if let Some(v) = &self.volume {
+            return v.scene(self.current);
+        }
         let Some(world) = &self.world else {
             return Scene {
                 joints: None,
                 camera: None,
                 flippable: Vec::new(),
+                cloud: Vec::new(),
+                segments: Vec::new(),
             };
         };
         let joints = world
@@ -1141,6 +1244,8 @@ impl App {
                 .into_iter()
                 .filter(|b| !(key.contains(&b.parent) && key.contains(&b.child)))
                 .collect(),
+            cloud: Vec::new(),
+            segments: Vec::new(),
         }
     }
 
@@ -1200,6 +1305,18 @@ const SHORTCUTS: &[(&str, &str)] = &[
 ];
 
 /// Joints below `joint` on its limb (the bone tree's descendants).
+/// Whether `path` is a folder of point clouds (and no images): volume mode.
+fn is_volume_dir(path: &Path) -> bool {
+    path.is_dir()
+        && videomocap::volume::list_frames(path).is_ok()
+        && !std::fs::read_dir(path).is_ok_and(|entries| {
+            entries.filter_map(Result::ok).any(|e| {
+                let name = e.file_name().to_string_lossy().to_ascii_lowercase();
+                name.ends_with(".png") || name.ends_with(".jpg") || name.ends_with(".jpeg")
+            })
+        })
+}
+
 fn descendants(joint: Joint) -> Vec<Joint> {
     let mut out = Vec::new();
     let mut frontier = vec![joint];
@@ -1313,6 +1430,20 @@ impl eframe::App for App {
             .default_size(240.0)
             .show(ui, |ui| self.side_panel(ui));
         let scene = self.scene();
+        if self.volume.is_some() {
+            // Volume mode: the 3D viewport fills the window.
+            egui::CentralPanel::default().show(ui, |ui| {
+                ui.horizontal(|ui| {
+                    ui.label("3D (point volumes)");
+                    if ui.button("Reset view").clicked() {
+                        self.orbit = Orbit::default();
+                    }
+                });
+                self.orbit.show(ui, &scene);
+            });
+            self.dialogs(&ctx);
+            return;
+        }
         let mut flip = None;
         egui::Panel::right("3d")
             .resizable(true)
@@ -1440,6 +1571,58 @@ mod tests {
         h.key_press(egui::Key::Home);
         h.step();
         assert_eq!(h.state().current_frame(), 0);
+    }
+
+    /// Volume mode: File ▸ Open point volumes processes a folder of PLY frames off the UI
+    /// thread, then the 3D viewport shows the frame's points, skeleton curve, bodies and
+    /// skeleton; arrow keys step through the frames.
+    #[test]
+    fn volume_mode_opens_a_point_volume_folder_and_steps_through_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let vols = dir.path().join("vols");
+        let motion = videomocap::synth::procedural(
+            videomocap::synth::ProceduralMotion::March,
+            &videomocap::skeleton::SubjectModel::default(),
+            6,
+            10.0,
+        );
+        videomocap::synth::write_volume_sequence(
+            &motion,
+            &vols,
+            &videomocap::synth::VoxelParams::default(),
+            |_, _| {},
+        )
+        .unwrap();
+        let dialogs = PreparedDialogs::default();
+        dialogs.answers.borrow_mut().push_back(vols.clone());
+        let mut h = harness(None, &dialogs, &dir.path().join("state"));
+        h.step();
+        h.get_by_label("File").click();
+        h.run_steps(3);
+        h.get_by_label("Open point volumes…").click();
+        h.run_steps(3);
+        assert!(h.state().volume().is_some(), "{}", h.state().status());
+        wait(&mut h, "the volumes to be processed", |a| {
+            a.frame_count() == 6
+        });
+        assert!(!h.state().busy());
+        assert!(
+            h.state().status().contains("6 with a five-limb"),
+            "{}",
+            h.state().status()
+        );
+        let scene = h.state().current_scene();
+        assert!(scene.joints.is_some());
+        assert!(scene.cloud.len() > 500, "{} points", scene.cloud.len());
+        assert!(scene.segments.len() > 50, "curve and bodies drawn");
+        h.key_press(egui::Key::ArrowRight);
+        h.step();
+        assert_eq!(h.state().current_frame(), 1);
+        // Hiding the points leaves the curve and the skeleton.
+        h.get_by_label("points (coloured by body)").click();
+        h.step();
+        let scene = h.state().current_scene();
+        assert!(scene.cloud.is_empty() && scene.joints.is_some());
     }
 
     /// The whole session a user has: open a clip, mark 16 joints by clicking, drag one, undo,

@@ -12,6 +12,7 @@ use videomocap::lift::{DepthOverrides, LiftJob, LiftOutput, LiftParams, lift};
 use videomocap::skeleton::{Proportions, SubjectModel};
 use videomocap::track::{TrackJob, TrackOutput, track_video};
 use videomocap::video::{OpenOptions, Video};
+use videomocap::volume::{Processed, VolumeParams, process_directory};
 
 /// What a job sends back.
 pub enum JobEvent {
@@ -26,6 +27,8 @@ pub enum JobEvent {
     Tracked(Result<TrackOutput, String>),
     /// Lifting finished.
     Lifted(Result<LiftOutput, String>),
+    /// A point-volume sequence was processed.
+    Volume(Result<Processed, String>),
 }
 
 /// A running job.
@@ -116,6 +119,33 @@ impl Job {
             ctx.request_repaint();
         });
         Job::new("Lifting", rx, cancel)
+    }
+
+    /// Runs the point-volume pipeline on `dir` on a worker thread (frames in parallel).
+    pub fn volume(dir: PathBuf, fps: f64, ctx: egui::Context) -> Job {
+        let (tx, rx) = channel();
+        let cancel = Arc::new(AtomicBool::new(false));
+        let flag = cancel.clone();
+        std::thread::spawn(move || {
+            let progress_tx = std::sync::Mutex::new(tx.clone());
+            let repaint = ctx.clone();
+            let progress = move |done: usize, total: usize| {
+                if let Ok(t) = progress_tx.lock() {
+                    let _ = t.send(JobEvent::Progress {
+                        done,
+                        total,
+                        stage: "volumes".to_owned(),
+                        frame: None,
+                    });
+                }
+                repaint.request_repaint();
+            };
+            let result = process_directory(&dir, &VolumeParams::default(), fps, &progress, &flag)
+                .map_err(|e| e.to_string());
+            let _ = tx.send(JobEvent::Volume(result));
+            ctx.request_repaint();
+        });
+        Job::new("Volumes", rx, cancel)
     }
 
     fn new(what: &'static str, events: Receiver<JobEvent>, cancel: Arc<AtomicBool>) -> Job {

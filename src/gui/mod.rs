@@ -10,6 +10,7 @@ mod frame_view;
 mod jobs;
 mod timeline;
 mod view3d;
+mod volume_view;
 
 use std::path::PathBuf;
 

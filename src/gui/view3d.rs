@@ -15,6 +15,10 @@ pub struct Scene {
     pub camera: Option<(Point3<f64>, [Point3<f64>; 4])>,
     /// Bones that can be flipped (drawn thicker on hover).
     pub flippable: Vec<Bone>,
+    /// Points to draw as dots (volume mode), world metres.
+    pub cloud: Vec<(Point3<f64>, Color32)>,
+    /// Extra line segments (skeleton curve, bodies), world metres.
+    pub segments: Vec<(Point3<f64>, Point3<f64>, Stroke)>,
 }
 
 /// An orbiting view around a target point.
@@ -107,6 +111,14 @@ impl Orbit {
                 line(&corners[k], &corners[(k + 1) % 4], s);
             }
         }
+        for (p, colour) in &scene.cloud {
+            if let Some(s) = self.project(rect, p) {
+                painter.circle_filled(s, 1.5, *colour);
+            }
+        }
+        for (a, b, stroke) in &scene.segments {
+            line(a, b, *stroke);
+        }
         let mut clicked = None;
         if let Some(joints) = &scene.joints {
             let hover = response.hover_pos();
@@ -145,7 +157,7 @@ impl Orbit {
             if response.clicked() {
                 clicked = response.interact_pointer_pos().and_then(near_bone);
             }
-        } else {
+        } else if scene.cloud.is_empty() {
             painter.text(
                 rect.center(),
                 egui::Align2::CENTER_CENTER,
