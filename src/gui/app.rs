@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use videomocap::export::{self, WorldSkeleton};
-use videomocap::formats::{FrameTracks, Marks, PointSource};
+use videomocap::formats::{FrameTracks, Marks, PointSource, Skeleton3d};
 use videomocap::lift::Root;
 use videomocap::lift::focal::default_focal;
 use videomocap::project::{History, Project};
@@ -119,7 +119,9 @@ pub struct App {
     partial: BTreeMap<usize, FrameTracks>,
     spans: Vec<WeakSpan>,
     strips: Option<Strips>,
-    choices: Vec<[Root; BONE_COUNT]>,
+    /// Depth-root choices of recent lifts, keyed by the skeleton they produced (so that undo
+    /// and redo, which bring back an earlier skeleton, find its choices).
+    choices: Vec<(Arc<Skeleton3d>, Vec<[Root; BONE_COUNT]>)>,
     world: Option<WorldSkeleton>,
     playing: bool,
     play_time: f64,
@@ -129,6 +131,12 @@ pub struct App {
     status: String,
     /// Volume mode: a point-volume sequence instead of a video.
     volume: Option<VolumeView>,
+    /// The project has edits not saved to its file (the autosave holds them).
+    dirty: bool,
+    /// A path to open once the user has answered "save changes?".
+    pending_open: Option<PathBuf>,
+    /// A settings slider is being dragged and its undo step is already recorded.
+    settings_drag_recorded: bool,
 }
 
 impl App {
@@ -174,7 +182,11 @@ impl App {
             recent: Vec::new(),
             status: "Open a video with File > Open video (or drop one here)".to_owned(),
             volume: None,
+            dirty: false,
+            pending_open: None,
+            settings_drag_recorded: false,
         };
+        app.recent = app.load_recent();
         if let Some(p) = path {
             app.open_path(ctx, &p);
         }
@@ -274,8 +286,42 @@ impl App {
         }
     }
 
-    /// Opens a video, image folder, project file or a folder of point volumes.
+    /// Opens a video, image folder, project file or a folder of point volumes; first asks to
+    /// save unsaved changes.
     pub fn open_path(&mut self, ctx: &egui::Context, path: &Path) {
+        if self.dirty && self.project.is_some() {
+            self.pending_open = Some(path.to_owned());
+            return;
+        }
+        self.open_now(ctx, path);
+    }
+
+    /// Whether the "save changes?" question is showing.
+    #[cfg(test)]
+    pub fn asks_to_save(&self) -> bool {
+        self.pending_open.is_some()
+    }
+
+    /// Answers "save changes?": save (then open), discard (open) or cancel (stay).
+    pub fn answer_save(&mut self, ctx: &egui::Context, answer: SaveAnswer) {
+        let Some(path) = self.pending_open.take() else {
+            return;
+        };
+        match answer {
+            SaveAnswer::Save => {
+                self.save_project(false);
+                if self.dirty {
+                    return; // not saved (dialog cancelled or write failed): stay
+                }
+            }
+            SaveAnswer::Discard => self.dirty = false,
+            SaveAnswer::Cancel => return,
+        }
+        self.open_now(ctx, &path);
+    }
+
+    fn open_now(&mut self, ctx: &egui::Context, path: &Path) {
+        self.dirty = false;
         if is_volume_dir(path) {
             self.open_volume(ctx, path);
         } else if path.is_file() && path.extension().is_some_and(|e| e == "json") {
@@ -294,6 +340,41 @@ impl App {
         self.recent.retain(|p| p != path);
         self.recent.insert(0, path.to_owned());
         self.recent.truncate(8);
+        self.save_recent();
+    }
+
+    fn recent_path(&self) -> Option<PathBuf> {
+        self.config
+            .autosave_dir
+            .as_ref()
+            .map(|d| d.join("recent.json"))
+    }
+
+    /// The recent-files list kept beside the autosave (missing or unreadable: empty).
+    fn load_recent(&self) -> Vec<PathBuf> {
+        self.recent_path()
+            .and_then(|p| std::fs::read_to_string(p).ok())
+            .and_then(|t| serde_json::from_str(&t).ok())
+            .unwrap_or_default()
+    }
+
+    fn save_recent(&self) {
+        let Some(path) = self.recent_path() else {
+            return;
+        };
+        if let Some(dir) = path.parent() {
+            let _ = std::fs::create_dir_all(dir);
+        }
+        if let Ok(text) = serde_json::to_string_pretty(&self.recent) {
+            // Losing the recent list is harmless; the write is still atomic.
+            let _ = videomocap::formats::write_atomically(&path, text.as_bytes());
+        }
+    }
+
+    /// The recent files (newest first).
+    #[cfg(test)]
+    pub fn recent(&self) -> &[PathBuf] {
+        &self.recent
     }
 
     /// Volume mode: processes the point volumes of `dir` on a worker thread.
@@ -368,8 +449,24 @@ impl App {
         let Some(p) = &mut self.project else { return };
         self.history.record(p.clone());
         f(p);
+        self.dirty = true;
         self.autosave();
         self.results_changed();
+    }
+
+    /// A settings change from the side panel: a slider drag is one undo step, not one per
+    /// repaint.
+    fn edit_settings(&mut self, settings: videomocap::project::Settings, dragging: bool) {
+        if dragging && self.settings_drag_recorded {
+            if let Some(p) = &mut self.project {
+                p.settings = settings;
+                self.dirty = true;
+                self.autosave();
+            }
+        } else {
+            self.edit(|p| p.settings = settings);
+        }
+        self.settings_drag_recorded = dragging;
     }
 
     fn autosave(&self) {
@@ -388,6 +485,7 @@ impl App {
                 }
                 None => p,
             });
+            self.dirty = true;
             self.autosave();
             self.results_changed();
         }
@@ -403,6 +501,7 @@ impl App {
                 }
                 None => p,
             });
+            self.dirty = true;
             self.autosave();
             self.results_changed();
         }
@@ -527,7 +626,17 @@ impl App {
         else {
             return;
         };
-        let Some(current) = self.choices.get(k).map(|c| c[bone.index()]) else {
+        let skeleton = self.project.as_ref().and_then(|p| p.skeleton.clone());
+        let known = skeleton.and_then(|s| {
+            self.choices
+                .iter()
+                .find(|(k, _)| Arc::ptr_eq(k, &s))
+                .map(|(_, c)| c)
+        });
+        let Some(current) = known.and_then(|c| c.get(k)).map(|c| c[bone.index()]) else {
+            self.status =
+                "This 3D result's depth choices are not known (it was loaded from a file): lift again (T), then flip"
+                    .to_owned();
             return;
         };
         let frame = self.current;
@@ -605,6 +714,7 @@ impl App {
         match p.save(path) {
             Ok(()) => {
                 self.project_path = Some(path.to_owned());
+                self.dirty = false;
                 if let Some(a) = &mut self.autosaver {
                     a.clear();
                 }
@@ -637,6 +747,7 @@ impl App {
                 Ok(p) => {
                     self.open_video(ctx, &p.video.clone());
                     self.set_project(p);
+                    self.dirty = true;
                     self.autosave();
                     self.status = "Recovered the unsaved session".to_owned();
                 }
@@ -808,6 +919,7 @@ impl App {
                     p.tracks = Some(tracks);
                     p.skeleton = None;
                 }
+                self.dirty = true;
                 self.autosave();
                 self.results_changed();
                 self.status = format!(
@@ -836,10 +948,15 @@ impl App {
                     self.status = "Lift finished for an older edit; result dropped".to_owned();
                     return;
                 }
-                self.choices = out.choices;
-                if let Some(p) = &mut self.project {
-                    p.skeleton = Some(Arc::new(out.skeleton));
+                let skeleton = Arc::new(out.skeleton);
+                self.choices.push((skeleton.clone(), out.choices));
+                if self.choices.len() > 16 {
+                    self.choices.remove(0);
                 }
+                if let Some(p) = &mut self.project {
+                    p.skeleton = Some(skeleton);
+                }
+                self.dirty = true;
                 self.autosave();
                 self.results_changed();
                 let done = std::mem::take(&mut self.status);
@@ -1140,8 +1257,11 @@ impl App {
                     *t = d;
                 }
             });
+            let dragging = ui.ctx().dragged_id().is_some();
             if settings != before {
-                self.edit(|p| p.settings = settings);
+                self.edit_settings(settings, dragging);
+            } else if !dragging {
+                self.settings_drag_recorded = false;
             }
         }
         ui.separator();
@@ -1271,6 +1391,32 @@ impl App {
                 self.answer_recovery(ctx, a);
             }
         }
+        if self.pending_open.is_some() {
+            let mut answer = None;
+            egui::Window::new("Save changes?")
+                .collapsible(false)
+                .resizable(false)
+                .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
+                .show(ctx, |ui| {
+                    ui.label(
+                        "The current project has changes that are not saved to a project file.",
+                    );
+                    ui.horizontal(|ui| {
+                        if ui.button("Save").clicked() {
+                            answer = Some(SaveAnswer::Save);
+                        }
+                        if ui.button("Don't save").clicked() {
+                            answer = Some(SaveAnswer::Discard);
+                        }
+                        if ui.button("Cancel").clicked() {
+                            answer = Some(SaveAnswer::Cancel);
+                        }
+                    });
+                });
+            if let Some(a) = answer {
+                self.answer_save(ctx, a);
+            }
+        }
         if self.show_help {
             egui::Window::new("Shortcuts")
                 .open(&mut self.show_help)
@@ -1285,6 +1431,14 @@ impl App {
                 });
         }
     }
+}
+
+/// The answers to "save changes?".
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SaveAnswer {
+    Save,
+    Discard,
+    Cancel,
 }
 
 const SHORTCUTS: &[(&str, &str)] = &[
@@ -1704,6 +1858,42 @@ mod tests {
         assert_eq!(h.state().current_frame(), 3);
         wait(&mut h, "frame 3", |a| a.shown() == Some(3));
 
+        // Correct a joint on frame 3 by dragging it: frame 3 becomes a key frame for it and
+        // tracking re-runs from there, keeping the correction.
+        let wrist = h.state().points(3)[Joint::LeftWrist].unwrap().0;
+        let moved_to = wrist + nalgebra::Vector2::new(6.0, -4.0);
+        let (from, to) = (screen(&h, wrist), screen(&h, moved_to));
+        drag(&mut h, from, to);
+        assert!(h.state().busy(), "re-tracking: {}", h.state().status());
+        wait(&mut h, "re-tracking and lifting", |a| {
+            !a.busy() && a.project().is_some_and(|p| p.skeleton.is_some())
+        });
+        let p = h.state().project().unwrap();
+        let key = p.keys.frames[&3][Joint::LeftWrist].unwrap();
+        assert!((key - moved_to).norm() < 1.5, "key {key} vs {moved_to}");
+        let tracked = &p.tracks.as_ref().unwrap().frames[3].points[Joint::LeftWrist];
+        assert!((tracked.pos - key).norm() < 1e-9, "the track keeps the key");
+
+        // Flip a limb's depth on this frame: an override is recorded and the lift re-runs;
+        // after undoing it, the earlier result's choices are still known and it flips again.
+        let flips_before = h.state().project().unwrap().overrides.len();
+        h.state_mut().flip(Bone::ALL[4]);
+        assert_eq!(
+            h.state().project().unwrap().overrides.len(),
+            flips_before + 1
+        );
+        wait(&mut h, "the lift after a flip", |a| !a.busy());
+        h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+        h.step();
+        assert_eq!(h.state().project().unwrap().overrides.len(), flips_before);
+        h.state_mut().flip(Bone::ALL[7]);
+        assert!(
+            !h.state().status().contains("not known"),
+            "{}",
+            h.state().status()
+        );
+        wait(&mut h, "the lift after the second flip", |a| !a.busy());
+
         // Orbit the 3D view by dragging in it (the right-hand panel).
         let before = h.state().orbit();
         drag(&mut h, egui::pos2(1200.0, 400.0), egui::pos2(1260.0, 420.0));
@@ -1743,5 +1933,59 @@ mod tests {
         assert_eq!(p.keys, expected.keys);
         assert_eq!(p.tracks, expected.tracks);
         assert!(p.skeleton.is_some());
+        // Recent files survive the restart.
+        assert_eq!(h.state().recent().first(), Some(&video));
+
+        // The recovered work is not in a project file: opening another video asks first.
+        let other = dir.path().join("other");
+        std::fs::create_dir(&other).unwrap();
+        image::RgbImage::new(8, 6)
+            .save(other.join("f0.png"))
+            .unwrap();
+        let ctx = h.ctx.clone();
+        h.state_mut().open_path(&ctx, &other);
+        h.run_steps(3);
+        assert!(h.state().asks_to_save());
+        h.get_by_label("Cancel").click();
+        h.run_steps(2);
+        assert!(!h.state().asks_to_save());
+        assert_eq!(
+            h.state().project().unwrap().video,
+            video,
+            "cancel keeps the work"
+        );
+        let saved = dir.path().join("saved.videomocap.json");
+        dialogs.answers.borrow_mut().push_back(saved.clone());
+        h.state_mut().open_path(&ctx, &other);
+        h.run_steps(3);
+        h.get_by_label("Save").click();
+        h.run_steps(2);
+        assert!(
+            saved.is_file(),
+            "saved before opening: {}",
+            h.state().status()
+        );
+        assert_eq!(Project::load(&saved).unwrap().keys, expected.keys);
+        wait(&mut h, "the other folder", |a| a.frame_count() == 1);
+    }
+
+    /// A slider drag changes the settings many times but is one undo step.
+    #[test]
+    fn a_settings_drag_is_one_undo_step() {
+        let dir = tempfile::tempdir().unwrap();
+        let dialogs = PreparedDialogs::default();
+        let mut h = harness(None, &dialogs, &dir.path().join("state"));
+        h.state_mut().project = Some(Project::new(dir.path().join("v.mp4")));
+        let mut s = h.state().project().unwrap().settings;
+        for k in 0..5 {
+            s.height_m = 1.6 + 0.01 * f64::from(k);
+            h.state_mut().edit_settings(s, true);
+        }
+        s.height_m = 1.9;
+        h.state_mut().edit_settings(s, false);
+        h.state_mut().undo();
+        assert!((h.state().project().unwrap().settings.height_m - 1.64).abs() < 1e-9);
+        h.state_mut().undo();
+        assert!((h.state().project().unwrap().settings.height_m - 1.70).abs() < 1e-9);
     }
 }
