@@ -77,8 +77,9 @@ fn swapped(p: &PerJoint<Point3<f64>>, arms: bool, legs: bool) -> PerJoint<Point3
     })
 }
 
+/// Summed joint errors of one frame: [head, trunk and arms; legs] (a swap of arms changes
+/// only the first, a swap of legs only the second).
 fn frame_errors(a: &PerJoint<Point3<f64>>, b: &PerJoint<Point3<f64>>) -> [f64; 2] {
-    // [arms, legs] summed error, rest counted in both entries' caller
     let mut e = [0.0; 2];
     for (j, p) in a.iter() {
         let d = (p - b[j]).norm();

@@ -379,18 +379,7 @@ impl App {
 
     /// Volume mode: processes the point volumes of `dir` on a worker thread.
     fn open_volume(&mut self, ctx: &egui::Context, dir: &Path) {
-        if let Some(r) = &self.running {
-            r.job.cancel();
-        }
-        self.loader = None;
-        self.project = None;
-        self.project_path = None;
-        self.history.clear();
-        self.results_changed();
-        self.texture = None;
-        self.shown = None;
-        self.marking = None;
-        self.current = 0;
+        self.close_current();
         self.volume = Some(VolumeView::new(dir.to_owned()));
         self.orbit = Orbit::default();
         self.running = Some(Running {
@@ -402,13 +391,22 @@ impl App {
     }
 
     fn open_video(&mut self, ctx: &egui::Context, path: &Path) {
-        if let Some(r) = &self.running {
-            r.job.cancel();
-        }
-        self.running = None;
-        self.volume = None;
+        self.close_current();
         self.loader = Some(FrameLoader::open(path.to_owned(), ctx.clone()));
         self.project = Some(Project::new(path.to_owned()));
+        self.results_changed();
+        self.view.fit();
+        self.status = format!("Opening {}…", path.display());
+    }
+
+    /// Stops any job and forgets the open video, project or volume sequence.
+    fn close_current(&mut self) {
+        if let Some(r) = self.running.take() {
+            r.job.cancel();
+        }
+        self.loader = None;
+        self.volume = None;
+        self.project = None;
         self.project_path = None;
         self.history.clear();
         self.results_changed();
@@ -416,8 +414,6 @@ impl App {
         self.shown = None;
         self.texture = None;
         self.marking = None;
-        self.view.fit();
-        self.status = format!("Opening {}…", path.display());
     }
 
     fn set_project(&mut self, p: Project) {

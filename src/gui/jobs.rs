@@ -127,17 +127,15 @@ impl Job {
         let cancel = Arc::new(AtomicBool::new(false));
         let flag = cancel.clone();
         std::thread::spawn(move || {
-            let progress_tx = std::sync::Mutex::new(tx.clone());
+            let progress_tx = tx.clone();
             let repaint = ctx.clone();
             let progress = move |done: usize, total: usize| {
-                if let Ok(t) = progress_tx.lock() {
-                    let _ = t.send(JobEvent::Progress {
-                        done,
-                        total,
-                        stage: "volumes".to_owned(),
-                        frame: None,
-                    });
-                }
+                let _ = progress_tx.send(JobEvent::Progress {
+                    done,
+                    total,
+                    stage: "volumes".to_owned(),
+                    frame: None,
+                });
                 repaint.request_repaint();
             };
             let result = process_directory(&dir, &VolumeParams::default(), fps, &progress, &flag)

@@ -66,8 +66,8 @@ pub fn voxelise(
             }
         }
     }
+    let span = (hi - lo) + Vector3::repeat(0.6);
     for _ in 0..params.noise_voxels {
-        let span = (hi - lo) + Vector3::repeat(0.6);
         let r = Vector3::new(
             rng.random::<f64>(),
             rng.random::<f64>(),

@@ -313,11 +313,11 @@ pub fn skeleton_curve(
     let head = limbs.remove(head_at);
     let head_start = points[head.0[0]];
     let head_attach = head.1;
+    // Limbs leaving the head's branch node first, then by distance from the head.
+    let rank = |l: &(Vec<usize>, usize)| (l.1 != head_attach, (points[l.0[0]] - head_start).norm());
     limbs.sort_by(|a, b| {
-        // Limbs leaving the head's branch node first, then by distance from the head.
-        let da = (points[a.0[0]] - head_start).norm() + if a.1 == head_attach { 0.0 } else { 1e3 };
-        let db = (points[b.0[0]] - head_start).norm() + if b.1 == head_attach { 0.0 } else { 1e3 };
-        da.total_cmp(&db)
+        let (ra, rb) = (rank(a), rank(b));
+        ra.0.cmp(&rb.0).then(ra.1.total_cmp(&rb.1))
     });
     // limbs: two arms then two legs (invariant: exactly four remain, checked by the leaf count).
     let [arm1, arm2, leg1, leg2]: [(Vec<usize>, usize); 4] = limbs

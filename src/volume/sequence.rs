@@ -37,8 +37,6 @@ pub struct Assembled {
     pub warnings: Vec<String>,
     /// How left and right were decided.
     pub sides_from: SidesFrom,
-    /// Share of frames (with a pose) where each limb slot was articulated.
-    pub articulated: [f64; 4],
 }
 
 type Limb = super::bodies::LimbFit;
@@ -106,10 +104,8 @@ pub fn assemble(
     // 2. Static lengths from articulated frames.
     let mut sums = [[0.0f64; 2]; 4];
     let mut counts = [0usize; 4];
-    let mut posed = 0usize;
     for i in 0..results.len() {
         let Some(limbs) = labelled(i) else { continue };
-        posed += 1;
         for (k, l) in limbs.iter().enumerate() {
             if let Some(s) = l.split {
                 sums[k][0] += (s - l.root).norm();
@@ -147,7 +143,6 @@ pub fn assemble(
         let chest_pelvis = model.length_to(Joint::Chest);
         neck_chest / (neck_chest + chest_pelvis)
     };
-    let articulated = counts.map(|c| c as f64 / posed.max(1) as f64);
 
     // 3. Sides, voted frame by frame: left = up × front, where front is the way knees bend
     //    (or, if no knee ever bends, the opposite of the way elbows bend). The arms then take
@@ -193,20 +188,25 @@ pub fn assemble(
     // Arm 0 is on leg 0's side when votes[0] > 0; it is the left arm when that leg is left.
     let swap_arms = (votes[0] < 0) != swap_legs;
 
-    // 4. The 16 joints.
-    let pose = |i: usize| -> Option<PerJoint<Point3<f64>>> {
-        let (Ok(f), Some(mut limbs)) = (&results[i], labelled(i)) else {
-            return None;
-        };
-        let mut frac = fraction;
+    // Labels → slots (left arm, right arm, left leg, right leg), in one place.
+    let to_slots = |mut x: [usize; 4]| {
         if swap_arms {
-            limbs.swap(0, 1);
-            frac.swap(0, 1);
+            x.swap(0, 1);
         }
         if swap_legs {
-            limbs.swap(2, 3);
-            frac.swap(2, 3);
+            x.swap(2, 3);
         }
+        x
+    };
+    let slots: Vec<Option<[usize; 4]>> = order.iter().map(|o| o.map(to_slots)).collect();
+    let frac = to_slots([0, 1, 2, 3]).map(|label| fraction[label]);
+
+    // 4. The 16 joints.
+    let pose = |i: usize| -> Option<PerJoint<Point3<f64>>> {
+        let (Ok(f), Some(s)) = (&results[i], slots[i]) else {
+            return None;
+        };
+        let limbs = s.map(|k| f.fit.limbs[k]);
         let mid = |k: usize| {
             let l = &limbs[k];
             l.split
@@ -289,20 +289,6 @@ pub fn assemble(
         .zip(&lengths)
         .map(|(b, l)| (b.key(), l.max(1e-6)))
         .collect();
-    let slots = order
-        .iter()
-        .map(|o| {
-            o.map(|mut o| {
-                if swap_arms {
-                    o.swap(0, 1);
-                }
-                if swap_legs {
-                    o.swap(2, 3);
-                }
-                o
-            })
-        })
-        .collect();
     Assembled {
         skeleton: Skeleton3d {
             // The volume has no camera; a nominal one keeps the file format whole.
@@ -314,6 +300,5 @@ pub fn assemble(
         slots,
         warnings,
         sides_from,
-        articulated,
     }
 }
