@@ -68,6 +68,23 @@ pub enum Command {
     Synth(SynthArgs),
     /// Measure decoding and rendering speed and print a table.
     Bench(BenchArgs),
+    /// (Testing) Save a project and write its exports over and over until killed; the
+    /// crash-safety test kills it at random moments and checks every file left behind.
+    #[command(hide = true)]
+    StressWrite(StressWriteArgs),
+}
+
+/// `stress-write`.
+#[derive(Debug, Args)]
+pub struct StressWriteArgs {
+    /// The project to rewrite in place (it must hold a skeleton).
+    pub project: PathBuf,
+    /// Directory for motion.bvh, joints3d.csv and motion.trc.
+    #[arg(long)]
+    pub out_dir: PathBuf,
+    /// Stop after this many rounds (default: until killed).
+    #[arg(long)]
+    pub rounds: Option<u64>,
 }
 
 /// `track`.

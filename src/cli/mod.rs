@@ -11,6 +11,7 @@ mod export;
 mod info;
 mod lift;
 mod run;
+mod stress_write;
 mod synth;
 mod track;
 mod volume;
@@ -61,6 +62,7 @@ pub fn run(command: Command, global: &GlobalArgs) -> Result<(), ExitError> {
         Command::Export(a) => export::run(&a, global),
         Command::Run(a) => run::run(&a, global),
         Command::Volume(a) => volume::run(&a, global),
+        Command::StressWrite(a) => stress_write::run(&a),
         Command::Gui { .. } => Err(ExitError::bad_input(anyhow::anyhow!(
             "the desktop app is opened by main, not by the CLI"
         ))),

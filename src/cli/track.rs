@@ -93,6 +93,20 @@ pub fn report(out: &TrackOutput, global: &GlobalArgs) {
             weak.len()
         ),
     );
+    if let (Some(first), Some(last)) = (out.damaged.first(), out.damaged.last()) {
+        let place = if first == last {
+            format!("frame {first}")
+        } else {
+            format!("between frames {first} and {last}")
+        };
+        say(
+            global,
+            &format!(
+                "  {} frame(s) could not be decoded (damaged file, {place}): tracked as lost and filled like occlusions",
+                out.damaged.len()
+            ),
+        );
+    }
     for s in weak.iter().take(20) {
         say(
             global,
@@ -167,6 +181,7 @@ pub fn run(a: &TrackArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             "seconds": seconds,
             "shrink": out.shrink,
             "spans": out.spans,
+            "damaged_frames": out.damaged,
             "reference": score.map(|s| serde_json::json!({
                 "mean_px": s.overall.mean_px(),
                 "pck01": s.overall.pck01(),

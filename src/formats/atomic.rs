@@ -16,8 +16,8 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), FormatError> {
         _ => Path::new("."),
     };
     let mut tmp = tempfile::Builder::new()
-        .prefix(".videomocap-")
-        .suffix(".tmp")
+        .prefix(TEMP_PREFIX)
+        .suffix(TEMP_SUFFIX)
         .tempfile_in(dir)
         .map_err(err)?;
     tmp.write_all(bytes).map_err(err)?;
@@ -33,7 +33,40 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), FormatError> {
     }
     tmp.as_file().sync_all().map_err(err)?;
     tmp.persist(path).map_err(|e| err(e.error))?;
+    remove_stale_temporaries(dir);
     Ok(())
+}
+
+/// Prefix and suffix of our temporary files.
+const TEMP_PREFIX: &str = ".videomocap-";
+const TEMP_SUFFIX: &str = ".tmp";
+
+/// Age past which a temporary file of ours can only be left over from a killed save.
+const STALE_AFTER: std::time::Duration = std::time::Duration::from_secs(600);
+
+/// Removes temporary files a killed or crashed save left in `dir` (ours only, by name, and only
+/// when older than [`STALE_AFTER`], so a save in progress elsewhere is never touched). Best
+/// effort: errors are ignored.
+fn remove_stale_temporaries(dir: &Path) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let name = name.to_string_lossy();
+        if !(name.starts_with(TEMP_PREFIX) && name.ends_with(TEMP_SUFFIX)) {
+            continue;
+        }
+        let stale = entry
+            .metadata()
+            .and_then(|m| m.modified())
+            .ok()
+            .and_then(|t| t.elapsed().ok())
+            .is_some_and(|age| age > STALE_AFTER);
+        if stale {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
 }
 
 #[cfg(unix)]
@@ -68,6 +101,30 @@ mod tests {
         std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o600)).unwrap();
         write_atomically(&path, b"b").unwrap();
         assert_eq!(mode(&path), 0o600);
+    }
+
+    #[test]
+    fn temporaries_left_by_a_killed_save_are_removed_by_the_next_save() {
+        let dir = tempfile::tempdir().unwrap();
+        let old = dir.path().join(".videomocap-abc123.tmp");
+        let fresh = dir.path().join(".videomocap-def456.tmp");
+        let other = dir.path().join(".other-abc.tmp");
+        for p in [&old, &fresh, &other] {
+            std::fs::write(p, b"partial").unwrap();
+        }
+        let hour_ago = std::time::SystemTime::now() - std::time::Duration::from_secs(3600);
+        for p in [&old, &other] {
+            std::fs::File::options()
+                .write(true)
+                .open(p)
+                .unwrap()
+                .set_modified(hour_ago)
+                .unwrap();
+        }
+        write_atomically(&dir.path().join("p.json"), b"x").unwrap();
+        assert!(!old.exists(), "a stale temporary of ours stays");
+        assert!(fresh.exists(), "a save in progress was disturbed");
+        assert!(other.exists(), "someone else's file was removed");
     }
 
     #[test]

@@ -923,6 +923,13 @@ impl App {
                     self.frame_count(),
                     self.spans.len()
                 );
+                if !out.damaged.is_empty() {
+                    self.status += &format!(
+                        "; {} damaged frame(s) could not be decoded and count as lost (first: {})",
+                        out.damaged.len(),
+                        out.damaged[0]
+                    );
+                }
                 self.start_lift();
             }
             Err(e) => {

@@ -77,6 +77,8 @@ pub enum TrackError {
     },
     #[error("re-tracking from frame {frame} needs an earlier result that covers it")]
     NoEarlierResult { frame: usize },
+    #[error("{path}: frame {frame}, where tracking starts, could not be decoded (damaged file?)")]
+    StartFrameDamaged { path: PathBuf, frame: usize },
     #[error("cancelled")]
     Cancelled,
 }
@@ -133,6 +135,9 @@ pub struct TrackOutput {
     pub spans: Vec<WeakSpan>,
     /// The integer shrink factor of the working scale.
     pub shrink: u32,
+    /// Frames the decoder could not read (damaged or cut-short files), ascending. They are
+    /// tracked as lost (reliability 0) and filled like occlusions, not fatal.
+    pub damaged: Vec<usize>,
 }
 
 /// Converts between video pixels and the working scale (pixel centres at integers).
@@ -236,6 +241,7 @@ pub fn track_video(
         width: info.width,
         height: info.height,
         threads: job.threads,
+        damaged: Vec::new(),
         done: 0,
         total: (n - start) + if job.from.is_none() { first_key } else { 0 },
         progress,
@@ -335,7 +341,11 @@ pub fn track_video(
         max_gap,
         &|i, j| job.keys.is_key(i, j),
     );
+    let mut damaged = std::mem::take(&mut ctx.damaged);
+    damaged.sort_unstable();
+    damaged.dedup();
     Ok(TrackOutput {
+        damaged,
         tracks: Tracks2d {
             source: SourceInfo {
                 path: info.path.clone(),
@@ -368,6 +378,8 @@ struct PassContext<'a, 'p> {
     width: u32,
     height: u32,
     threads: usize,
+    /// Frames that could not be decoded so far.
+    damaged: Vec<usize>,
     done: usize,
     total: usize,
     progress: &'p mut (dyn FnMut(&TrackProgress) + Send),
@@ -414,11 +426,25 @@ impl PassContext<'_, '_> {
         };
         let mut handle = |ctx_done: &mut usize,
                           index: usize,
-                          image: Arc<RgbImage>|
+                          image: Option<Arc<RgbImage>>|
          -> Result<PerJoint<JointResult>, TrackError> {
             if cancel.load(Ordering::Relaxed) {
                 return Err(TrackError::Cancelled);
             }
+            let Some(image) = image else {
+                // A damaged frame: the last pose, lost; the tracker waits for the next frame.
+                let t = tracker
+                    .as_ref()
+                    .ok_or_else(|| TrackError::StartFrameDamaged {
+                        path: path.clone(),
+                        frame: index,
+                    })?;
+                *ctx_done += 1;
+                return Ok(to_video(t.pose().map(|_, j| JointResult {
+                    pos: j.pos,
+                    reliability: 0.0,
+                })));
+            };
             let result = match tracker.as_mut() {
                 None => {
                     let work = pose.map(|_, p| scale.to_work(*p));
@@ -469,11 +495,20 @@ impl PassContext<'_, '_> {
                 }),
             });
         };
+        let damaged = &mut self.damaged;
         if self.threads <= 1 {
             for &index in order {
-                let frame = self.video.frame(index)?;
-                check(index, &frame.image)?;
-                let r = handle(&mut done, index, scale.shrink(frame.image))?;
+                let image = match undamaged(self.video.frame(index))? {
+                    Some(frame) => {
+                        check(index, &frame.image)?;
+                        Some(scale.shrink(frame.image))
+                    }
+                    None => {
+                        damaged.push(index);
+                        None
+                    }
+                };
+                let r = handle(&mut done, index, image)?;
                 emit(done, index, &r);
                 out.push(r);
             }
@@ -484,8 +519,8 @@ impl PassContext<'_, '_> {
             let stop_flag = AtomicBool::new(false);
             let stop = &stop_flag;
             std::thread::scope(|s| -> Result<(), TrackError> {
-                let (tx, rx) =
-                    std::sync::mpsc::sync_channel::<Result<(usize, Arc<RgbImage>), TrackError>>(6);
+                type Decoded = Result<(usize, Option<Arc<RgbImage>>), TrackError>;
+                let (tx, rx) = std::sync::mpsc::sync_channel::<Decoded>(6);
                 s.spawn(move || {
                     for chunk in decode_order(&order_owned) {
                         let mut images = Vec::with_capacity(chunk.decode.len());
@@ -493,14 +528,15 @@ impl PassContext<'_, '_> {
                             if stop.load(Ordering::Relaxed) {
                                 return;
                             }
-                            let item =
-                                video
-                                    .frame(index)
-                                    .map_err(TrackError::from)
-                                    .and_then(|frame| {
+                            let item = undamaged(video.frame(index)).and_then(|frame| {
+                                frame
+                                    .map(|frame| {
                                         check(index, &frame.image)?;
-                                        Ok((index, scale.shrink(frame.image)))
-                                    });
+                                        Ok(scale.shrink(frame.image))
+                                    })
+                                    .transpose()
+                                    .map(|image| (index, image))
+                            });
                             images.push(item);
                         }
                         if chunk.reverse {
@@ -516,6 +552,9 @@ impl PassContext<'_, '_> {
                 let result = (|| {
                     for _ in 0..order.len() {
                         let (index, image) = rx.recv().map_err(|_| TrackError::Cancelled)??;
+                        if image.is_none() {
+                            damaged.push(index);
+                        }
                         let r = handle(&mut done, index, image)?;
                         emit(done, index, &r);
                         out.push(r);
@@ -529,6 +568,18 @@ impl PassContext<'_, '_> {
         }
         self.done = done;
         Ok(out)
+    }
+}
+
+/// A decoded frame, `None` when the file is damaged there (the decoder's error for that
+/// frame), or another error.
+fn undamaged(
+    frame: Result<crate::video::Frame, VideoError>,
+) -> Result<Option<crate::video::Frame>, TrackError> {
+    match frame {
+        Ok(f) => Ok(Some(f)),
+        Err(VideoError::Decode { .. }) => Ok(None),
+        Err(e) => Err(e.into()),
     }
 }
 

@@ -43,6 +43,10 @@ pub struct FfmpegSource {
     last_decoded: Option<usize>,
     /// Whether end of stream was sent to the decoder since the last seek.
     eof_sent: bool,
+    /// While seeking: the target's timestamp. Until its packet is sent the decoder skips
+    /// non-reference frames, which no later frame needs (exact, and about half the work on
+    /// clips with B-frames).
+    skip_until_pts: Option<i64>,
     info: VideoInfo,
 }
 
@@ -84,7 +88,19 @@ impl FfmpegSource {
             path: path.to_owned(),
             source,
         })?;
-        let mut input = ff::format::input(path).map_err(|e| not_a_video(path, e))?;
+        let mut input = ff::format::input(path).map_err(|e| {
+            let mp4 = path.extension().and_then(|e| e.to_str()).is_some_and(|e| {
+                ["mp4", "mov", "m4v"].contains(&e.to_ascii_lowercase().as_str())
+            });
+            if mp4 && e == ff::Error::InvalidData {
+                not_a_video(
+                    path,
+                    format!("{e}; an MP4/MOV recording cut short, before its index was written, reads like this"),
+                )
+            } else {
+                not_a_video(path, e)
+            }
+        })?;
         let stream = input
             .streams()
             .best(ff::media::Type::Video)
@@ -185,6 +201,7 @@ impl FfmpegSource {
             scaler: None,
             last_decoded: None,
             eof_sent: false,
+            skip_until_pts: None,
             info,
         };
         me.seek_to_keyframe_before(0)?;
@@ -219,7 +236,19 @@ impl FfmpegSource {
         self.decoder.flush();
         self.last_decoded = None;
         self.eof_sent = false;
+        self.set_skip_until(None);
         Ok(())
+    }
+
+    /// Skips non-reference frames until the packet with timestamp `pts` (or a later one) is sent;
+    /// `None` decodes everything.
+    fn set_skip_until(&mut self, pts: Option<i64>) {
+        self.skip_until_pts = pts;
+        self.decoder.skip_frame(if pts.is_some() {
+            ff::Discard::NonReference
+        } else {
+            ff::Discard::Default
+        });
     }
 
     /// Seeks to the last keyframe at or before frame `index`.
@@ -250,6 +279,11 @@ impl FfmpegSource {
             while let Some((s, packet)) = self.input.packets().next() {
                 if s.index() != self.stream_index {
                     continue;
+                }
+                if let Some(until) = self.skip_until_pts
+                    && packet.pts().or(packet.dts()).is_none_or(|ts| ts >= until)
+                {
+                    self.set_skip_until(None);
                 }
                 // A damaged packet is skipped; the decoder conceals or drops its frame.
                 let _ = self.decoder.send_packet(&packet);
@@ -396,15 +430,21 @@ impl VideoSource for FfmpegSource {
                 count: self.pts.len(),
             });
         }
-        // Decode on from the current position when the target is a little ahead.
-        let ahead = self
-            .last_decoded
-            .is_some_and(|last| index > last && index - last <= DECODE_ON_LIMIT);
+        // Decode on from the current position when the target is a little ahead, or anywhere
+        // ahead in the same group of pictures (a seek would restart at the same keyframe).
+        let gop_start = self.keyframes[self
+            .keyframes
+            .partition_point(|&f| f <= index)
+            .saturating_sub(1)];
+        let ahead = self.last_decoded.is_some_and(|last| {
+            index > last && (index - last <= DECODE_ON_LIMIT || last >= gop_start)
+        });
         if ahead && let Some(frame) = self.decode_forward_to(index)? {
             return self.convert_to_rgb(&frame, index);
         }
         // Seek to the keyframe before; if that lands too late (inexact index), step back.
         let mut k = self.seek_to_keyframe_before(index)?;
+        self.set_skip_until(Some(self.pts[index]));
         loop {
             if let Some(frame) = self.decode_forward_to(index)? {
                 return self.convert_to_rgb(&frame, index);
@@ -417,6 +457,7 @@ impl VideoSource for FfmpegSource {
             }
             k -= 1;
             self.seek_to_keyframe(k)?;
+            self.set_skip_until(Some(self.pts[index]));
         }
     }
 }

@@ -68,10 +68,24 @@ pub fn read_cloud(path: &Path) -> Result<PointCloud, VolumeError> {
         path: path.to_owned(),
         problem: "unknown point cloud type (expected .ply, .xyz, .txt or .voxels.json)".into(),
     })?;
+    let bytes = std::fs::read(path).map_err(io_error(path))?;
+    parse_cloud(kind, &bytes, path)
+}
+
+/// Parses one frame's points from the bytes of a file of the given kind; `path` names the
+/// file in errors. This is what [`read_cloud`] does after reading the file, and what the
+/// fuzz targets call.
+pub fn parse_cloud(kind: CloudKind, bytes: &[u8], path: &Path) -> Result<PointCloud, VolumeError> {
+    let text = || {
+        std::str::from_utf8(bytes).map_err(|e| VolumeError::Invalid {
+            path: path.to_owned(),
+            problem: format!("not UTF-8 text: {e}"),
+        })
+    };
     let points = match kind {
-        CloudKind::Ply => read_ply(path)?,
-        CloudKind::Xyz => read_xyz(path)?,
-        CloudKind::Voxels => VoxelGrid::load(path)?.centres(),
+        CloudKind::Ply => parse_ply(bytes, path)?,
+        CloudKind::Xyz => parse_xyz(text()?, path)?,
+        CloudKind::Voxels => VoxelGrid::parse(text()?, path)?.centres(),
     };
     if let Some(i) = points
         .iter()
@@ -92,9 +106,8 @@ fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> VolumeError + '_ {
     }
 }
 
-fn read_ply(path: &Path) -> Result<PointCloud, VolumeError> {
-    let file = std::fs::File::open(path).map_err(io_error(path))?;
-    let mut reader = std::io::BufReader::new(file);
+fn parse_ply(bytes: &[u8], path: &Path) -> Result<PointCloud, VolumeError> {
+    let mut reader = bytes;
     let parser = ply_rs_bw::parser::Parser::<DefaultElement>::new();
     let ply = parser
         .read_ply(&mut reader)
@@ -141,8 +154,7 @@ fn read_ply(path: &Path) -> Result<PointCloud, VolumeError> {
         .collect()
 }
 
-fn read_xyz(path: &Path) -> Result<PointCloud, VolumeError> {
-    let text = std::fs::read_to_string(path).map_err(io_error(path))?;
+fn parse_xyz(text: &str, path: &Path) -> Result<PointCloud, VolumeError> {
     let mut points = Vec::new();
     for (n, line) in text.lines().enumerate() {
         let line = line.split('#').next().unwrap_or("").trim();

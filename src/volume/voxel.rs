@@ -130,7 +130,12 @@ impl VoxelGrid {
 
     /// Reads and checks a `.voxels.json` file.
     pub fn load(path: &Path) -> Result<VoxelGrid, VolumeError> {
-        let raw: VoxelFile = parse_json(&read_text(path)?, path)?;
+        VoxelGrid::parse(&read_text(path)?, path)
+    }
+
+    /// Parses and checks `.voxels.json` text; `path` names the file in errors.
+    pub fn parse(text: &str, path: &Path) -> Result<VoxelGrid, VolumeError> {
+        let raw: VoxelFile = parse_json(text, path)?;
         check_header(path, VOXELS_FORMAT, raw.format.as_deref(), raw.version)?;
         let invalid = |problem: String| VolumeError::Invalid {
             path: path.to_owned(),
