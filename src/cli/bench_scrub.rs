@@ -1,12 +1,15 @@
 //! `videomocap bench scrub`: what the desktop app's frame access costs on a long 1080p clip made
 //! with `ffmpeg -f lavfi`: opening (the frame index), random seeks, stepping through frames,
 //! revisiting cached frames (decode cache plus the RGB → RGBA copy the texture upload needs),
-//! and the process's peak memory. The app does the same calls on its frame-loader thread.
+//! tracking a 300-frame span from the middle, and the process's peak memory. The app does the same calls on its frame-loader thread.
 
 use super::args::{BenchArgs, GlobalArgs};
 use super::{ExitError, say};
 use rand::{Rng, SeedableRng};
+use std::sync::atomic::AtomicBool;
 use std::time::Instant;
+use videomocap::formats::Marks;
+use videomocap::track::{TrackJob, TrackerParams, track_video};
 use videomocap::video::{OpenOptions, Video};
 
 pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
@@ -63,6 +66,25 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         }
     }
     let cached_fps = (5 * window) as f64 / t.elapsed().as_secs_f64();
+    let rss_scrub = peak_rss_mib();
+    drop(video);
+
+    // Track a 300-frame span from the middle, as a user tracking one stretch of a long clip.
+    let span_len = n.min(300);
+    let span_start = (n - span_len) / 2;
+    let mut span = Video::open(&file, &OpenOptions::default())
+        .and_then(|v| v.into_span(span_start, span_len))
+        .map_err(ExitError::failed)?;
+    let (w, h) = (span.info().width, span.info().height);
+    let job = TrackJob::from_marks(&figure_marks(w, h)?, TrackerParams::default(), 2);
+    let t = Instant::now();
+    track_video(&mut span, &job, &mut |_| {}, &AtomicBool::new(false))
+        .map_err(ExitError::failed)?;
+    let track_fps = span_len as f64 / t.elapsed().as_secs_f64();
+    let track_label = format!(
+        "track frames {span_start}–{} (2 threads)",
+        span_start + span_len - 1
+    );
     let pct = |q: f64| seeks[((seeks.len() - 1) as f64 * q).round() as usize];
     let rows = [
         (
@@ -84,12 +106,17 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             "revisit cached frames incl. RGBA copy",
             format!("{cached_fps:.0} frames/s"),
         ),
+        (track_label.as_str(), format!("{track_fps:.0} frames/s")),
         (
             "peak memory (VmHWM) before open",
             format!("{rss_before:.0} MiB"),
         ),
         (
-            "peak memory (VmHWM) after all",
+            "peak memory (VmHWM) after scrubbing",
+            format!("{rss_scrub:.0} MiB"),
+        ),
+        (
+            "peak memory (VmHWM) after tracking",
             format!("{:.0} MiB", peak_rss_mib()),
         ),
     ];
@@ -101,6 +128,20 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         println!("(no frames)");
     }
     Ok(())
+}
+
+/// The synthetic sample's marks (640×480) scaled to a `w`×`h` frame: a figure to track (on
+/// the test pattern it measures speed and memory, not accuracy).
+fn figure_marks(w: u32, h: u32) -> Result<Marks, ExitError> {
+    let mut marks = Marks::load(std::path::Path::new(
+        "sample_videos/synth_walk_oblique/marks.json",
+    ))
+    .map_err(ExitError::failed)?;
+    for p in marks.points.0.iter_mut() {
+        p.x *= f64::from(w - 1) / 639.0;
+        p.y *= f64::from(h - 1) / 479.0;
+    }
+    Ok(marks)
 }
 
 /// The process's peak resident memory, MiB (Linux; 0 elsewhere).

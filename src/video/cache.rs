@@ -40,6 +40,11 @@ impl FrameCache {
         self.frames.len() * self.frame_bytes
     }
 
+    /// Bytes of one frame.
+    pub fn frame_bytes(&self) -> usize {
+        self.frame_bytes
+    }
+
     /// How many frames fit.
     pub fn capacity_frames(&self) -> usize {
         self.frames.cap().get()

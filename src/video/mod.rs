@@ -11,6 +11,7 @@ mod error;
 #[cfg(feature = "ffmpeg")]
 mod ffmpeg;
 mod image_sequence;
+mod span;
 
 pub use cache::{DEFAULT_CACHE_BYTES, FrameCache};
 #[cfg(feature = "ffmpeg")]
@@ -19,6 +20,7 @@ pub use error::VideoError;
 #[cfg(feature = "ffmpeg")]
 pub use ffmpeg::FfmpegSource;
 pub use image_sequence::{DEFAULT_SEQUENCE_FPS, ImageSequence};
+pub use span::SpanSource;
 
 use image::RgbImage;
 use serde::Serialize;
@@ -147,6 +149,14 @@ impl Video {
             time_s: self.source.time_of(index),
             image,
         })
+    }
+
+    /// Frames `start..start + len` of this video as a video of its own, numbered from 0 (the
+    /// cache starts empty).
+    pub fn into_span(self, start: usize, len: usize) -> Result<Video, VideoError> {
+        let cache_bytes = self.cache.capacity_frames() * self.cache.frame_bytes();
+        let span = SpanSource::new(self.source, start, len)?;
+        Ok(Video::from_source(Box::new(span), cache_bytes))
     }
 
     /// Bytes currently held by the frame cache.
