@@ -28,6 +28,10 @@ pub(super) fn init() {
 /// than decoding on (a seek costs up to one GOP of decoding; most GOPs are ≤ 250 frames).
 const DECODE_ON_LIMIT: usize = 48;
 
+/// Keyframes a seek steps back at most when the frame does not come out after the nearest
+/// one (inexact keyframe flags); beyond that the frame counts as damaged.
+const STEP_BACK_KEYFRAMES: usize = 2;
+
 /// A video file read through FFmpeg.
 pub struct FfmpegSource {
     input: ff::format::context::Input,
@@ -443,13 +447,16 @@ impl VideoSource for FfmpegSource {
             return self.convert_to_rgb(&frame, index);
         }
         // Seek to the keyframe before; if that lands too late (inexact index), step back.
+        // Stepping back is bounded: a damaged frame must fail fast, not decode the whole file
+        // back to its start.
         let mut k = self.seek_to_keyframe_before(index)?;
+        let lowest = k.saturating_sub(STEP_BACK_KEYFRAMES);
         self.set_skip_until(Some(self.pts[index]));
         loop {
             if let Some(frame) = self.decode_forward_to(index)? {
                 return self.convert_to_rgb(&frame, index);
             }
-            if k == 0 {
+            if k == lowest {
                 return Err(self.decode_error(
                     index,
                     "the frame could not be decoded (damaged or truncated file?)",
