@@ -99,6 +99,10 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         ),
         ("random seek, worst of 40", format!("{:.0} ms", pct(1.0))),
         (
+            "random seeks within 150 ms",
+            format!("{} of 40", seeks.iter().filter(|&&s| s <= 150.0).count()),
+        ),
+        (
             "step forward one frame at a time",
             format!("{step_fps:.0} frames/s"),
         ),

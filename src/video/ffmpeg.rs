@@ -120,7 +120,7 @@ impl FfmpegSource {
             .map_err(|e| not_a_video(path, e))?;
         ctx.set_threading(ff::codec::threading::Config {
             kind: ff::codec::threading::Type::Frame,
-            count: 0,
+            count: std::thread::available_parallelism().map_or(2, |n| n.get()),
             ..Default::default()
         });
         let decoder = ctx.decoder().video().map_err(|e| not_a_video(path, e))?;
