@@ -91,27 +91,17 @@ fn pose(
     p[Joint::HeadTop] = p[Joint::Neck] + up * len(Joint::Neck, Joint::HeadTop);
     let half_width = subject.shoulder_width_m / 2.0;
     for (side, sign) in [(0usize, 1.0), (1, -1.0)] {
-        let (sh, el, wr, hip, kn, an) = if side == 0 {
-            use Joint::*;
-            (
-                LeftShoulder,
-                LeftElbow,
-                LeftWrist,
-                LeftHip,
-                LeftKnee,
-                LeftAnkle,
-            )
-        } else {
-            use Joint::*;
-            (
-                RightShoulder,
-                RightElbow,
-                RightWrist,
-                RightHip,
-                RightKnee,
-                RightAnkle,
-            )
-        };
+        // The left side's joints, mirrored for the right.
+        let on_side = |j: Joint| if side == 0 { j } else { j.mirrored() };
+        let [sh, el, wr, hip, kn, an] = [
+            Joint::LeftShoulder,
+            Joint::LeftElbow,
+            Joint::LeftWrist,
+            Joint::LeftHip,
+            Joint::LeftKnee,
+            Joint::LeftAnkle,
+        ]
+        .map(on_side);
         let cs = len(Joint::Chest, sh);
         let rise = (cs * cs - half_width * half_width).max(0.0).sqrt();
         p[sh] = p[Joint::Chest] + Vector3::new(sign * half_width.min(cs), rise, 0.0);
