@@ -228,6 +228,10 @@ pub struct SynthArgs {
     /// Stature of the person in the image, pixels (default 0.65 × height).
     #[arg(long)]
     pub person_px: Option<f64>,
+    /// Keep the camera at the distance of --person-px even when joints leave the image later
+    /// in the clip (default: move back until every joint of every frame is on the image).
+    #[arg(long)]
+    pub allow_off_frame: bool,
     /// Sensor noise, standard deviation in 8-bit levels.
     #[arg(long, default_value_t = 2.0)]
     pub noise: f64,

@@ -65,6 +65,7 @@ pub fn params_from_args(a: &SynthArgs) -> Result<SynthParams, ExitError> {
         view,
         focal_px,
         person_px: a.person_px.unwrap_or(0.65 * f64::from(a.height)),
+        allow_off_frame: a.allow_off_frame,
         effects: SensorEffects {
             noise_sigma: a.noise.max(0.0),
             flicker: a.flicker.max(0.0),

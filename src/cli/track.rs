@@ -81,16 +81,21 @@ pub fn report(out: &TrackOutput, global: &GlobalArgs) {
     let weak: Vec<_> = out
         .spans
         .iter()
-        .filter(|s| s.kind == SpanKind::Weak)
+        .filter(|s| s.kind != SpanKind::Interpolated)
         .collect();
+    let off_frame = weak
+        .iter()
+        .filter(|s| s.kind == SpanKind::OffFrame)
+        .count();
     say(
         global,
         &format!(
-            "{} frames tracked (working scale 1/{}); {} short weak runs interpolated, {} weak spans left for review",
+            "{} frames tracked (working scale 1/{}); {} short weak runs interpolated, {} weak spans left for review ({} of them off the frame)",
             out.tracks.frames.len(),
             out.shrink,
             interpolated,
-            weak.len()
+            weak.len(),
+            off_frame
         ),
     );
     if let (Some(first), Some(last)) = (out.damaged.first(), out.damaged.last()) {
@@ -111,8 +116,12 @@ pub fn report(out: &TrackOutput, global: &GlobalArgs) {
         say(
             global,
             &format!(
-                "  weak: {:<15} frames {}–{} (lowest reliability {:.2})",
-                s.joint, s.start, s.end, s.min_reliability
+                "  {:<9}  {:<15} frames {}–{} (lowest reliability {:.2})",
+                format!("{}:", s.kind),
+                s.joint,
+                s.start,
+                s.end,
+                s.min_reliability
             ),
         );
     }

@@ -55,6 +55,9 @@ pub struct WorldSkeleton {
     pub indices: Vec<usize>,
     /// Joints per frame, world metres.
     pub frames: Vec<PerJoint<Point3<f64>>>,
+    /// Per frame, the joints whose 2D track was off the frame (from the `off_frame:` flags):
+    /// estimates, written as gaps where a format has them (TRC) and flagged in the CSV.
+    pub off_frame: Vec<PerJoint<bool>>,
 }
 
 impl WorldSkeleton {
@@ -76,6 +79,7 @@ impl WorldSkeleton {
             fps,
             indices: skeleton.frames.iter().map(|f| f.index).collect(),
             frames,
+            off_frame: skeleton.frames.iter().map(|f| f.off_frame()).collect(),
         })
     }
 

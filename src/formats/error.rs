@@ -27,7 +27,9 @@ pub enum FormatError {
         found: String,
         expected: &'static str,
     },
-    #[error("{path}: version {version} is not supported (this build reads version {supported})")]
+    #[error(
+        "{path}: version {version} is not supported (this build reads up to version {supported}; was it written by a newer videomocap?)"
+    )]
     UnsupportedVersion {
         path: PathBuf,
         version: u32,

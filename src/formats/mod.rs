@@ -10,8 +10,10 @@ mod tracks2d;
 pub use atomic::write_atomically;
 pub use error::FormatError;
 pub use marks::{MARKS_FORMAT, Marks};
-pub use skeleton3d::{Frame3d, SKELETON3D_FORMAT, Skeleton3d};
-pub use tracks2d::{FrameTracks, PointSource, SourceInfo, TRACKS2D_FORMAT, TrackedPoint, Tracks2d};
+pub use skeleton3d::{Frame3d, OFF_FRAME_FLAG, SKELETON3D_FORMAT, Skeleton3d};
+pub use tracks2d::{
+    FrameTracks, PointSource, SourceInfo, TRACKS2D_FORMAT, TRACKS2D_VERSION, TrackedPoint, Tracks2d,
+};
 
 use crate::skeleton::{JOINT_COUNT, Joint};
 use serde::Deserialize;
@@ -49,7 +51,7 @@ pub fn load_any(path: &Path) -> Result<AnyFile, FormatError> {
     }
 }
 
-/// The version of every format this build writes and reads.
+/// The version this build writes and reads of marks, skeleton3d, projects and voxel grids.
 pub const FORMAT_VERSION: u32 = 1;
 
 /// Reads a whole file as text, naming it in the error.
@@ -71,12 +73,24 @@ pub(crate) fn parse_json<T: for<'de> Deserialize<'de>>(
     })
 }
 
-/// Checks the optional `format` and `version` fields of a file.
+/// Checks the optional `format` and `version` fields of a file (version 1 only).
 pub(crate) fn check_header(
     path: &Path,
     expected: &'static str,
     format: Option<&str>,
     version: Option<u32>,
+) -> Result<(), FormatError> {
+    check_header_up_to(path, expected, format, version, FORMAT_VERSION)
+}
+
+/// Checks the optional `format` and `version` fields of a file whose format has reached
+/// version `newest` (every version from 1 to `newest` is read).
+pub(crate) fn check_header_up_to(
+    path: &Path,
+    expected: &'static str,
+    format: Option<&str>,
+    version: Option<u32>,
+    newest: u32,
 ) -> Result<(), FormatError> {
     if let Some(found) = format
         && found != expected
@@ -88,12 +102,12 @@ pub(crate) fn check_header(
         });
     }
     if let Some(v) = version
-        && v != FORMAT_VERSION
+        && !(1..=newest).contains(&v)
     {
         return Err(FormatError::UnsupportedVersion {
             path: path.to_owned(),
             version: v,
-            supported: FORMAT_VERSION,
+            supported: newest,
         });
     }
     Ok(())

@@ -15,6 +15,10 @@ use std::path::Path;
 /// The `format` tag of skeleton3d files.
 pub const SKELETON3D_FORMAT: &str = "videomocap.skeleton3d";
 
+/// The prefix of the frame flag that marks a joint whose 2D track was off the frame
+/// (`off_frame:left_wrist`): its 3D position rests on the tracker's estimate.
+pub const OFF_FRAME_FLAG: &str = "off_frame:";
+
 /// The 16 joints of one frame in camera space.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Frame3d {
@@ -39,6 +43,22 @@ pub struct Skeleton3d {
     pub bone_lengths_m: BTreeMap<String, f64>,
     /// Frames in increasing index order.
     pub frames: Vec<Frame3d>,
+}
+
+impl Frame3d {
+    /// Per joint, whether the frame flags it `off_frame:<joint>`.
+    pub fn off_frame(&self) -> PerJoint<bool> {
+        let mut out = PerJoint::from_fn(|_| false);
+        for flag in &self.flags {
+            if let Some(joint) = flag
+                .strip_prefix(OFF_FRAME_FLAG)
+                .and_then(Joint::from_name)
+            {
+                out[joint] = true;
+            }
+        }
+        out
+    }
 }
 
 #[derive(Serialize, Deserialize)]

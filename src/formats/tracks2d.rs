@@ -1,9 +1,9 @@
 //! `tracks2d.json`: the tracker's output, every joint's image position per frame with its
-//! reliability and whether it was interpolated.
+//! reliability and whether it was interpolated or off the frame.
 
 use super::{
-    FORMAT_VERSION, FormatError, check_frame_order, check_header, joint_columns, joint_names,
-    parse_json, read_text, save_json,
+    FormatError, check_frame_order, check_header_up_to, joint_columns, joint_names, parse_json,
+    read_text, save_json,
 };
 use crate::camera::point_in_frame;
 use crate::skeleton::{Joint, PerJoint};
@@ -13,6 +13,10 @@ use std::path::{Path, PathBuf};
 
 /// The `format` tag of tracks2d files.
 pub const TRACKS2D_FORMAT: &str = "videomocap.tracks2d";
+
+/// The tracks2d version this build writes (it reads 1 and 2). Version 2 added `off_frame`:
+/// a version 1 reader would refuse its points outside the frame.
+pub const TRACKS2D_VERSION: u32 = 2;
 
 /// The video the tracks belong to.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -36,16 +40,19 @@ pub enum PointSource {
     Tracked,
     /// Filled in between reliable frames (occlusion handling).
     Interpolated,
+    /// Outside the image: the position is the tracker's estimate (the limb held at its last
+    /// seen angle to its parent), its confidence 0; never interpolated across the frame.
+    OffFrame,
 }
 
 /// One joint in one frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrackedPoint {
-    /// Position in image pixels.
+    /// Position in image pixels (outside the frame only for [`PointSource::OffFrame`]).
     pub pos: Point2<f64>,
     /// Reliability in `[0, 1]` (the block similarity mapped to this range).
     pub confidence: f32,
-    /// Tracked or interpolated.
+    /// Tracked, interpolated or off the frame.
     pub source: PointSource,
 }
 
@@ -73,6 +80,9 @@ struct FrameFile {
     points: Vec<[f64; 2]>,
     confidence: Vec<f32>,
     interpolated: Vec<bool>,
+    /// Version 2; omitted when no joint of the frame is off it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    off_frame: Option<Vec<bool>>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -95,7 +105,13 @@ impl Tracks2d {
     /// Parses tracks from JSON text; `path` names the source in errors.
     pub fn parse(text: &str, path: &Path) -> Result<Self, FormatError> {
         let raw: TracksFile = parse_json(text, path)?;
-        check_header(path, TRACKS2D_FORMAT, raw.format.as_deref(), raw.version)?;
+        check_header_up_to(
+            path,
+            TRACKS2D_FORMAT,
+            raw.format.as_deref(),
+            raw.version,
+            TRACKS2D_VERSION,
+        )?;
         let columns = joint_columns(path, &raw.joints)?;
         let src = raw.source;
         if src.width == 0 || src.height == 0 || !(src.fps.is_finite() && src.fps > 0.0) {
@@ -111,10 +127,12 @@ impl Tracks2d {
         let mut previous: Option<usize> = None;
         for f in raw.frames {
             let n = raw.joints.len();
+            let off_frame = f.off_frame.unwrap_or_else(|| vec![false; n]);
             for (field, found) in [
                 ("points", f.points.len()),
                 ("confidence", f.confidence.len()),
                 ("interpolated", f.interpolated.len()),
+                ("off_frame", off_frame.len()),
             ] {
                 if found != n {
                     return Err(FormatError::WrongLength {
@@ -149,7 +167,8 @@ impl Tracks2d {
                     });
                 }
                 let pos = Point2::new(x, y);
-                if !point_in_frame(&pos, src.width, src.height) {
+                let inside = point_in_frame(&pos, src.width, src.height);
+                if !inside && !off_frame[col] {
                     return Err(FormatError::OutsideFrame {
                         path: path.to_owned(),
                         joint,
@@ -160,10 +179,30 @@ impl Tracks2d {
                         frame: Some(f.index),
                     });
                 }
+                let problem = if off_frame[col] && inside {
+                    Some("is marked off_frame but lies on the frame")
+                } else if off_frame[col] && f.interpolated[col] {
+                    Some("is marked both off_frame and interpolated")
+                } else if off_frame[col] && confidence != 0.0 {
+                    Some("is marked off_frame with a confidence other than 0")
+                } else {
+                    None
+                };
+                if let Some(problem) = problem {
+                    return Err(FormatError::Invalid {
+                        path: path.to_owned(),
+                        problem: format!(
+                            "joint {joint} in frame {} at ({x:.1}, {y:.1}) {problem}",
+                            f.index
+                        ),
+                    });
+                }
                 points.push(TrackedPoint {
                     pos,
                     confidence,
-                    source: if f.interpolated[col] {
+                    source: if off_frame[col] {
+                        PointSource::OffFrame
+                    } else if f.interpolated[col] {
                         PointSource::Interpolated
                     } else {
                         PointSource::Tracked
@@ -200,7 +239,7 @@ impl Tracks2d {
     fn file(&self) -> TracksFile {
         TracksFile {
             format: Some(TRACKS2D_FORMAT.to_owned()),
-            version: Some(FORMAT_VERSION),
+            version: Some(TRACKS2D_VERSION),
             source: self.source.clone(),
             joints: joint_names(),
             frames: self
@@ -216,6 +255,18 @@ impl Tracks2d {
                         .iter()
                         .map(|p| p.source == PointSource::Interpolated)
                         .collect(),
+                    off_frame: f
+                        .points
+                        .0
+                        .iter()
+                        .any(|p| p.source == PointSource::OffFrame)
+                        .then(|| {
+                            f.points
+                                .0
+                                .iter()
+                                .map(|p| p.source == PointSource::OffFrame)
+                                .collect()
+                        }),
                 })
                 .collect(),
         }

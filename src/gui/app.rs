@@ -517,14 +517,24 @@ impl App {
         let frame = self.current;
         let shown = self.points(frame);
         let move_limb = self.move_limb;
+        // Hand-placed joints stay on the image (marks and key frames must be on it to be saved
+        // and read back); a click beside the image lands on its edge.
+        let size = self.video_info().map(|i| (i.width, i.height));
+        let onto_image = move |q: Point2<f64>| match size {
+            Some((w, h)) => Point2::new(
+                q.x.clamp(-0.5, f64::from(w) - 0.5),
+                q.y.clamp(-0.5, f64::from(h) - 0.5),
+            ),
+            None => q,
+        };
         self.edit(|p| {
             let old = shown[joint].map(|(q, _)| q);
-            p.keys.set(frame, joint, pos);
+            p.keys.set(frame, joint, onto_image(pos));
             if move_limb && let Some(old) = old {
                 let delta = pos - old;
                 for j in descendants(joint) {
                     if let Some((q, _)) = shown[j] {
-                        p.keys.set(frame, j, q + delta);
+                        p.keys.set(frame, j, onto_image(q + delta));
                     }
                 }
             }
@@ -780,6 +790,8 @@ impl App {
             let t = tracked?.points[j];
             let state = if t.source == PointSource::Interpolated {
                 PointState::Interpolated
+            } else if t.source == PointSource::OffFrame {
+                PointState::OffFrame
             } else if t.confidence < weak {
                 PointState::Weak
             } else {
@@ -1278,7 +1290,7 @@ impl App {
                 let mut jump = None;
                 for s in &self.spans {
                     let text = format!(
-                        "{} {}–{} ({:?}, {:.2})",
+                        "{} {}–{} ({}, {:.2})",
                         s.joint, s.start, s.end, s.kind, s.min_reliability
                     );
                     if ui.link(text).clicked() {

@@ -17,6 +17,8 @@ pub enum PointState {
     Weak,
     /// Filled in across an occlusion.
     Interpolated,
+    /// Outside the image: the tracker's estimate.
+    OffFrame,
 }
 
 impl PointState {
@@ -27,6 +29,7 @@ impl PointState {
             PointState::Tracked => Color32::from_rgb(60, 200, 90),
             PointState::Weak => Color32::from_rgb(240, 150, 30),
             PointState::Interpolated => Color32::from_rgb(80, 140, 255),
+            PointState::OffFrame => Color32::from_rgb(170, 110, 230),
         }
     }
 }

@@ -1,6 +1,6 @@
 //! The timeline: a scrubber with frame number and time, key frames marked, and one thin strip
-//! per joint coloured by state (tracked, weak, interpolated, lost) for every frame; clicking a
-//! strip jumps there.
+//! per joint coloured by state (tracked, weak, interpolated, off the frame, lost) for every frame;
+//! clicking a strip jumps there.
 
 use super::frame_view::PointState;
 use egui::{Color32, Rect, Sense, Stroke, Vec2};
@@ -33,6 +33,8 @@ impl Strips {
                     });
                     let colour = if keys.is_key(f.index, j) {
                         PointState::Key.colour()
+                    } else if p.source == PointSource::OffFrame {
+                        PointState::OffFrame.colour()
                     } else if lost {
                         LOST
                     } else if p.source == PointSource::Interpolated {
@@ -113,6 +115,6 @@ pub fn show(
         let k = ((pos.x - rect.left()) / rect.width() * frames as f32).floor();
         jump = Some((k.max(0.0) as usize).min(frames.saturating_sub(1)));
     }
-    response.on_hover_text("one strip per joint, top to bottom in model order: white key frame, green tracked, orange weak, blue interpolated, red lost; click to jump");
+    response.on_hover_text("one strip per joint, top to bottom in model order: white key frame, green tracked, orange weak, blue interpolated, purple off the frame, red lost; click to jump");
     jump
 }

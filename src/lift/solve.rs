@@ -10,7 +10,7 @@ use super::error::LiftError;
 use super::propagate::key_depths;
 use super::refine::{RefineParams, RefineSummary, refine};
 use crate::camera::PinholeCamera;
-use crate::formats::{Frame3d, Skeleton3d, Tracks2d};
+use crate::formats::{Frame3d, PointSource, Skeleton3d, Tracks2d};
 use crate::skeleton::{BONE_COUNT, Bone, Joint, PerJoint, SubjectModel};
 use nalgebra::{Point2, Point3};
 use serde::{Deserialize, Serialize};
@@ -78,6 +78,8 @@ pub enum FrameFlag {
     KeyTriangleNotConverged,
     /// The bone's 2D image is longer than its 3D length allows: the joint is off its ray.
     TooLong(Bone),
+    /// The joint's 2D track was off the frame: its 3D position rests on the tracker's estimate.
+    OffFrame(Joint),
 }
 
 impl fmt::Display for FrameFlag {
@@ -85,6 +87,7 @@ impl fmt::Display for FrameFlag {
         match self {
             FrameFlag::KeyTriangleNotConverged => f.write_str("key_triangle_not_converged"),
             FrameFlag::TooLong(b) => write!(f, "too_long:{}", b.key()),
+            FrameFlag::OffFrame(j) => write!(f, "{}{}", crate::formats::OFF_FRAME_FLAG, j.name()),
         }
     }
 }
@@ -292,11 +295,16 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
                     .sum::<f64>()
                     .sqrt()
                     / 3f64.sqrt(),
-                flags: if *converged {
-                    Vec::new()
-                } else {
-                    vec![FrameFlag::KeyTriangleNotConverged]
-                },
+                flags: (!*converged)
+                    .then_some(FrameFlag::KeyTriangleNotConverged)
+                    .into_iter()
+                    .chain(
+                        Joint::ALL
+                            .into_iter()
+                            .filter(|&j| f.points[j].source == PointSource::OffFrame)
+                            .map(FrameFlag::OffFrame),
+                    )
+                    .collect(),
             })
             .collect();
         let resolved = resolve(

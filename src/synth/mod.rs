@@ -96,8 +96,11 @@ pub struct SynthParams {
     /// Focal length, pixels.
     pub focal_px: f64,
     /// Wanted stature of the person in the image, pixels (the camera distance follows; it grows
-    /// further if some frame would leave the image).
+    /// further if some frame would leave the image, unless `allow_off_frame`).
     pub person_px: f64,
+    /// Keep the camera at the distance of `person_px` even when joints leave the image in some
+    /// frames (clips with off-frame joints); the first frame must still show every joint.
+    pub allow_off_frame: bool,
     /// Sensor noise and flicker.
     pub effects: SensorEffects,
     /// Background texture seed (procedural background).
@@ -121,6 +124,7 @@ impl Default for SynthParams {
             view: View::Oblique,
             focal_px: 600.0,
             person_px: 300.0,
+            allow_off_frame: false,
             effects: SensorEffects {
                 noise_sigma: 2.0,
                 flicker: 0.02,
@@ -173,8 +177,9 @@ pub struct SynthResult {
 }
 
 /// Places the camera: looking at the clip's mean pelvis from the view's direction, at the distance
-/// that gives the wanted stature in pixels, moved back until every joint of every frame is on the
-/// image with a 3% margin. Returns the world→camera rotation and the camera centre.
+/// that gives the wanted stature in pixels, moved back until every joint of every frame (of the
+/// first frame only, with `allow_off_frame`) is on the image with a 3% margin. Returns the
+/// world→camera rotation and the camera centre.
 fn place_camera(
     motion: &Motion,
     params: &SynthParams,
@@ -202,7 +207,12 @@ fn place_camera(
     let margin = 0.03 * f64::from(camera.width.min(camera.height));
     for _ in 0..40 {
         let centre = target + dir * distance;
-        let fits = motion.frames.iter().all(|p| {
+        let checked = if params.allow_off_frame {
+            &motion.frames[..motion.frames.len().min(1)]
+        } else {
+            &motion.frames[..]
+        };
+        let fits = checked.iter().all(|p| {
             p.0.iter().all(|q| {
                 let c = Point3::from(r * (q.coords - centre));
                 camera.project(&c).is_some_and(|uv| {

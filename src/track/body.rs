@@ -53,6 +53,8 @@ struct Part {
     reliability: f32,
     /// Longest plausible image length of the bone, pixels (proportions × marked stature).
     max_len: f64,
+    /// How far along its bone the part is sampled.
+    extent: Extent,
 }
 
 /// The sampled extent of each part along its bone (see [`Extent`]): the head block reaches a
@@ -167,6 +169,7 @@ impl BodyTracker {
                 template: Template::sample(frame, &block, extent(kind), w),
                 reliability: 1.0,
                 max_len: (1.2 * fraction * stature).max(block.m * 1.05),
+                extent: extent(kind),
             }
         };
         // The head block runs from the calvaria down to the neck (its anchor is head_top).
@@ -404,9 +407,15 @@ fn accept(part: &mut Part, found: Found, frame: FrameView, p: &TrackerParams) {
     }
 }
 
+/// Whether a point lies off the image (pixel centres at integers).
+fn off_image(q: Point2<f64>, frame: FrameView) -> bool {
+    q.x < -0.5 || q.y < -0.5 || q.x > frame.width() as f64 - 0.5 || q.y > frame.height() as f64 - 0.5
+}
+
 /// One limb chain: the upper block anchored at the root, the lower at the found middle joint.
 /// A weak result from the narrow search around the prediction is searched again over the wide
-/// range (fast limbs).
+/// range (fast limbs), unless the prediction has left the image: then the part is held at its
+/// angle to its parent, reliability 0, until its prediction comes back.
 fn track_limb(
     parts: &mut [Part; 2],
     root: Point2<f64>,
@@ -427,8 +436,32 @@ fn track_limb(
             scale_width: false,
         };
         let prior = prior(part, &pred, p);
+        let predicted_off = off_image(pred.end(), frame);
+        let narrow = if off_image(pred.to_image(part.extent.end, 0.0), frame) {
+            // The far end of the sampled part is cut off by the image's edge, so its length
+            // cannot be seen: search the angle only.
+            AngularParams {
+                range_m: 0.0,
+                m_count: 1,
+                ..narrow
+            }
+        } else {
+            narrow
+        };
         let mut found = angular(&part.template, frame, &pred, &narrow, &prior);
-        if reliability(found.cost, p.reliability_c0) < p.weak_reliability {
+        let weak = reliability(found.cost, p.reliability_c0) < p.weak_reliability;
+        if weak && predicted_off {
+            // The joint left the frame: nothing to match, so the part keeps its angle to its
+            // parent (no angular velocity, which would spin it) until its prediction is back
+            // on the image.
+            part.prev_theta = part.block.theta;
+            part.block = predict_anchored(part, anchor, Some(parent), 0.0);
+            part.reliability = 0.0;
+            parent = [part.block.theta, before.0, before.1];
+            anchor = part.block.end();
+            continue;
+        }
+        if weak {
             let wide = AngularParams {
                 range_theta: p.wide_range_deg.to_radians(),
                 step_theta: 2.0 * p.coarse_step_deg.to_radians(),

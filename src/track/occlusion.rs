@@ -1,11 +1,14 @@
 //! Occlusion handling (Pan et al., end of "Trunk and Limb"): a run of low-reliability frames
 //! between reliable ones is filled by linear interpolation of the joint; longer runs, and runs
 //! with no reliable frame on one side, are reported as weak spans and never silently filled.
+//! Runs in which the joint leaves the image are reported as off-frame spans and never filled:
+//! a straight line between the exit and the re-entry would draw the joint inside the frame.
 //! Key frames (hand-placed joints) always count as reliable anchors.
 
 use crate::formats::{FrameTracks, PointSource};
 use crate::skeleton::Joint;
 use serde::Serialize;
+use std::fmt;
 
 /// What happened to a run of weak frames of one joint.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -15,6 +18,18 @@ pub enum SpanKind {
     Interpolated,
     /// Left as tracked and reported: too long to interpolate, or not bounded by reliable frames.
     Weak,
+    /// The joint is off the frame somewhere in the run: left as the tracker estimated it.
+    OffFrame,
+}
+
+impl fmt::Display for SpanKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            SpanKind::Interpolated => "interpolated",
+            SpanKind::Weak => "weak",
+            SpanKind::OffFrame => "off frame",
+        })
+    }
 }
 
 /// A run of consecutive weak frames of one joint.
@@ -63,7 +78,12 @@ pub fn fill_weak_runs(
                 .fold(f32::INFINITY, f32::min);
             let bounded = start > 0 && end + 1 < n;
             let len = end - start + 1;
-            let kind = if bounded && len <= max_gap {
+            let off_frame = frames[start..=end]
+                .iter()
+                .any(|f| f.points[joint].source == PointSource::OffFrame);
+            let kind = if off_frame {
+                SpanKind::OffFrame
+            } else if bounded && len <= max_gap {
                 let a = frames[start - 1].points[joint].pos;
                 let b = frames[end + 1].points[joint].pos;
                 for (k, f) in frames[start..=end].iter_mut().enumerate() {

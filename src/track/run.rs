@@ -4,13 +4,15 @@
 //! the start. Each later key frame (a frame where the user corrected joints) restarts the
 //! forward pass there with the corrected pose and fresh key-frame colour models, and a backward
 //! pass from it fills the weak frames before it, keeping for each joint and frame whichever pass
-//! is more reliable. Short weak runs are then interpolated with key frames as anchors
-//! ([`super::occlusion`]). Frames are decoded (and shrunk to the working scale) on a separate
+//! is more reliable. A joint that ends up outside the image is off the frame (confidence 0, its
+//! position the tracker's estimate). Short weak runs are then interpolated with key frames as
+//! anchors ([`super::occlusion`]), never runs that leave the frame. Frames are decoded (and shrunk to the working scale) on a separate
 //! thread while the tracker works, unless one thread is asked for.
 
 use super::body::{BodyTracker, JointResult, stature_px};
 use super::occlusion::{WeakSpan, fill_weak_runs};
 use super::params::TrackerParams;
+use crate::camera::point_in_frame;
 use crate::formats::{FrameTracks, PointSource, SourceInfo, TrackedPoint, Tracks2d};
 use crate::skeleton::{JOINT_COUNT, Joint, PerJoint, Proportions};
 use crate::video::{Video, VideoError};
@@ -318,19 +320,28 @@ pub fn track_video(
                         reliability: 0.0,
                     })
                 })
-                .map(|j, r| TrackedPoint {
-                    pos: job
-                        .keys
-                        .frames
-                        .get(&index)
-                        .and_then(|k| k[j])
-                        .unwrap_or(r.pos),
-                    confidence: if job.keys.is_key(index, j) {
-                        1.0
+                .map(|j, r| {
+                    let key = job.keys.frames.get(&index).and_then(|k| k[j]);
+                    let pos = key.unwrap_or(r.pos);
+                    if key.is_some() {
+                        TrackedPoint {
+                            pos,
+                            confidence: 1.0,
+                            source: PointSource::Tracked,
+                        }
+                    } else if point_in_frame(&pos, info.width, info.height) {
+                        TrackedPoint {
+                            pos,
+                            confidence: r.reliability,
+                            source: PointSource::Tracked,
+                        }
                     } else {
-                        r.reliability
-                    },
-                    source: PointSource::Tracked,
+                        TrackedPoint {
+                            pos,
+                            confidence: 0.0,
+                            source: PointSource::OffFrame,
+                        }
+                    }
                 }),
         })
         .collect();

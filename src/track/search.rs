@@ -215,12 +215,14 @@ pub fn refine(
                 theta: b.theta - dt,
                 ..b
             });
-            for (k, f) in [(2, 1.0 + ds), (3, 1.0 / (1.0 + ds))] {
-                cands[k] = Some(MorphBlock {
-                    m: b.m * f,
-                    n: if s.scale_width { b.n * f } else { b.n },
-                    ..b
-                });
+            if ds > 0.0 {
+                for (k, f) in [(2, 1.0 + ds), (3, 1.0 / (1.0 + ds))] {
+                    cands[k] = Some(MorphBlock {
+                        m: b.m * f,
+                        n: if s.scale_width { b.n * f } else { b.n },
+                        ..b
+                    });
+                }
             }
             if s.move_origin {
                 for (k, d) in [
@@ -314,7 +316,12 @@ pub fn angular(
     let steps = Steps {
         position: 0.0,
         theta: p.step_theta / 2.0,
-        scale: (p.range_m / half_m.max(1) as f64 / 2.0).max(0.01),
+        // A length range of 0 holds the length through the refinement too.
+        scale: if p.range_m > 0.0 {
+            (p.range_m / half_m.max(1) as f64 / 2.0).max(0.01)
+        } else {
+            0.0
+        },
         scale_width: p.scale_width,
         move_origin: false,
         levels: 4,
