@@ -83,10 +83,7 @@ pub fn report(out: &TrackOutput, global: &GlobalArgs) {
         .iter()
         .filter(|s| s.kind != SpanKind::Interpolated)
         .collect();
-    let off_frame = weak
-        .iter()
-        .filter(|s| s.kind == SpanKind::OffFrame)
-        .count();
+    let off_frame = weak.iter().filter(|s| s.kind == SpanKind::OffFrame).count();
     say(
         global,
         &format!(

@@ -50,10 +50,7 @@ impl Frame3d {
     pub fn off_frame(&self) -> PerJoint<bool> {
         let mut out = PerJoint::from_fn(|_| false);
         for flag in &self.flags {
-            if let Some(joint) = flag
-                .strip_prefix(OFF_FRAME_FLAG)
-                .and_then(Joint::from_name)
-            {
+            if let Some(joint) = flag.strip_prefix(OFF_FRAME_FLAG).and_then(Joint::from_name) {
                 out[joint] = true;
             }
         }

@@ -329,6 +329,95 @@ mod tests {
         assert_eq!(t, sample());
     }
 
+    /// The sample with the left wrist off the frame (left of the image) in frame 1.
+    fn with_off_frame() -> Tracks2d {
+        let mut t = sample();
+        t.frames[1].points[Joint::LeftWrist] = TrackedPoint {
+            pos: Point2::new(-40.0, 200.0),
+            confidence: 0.0,
+            source: PointSource::OffFrame,
+        };
+        t
+    }
+
+    #[test]
+    fn off_frame_points_round_trip_as_version_2() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.json");
+        with_off_frame().save(&path).unwrap();
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        assert_eq!(v["version"], 2);
+        // Only the frame with an off-frame joint carries the array.
+        assert!(v["frames"][0].get("off_frame").is_none());
+        assert_eq!(v["frames"][1]["off_frame"][6], true);
+        assert_eq!(v["frames"][1]["off_frame"][5], false);
+        assert_eq!(Tracks2d::load(&path).unwrap(), with_off_frame());
+    }
+
+    #[test]
+    fn version_1_is_read_and_a_newer_version_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.json");
+        sample().save(&path).unwrap();
+        let mut v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        v["version"] = serde_json::json!(1);
+        assert_eq!(Tracks2d::parse(&v.to_string(), &path).unwrap(), sample());
+        v["version"] = serde_json::json!(3);
+        let err = Tracks2d::parse(&v.to_string(), &path)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("t.json") && err.contains("version 3") && err.contains("up to version 2"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn off_frame_marks_must_agree_with_the_point() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.json");
+        with_off_frame().save(&path).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let base: serde_json::Value = serde_json::from_str(&text).unwrap();
+        let cases: [(&str, serde_json::Value, &str); 3] = [
+            (
+                "points",
+                serde_json::json!([100.0, 200.0]),
+                "lies on the frame",
+            ),
+            (
+                "confidence",
+                serde_json::json!(0.5),
+                "confidence other than 0",
+            ),
+            (
+                "interpolated",
+                serde_json::json!(true),
+                "both off_frame and interpolated",
+            ),
+        ];
+        for (field, value, says) in cases {
+            let mut v = base.clone();
+            v["frames"][1][field][6] = value;
+            let err = Tracks2d::parse(&v.to_string(), &path)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("t.json") && err.contains("left_wrist") && err.contains(says),
+                "{field}: {err}"
+            );
+        }
+        // Unmarked, the same point is simply outside the frame.
+        let mut v = base.clone();
+        v["frames"][1]["off_frame"][6] = serde_json::json!(false);
+        let err = Tracks2d::parse(&v.to_string(), &path)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("outside the 640×480 frame"), "{err}");
+    }
+
     #[test]
     fn short_arrays_and_points_off_the_frame_are_named() {
         let dir = tempfile::tempdir().unwrap();

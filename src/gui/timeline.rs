@@ -118,3 +118,74 @@ pub fn show(
     response.on_hover_text("one strip per joint, top to bottom in model order: white key frame, green tracked, orange weak, blue interpolated, purple off the frame, red lost; click to jump");
     jump
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Point2;
+    use videomocap::formats::{FrameTracks, SourceInfo, TrackedPoint};
+    use videomocap::skeleton::PerJoint;
+
+    #[test]
+    fn strips_colour_each_state_and_off_the_frame_is_not_lost() {
+        // Left wrist: tracked, weak, interpolated, off the frame, then a weak span left weak.
+        let states = [
+            (0.9, PointSource::Tracked),
+            (0.2, PointSource::Tracked),
+            (0.2, PointSource::Interpolated),
+            (0.0, PointSource::OffFrame),
+            (0.1, PointSource::Tracked),
+        ];
+        let tracks = Tracks2d {
+            source: SourceInfo {
+                path: "clip.mp4".into(),
+                width: 64,
+                height: 48,
+                fps: 30.0,
+                frame_count: states.len(),
+            },
+            frames: states
+                .iter()
+                .enumerate()
+                .map(|(i, &(confidence, source))| FrameTracks {
+                    index: i,
+                    points: PerJoint::from_fn(|j| TrackedPoint {
+                        pos: Point2::new(10.0, 10.0),
+                        confidence: if j == Joint::LeftWrist {
+                            confidence
+                        } else {
+                            0.9
+                        },
+                        source: if j == Joint::LeftWrist {
+                            source
+                        } else {
+                            PointSource::Tracked
+                        },
+                    }),
+                })
+                .collect(),
+        };
+        let spans = [WeakSpan {
+            joint: "left_wrist",
+            start: 4,
+            end: 4,
+            kind: SpanKind::Weak,
+            min_reliability: 0.1,
+        }];
+        let strips = Strips::new(&tracks, &spans, &KeyFrames::default(), 0.45);
+        let colours: Vec<Color32> = strips.runs[Joint::LeftWrist.index()]
+            .iter()
+            .map(|r| r.2)
+            .collect();
+        assert_eq!(
+            colours,
+            [
+                PointState::Tracked.colour(),
+                PointState::Weak.colour(),
+                PointState::Interpolated.colour(),
+                PointState::OffFrame.colour(),
+                LOST,
+            ]
+        );
+    }
+}

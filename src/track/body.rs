@@ -409,7 +409,10 @@ fn accept(part: &mut Part, found: Found, frame: FrameView, p: &TrackerParams) {
 
 /// Whether a point lies off the image (pixel centres at integers).
 fn off_image(q: Point2<f64>, frame: FrameView) -> bool {
-    q.x < -0.5 || q.y < -0.5 || q.x > frame.width() as f64 - 0.5 || q.y > frame.height() as f64 - 0.5
+    q.x < -0.5
+        || q.y < -0.5
+        || q.x > frame.width() as f64 - 0.5
+        || q.y > frame.height() as f64 - 0.5
 }
 
 /// One limb chain: the upper block anchored at the root, the lower at the found middle joint.

@@ -153,6 +153,29 @@ mod tests {
     }
 
     #[test]
+    fn a_run_that_leaves_the_frame_is_never_filled() {
+        // A short bounded run, which would be interpolated, but the joint is off the frame in
+        // its middle frame: the whole run stays as the tracker left it.
+        let mut f = frames(&[0.9, 0.2, 0.0, 0.2, 0.9]);
+        f[2].points[Joint::LeftWrist].source = PointSource::OffFrame;
+        let before: Vec<_> = f.iter().map(|f| f.points[Joint::LeftWrist]).collect();
+        let spans = fill_weak_runs(&mut f, 0.5, 10, &|_, _| false);
+        let wrist: Vec<_> = spans.iter().filter(|s| s.joint == "left_wrist").collect();
+        assert_eq!(wrist.len(), 1);
+        assert_eq!(
+            (wrist[0].start, wrist[0].end, wrist[0].kind),
+            (1, 3, SpanKind::OffFrame)
+        );
+        let after: Vec<_> = f.iter().map(|f| f.points[Joint::LeftWrist]).collect();
+        assert_eq!(before, after);
+        // The other joints' identical runs are filled as usual.
+        assert_eq!(
+            f[2].points[Joint::RightWrist].source,
+            PointSource::Interpolated
+        );
+    }
+
+    #[test]
     fn runs_at_the_ends_are_never_filled_and_key_frames_anchor() {
         let mut f = frames(&[0.1, 0.9, 0.9, 0.1]);
         let spans = fill_weak_runs(&mut f, 0.5, 10, &|_, _| false);
