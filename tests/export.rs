@@ -285,7 +285,7 @@ fn csv_and_trc_hold_every_joint_of_every_frame() {
     let ws = WorldSkeleton::new(&to_camera(&frames_of(&m, 5), 0.0, 0.0), None).unwrap();
     let csv = skeleton_csv(&ws);
     let lines: Vec<&str> = csv.lines().collect();
-    assert_eq!(lines[0], "frame,time_s,joint,x_m,y_m,z_m,off_frame");
+    assert_eq!(lines[0], "frame,time_s,joint,x_m,y_m,z_m,off_frame,lost");
     assert_eq!(lines.len(), 1 + 5 * 16);
     let row: Vec<&str> = lines[1 + 16 * 2 + 3].split(',').collect();
     assert_eq!(row[0], "2");

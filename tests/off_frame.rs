@@ -3,7 +3,8 @@
 //! which frames a wrist is off the frame, never draw it across the image between exit and
 //! re-entry, pick it up again after re-entry, and every file written from the result (tracks2d,
 //! project, tracks CSV, skeleton3d, joints CSV, TRC, BVH) must agree on which joints were off
-//! the frame.
+//! the frame, and which were lost (weak runs too long to fill: the left elbow, which the
+//! tracker follows poorly on this clip).
 
 use assert_cmd::Command;
 use nalgebra::Point2;
@@ -12,18 +13,48 @@ use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use videomocap::camera::point_in_frame;
-use videomocap::formats::{Marks, PointSource, Skeleton3d, Tracks2d};
+use videomocap::formats::{LOST_FLAG, Marks, OFF_FRAME_FLAG, PointSource, Skeleton3d, Tracks2d};
 use videomocap::project::Project;
 use videomocap::skeleton::Joint;
 use videomocap::synth::{
     GroundTruth, MotionSource, ProceduralMotion, SynthParams, VideoOutput, View, render_clip,
 };
-use videomocap::track::KeyFrames;
+use videomocap::track::{KeyFrames, TrackerParams, weak_spans};
 
 const FRAMES: usize = 60;
 
-/// Frame and joint of every off-frame point.
-type OffSet = BTreeSet<(usize, &'static str)>;
+/// Frame and joint of every point in some state.
+type PointSet = BTreeSet<(usize, &'static str)>;
+
+fn points_with(tracks: &Tracks2d, source: PointSource) -> PointSet {
+    tracks
+        .frames
+        .iter()
+        .flat_map(|f| {
+            Joint::ALL
+                .into_iter()
+                .filter(move |&j| f.points[j].source == source)
+                .map(move |j| (f.index, j.name()))
+        })
+        .collect()
+}
+
+/// The (frame, joint) of the CSV rows whose column `flag` is 1.
+fn csv_flagged(path: &Path, flag: &str) -> PointSet {
+    let mut reader = csv::Reader::from_path(path).unwrap();
+    let header = reader.headers().unwrap().clone();
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let (frame_c, joint_c, flag_c) = (col("frame"), col("joint"), col(flag));
+    reader
+        .records()
+        .map(Result::unwrap)
+        .filter(|row| &row[flag_c] == "1")
+        .map(|row| {
+            let joint = Joint::from_name(&row[joint_c]).unwrap().name();
+            (row[frame_c].parse::<usize>().unwrap(), joint)
+        })
+        .collect()
+}
 
 fn cli(args: &[&str]) -> String {
     let out = Command::cargo_bin("videomocap")
@@ -154,17 +185,10 @@ fn joints_leaving_the_frame_are_tracked_and_exported_consistently() {
     }
     println!("{table}");
 
-    let off_set: OffSet = tracks
-        .frames
-        .iter()
-        .flat_map(|f| {
-            Joint::ALL
-                .into_iter()
-                .filter(|&j| f.points[j].source == PointSource::OffFrame)
-                .map(move |j| (f.index, j.name()))
-        })
-        .collect();
+    let off_set = points_with(&tracks, PointSource::OffFrame);
+    let lost_set = points_with(&tracks, PointSource::Lost);
     assert!(!off_set.is_empty());
+    assert!(!lost_set.is_empty());
     for f in &tracks.frames {
         for j in Joint::ALL {
             let p = f.points[j];
@@ -180,7 +204,8 @@ fn joints_leaving_the_frame_are_tracked_and_exported_consistently() {
             }
         }
     }
-    // The report lists the off-frame runs and no interpolated run contains one.
+    // The report lists the off-frame runs and no interpolated run contains one; lost points
+    // lie in the runs left weak.
     let summary: serde_json::Value = serde_json::from_str(&summary).unwrap();
     let spans = summary["spans"].as_array().unwrap();
     for span in spans {
@@ -189,8 +214,13 @@ fn joints_leaving_the_frame_are_tracked_and_exported_consistently() {
             span["start"].as_u64().unwrap() as usize,
             span["end"].as_u64().unwrap() as usize,
         );
-        let has_off = (a..=b).any(|f| off_set.iter().any(|&(g, k)| g == f && k == joint));
-        assert_eq!(span["kind"] == "off_frame", has_off, "{span}");
+        let has = |set: &PointSet| {
+            (a..=b).any(|f| set.contains(&(f, Joint::from_name(joint).unwrap().name())))
+        };
+        assert_eq!(span["kind"] == "off_frame", has(&off_set), "{span}");
+        if span["kind"] == "weak" {
+            assert!(has(&lost_set), "{span}");
+        }
     }
 
     // 2. The project keeps the states.
@@ -201,31 +231,24 @@ fn joints_leaving_the_frame_are_tracked_and_exported_consistently() {
     project.save(&project_path).unwrap();
     let reopened = Project::load(&project_path).unwrap();
     assert_eq!(reopened.tracks.as_deref(), Some(&tracks));
+    // The reopened tracks alone give the tracker's report again (what the app lists).
+    let again = weak_spans(
+        &tracks.frames,
+        TrackerParams::default().weak_reliability,
+        &|i, j| reopened.keys.is_key(tracks.frames[i].index, j),
+    );
+    assert_eq!(serde_json::to_value(&again).unwrap(), summary["spans"]);
 
     // 3. The tracks CSV flags exactly those points.
     let csv_path = d.join("tracks2d.csv");
     cli(&["export", &s(&tracks_path), "--csv", &s(&csv_path)]);
-    let mut reader = csv::Reader::from_path(&csv_path).unwrap();
-    let header = reader.headers().unwrap().clone();
-    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
-    let (frame_c, joint_c, off_c, conf_c, interp_c) = (
-        col("frame"),
-        col("joint"),
-        col("off_frame"),
-        col("confidence"),
-        col("interpolated"),
-    );
-    let mut csv_off = BTreeSet::new();
-    for row in reader.records() {
-        let row = row.unwrap();
-        if &row[off_c] == "1" {
-            assert_eq!(&row[conf_c], "0.000");
-            assert_eq!(&row[interp_c], "0");
-            let joint = Joint::from_name(&row[joint_c]).unwrap().name();
-            csv_off.insert((row[frame_c].parse::<usize>().unwrap(), joint));
-        }
+    assert_eq!(csv_flagged(&csv_path, "off_frame"), off_set, "tracks CSV");
+    assert_eq!(csv_flagged(&csv_path, "lost"), lost_set, "tracks CSV");
+    let text = std::fs::read_to_string(&csv_path).unwrap();
+    for row in text.lines().filter(|r| r.ends_with(",1,0")) {
+        // off the frame: confidence 0, not interpolated
+        assert!(row.ends_with(",0.000,0,1,0"), "{row}");
     }
-    assert_eq!(csv_off, off_set, "tracks CSV");
 
     // 4. The lift flags them; the 3D exports carry the flags.
     let skeleton_path = d.join("skeleton3d.json");
@@ -239,18 +262,21 @@ fn joints_leaving_the_frame_are_tracked_and_exported_consistently() {
         &s(&bvh_path),
     ]);
     let skeleton = Skeleton3d::load(&skeleton_path).unwrap();
-    let flagged: OffSet = skeleton
-        .frames
-        .iter()
-        .flat_map(|f| {
-            let off = f.off_frame();
-            Joint::ALL
-                .into_iter()
-                .filter(move |&j| off[j])
-                .map(move |j| (f.index, j.name()))
-        })
-        .collect();
-    assert_eq!(flagged, off_set, "skeleton3d flags");
+    let flagged = |prefix: &str| -> PointSet {
+        skeleton
+            .frames
+            .iter()
+            .flat_map(|f| {
+                let on = f.joint_flags(prefix);
+                Joint::ALL
+                    .into_iter()
+                    .filter(move |&j| on[j])
+                    .map(move |j| (f.index, j.name()))
+            })
+            .collect()
+    };
+    assert_eq!(flagged(OFF_FRAME_FLAG), off_set, "skeleton3d flags");
+    assert_eq!(flagged(LOST_FLAG), lost_set, "skeleton3d flags");
 
     let joints_csv = d.join("joints3d.csv");
     let trc_path = d.join("motion.trc");
@@ -262,19 +288,8 @@ fn joints_leaving_the_frame_are_tracked_and_exported_consistently() {
         "--trc",
         &s(&trc_path),
     ]);
-    let mut reader = csv::Reader::from_path(&joints_csv).unwrap();
-    let header = reader.headers().unwrap().clone();
-    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
-    let (frame_c, joint_c, off_c) = (col("frame"), col("joint"), col("off_frame"));
-    let mut csv_off = BTreeSet::new();
-    for row in reader.records() {
-        let row = row.unwrap();
-        if &row[off_c] == "1" {
-            let joint = Joint::from_name(&row[joint_c]).unwrap().name();
-            csv_off.insert((row[frame_c].parse::<usize>().unwrap(), joint));
-        }
-    }
-    assert_eq!(csv_off, off_set, "joints CSV");
+    assert_eq!(csv_flagged(&joints_csv, "off_frame"), off_set, "joints CSV");
+    assert_eq!(csv_flagged(&joints_csv, "lost"), lost_set, "joints CSV");
 
     // TRC: rows after the 5 header lines and one blank line; Frame# counts from 1.
     let trc = std::fs::read_to_string(&trc_path).unwrap();
@@ -297,7 +312,8 @@ fn joints_leaving_the_frame_are_tracked_and_exported_consistently() {
             }
         }
     }
-    assert_eq!(trc_off, off_set, "TRC gaps");
+    let missing: PointSet = off_set.union(&lost_set).copied().collect();
+    assert_eq!(trc_off, missing, "TRC gaps");
 
     // BVH: every frame, every channel a finite number (the estimated pose), and it reads back.
     let bvh = videomocap::bvh::Bvh::load(&bvh_path).unwrap();

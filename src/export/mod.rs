@@ -17,7 +17,7 @@ pub use euler::zxy_degrees;
 pub use tables::{skeleton_csv, tracks_csv, trc};
 pub use world::{UpSource, WorldFrame};
 
-use crate::formats::{FormatError, Skeleton3d, write_atomically};
+use crate::formats::{FormatError, LOST_FLAG, OFF_FRAME_FLAG, Skeleton3d, write_atomically};
 use crate::skeleton::{Joint, PerJoint};
 use nalgebra::Point3;
 use std::path::{Path, PathBuf};
@@ -58,6 +58,9 @@ pub struct WorldSkeleton {
     /// Per frame, the joints whose 2D track was off the frame (from the `off_frame:` flags):
     /// estimates, written as gaps where a format has them (TRC) and flagged in the CSV.
     pub off_frame: Vec<PerJoint<bool>>,
+    /// Per frame, the joints whose 2D track was lost (from the `lost:` flags): guesses,
+    /// handled like `off_frame`.
+    pub lost: Vec<PerJoint<bool>>,
 }
 
 impl WorldSkeleton {
@@ -79,7 +82,16 @@ impl WorldSkeleton {
             fps,
             indices: skeleton.frames.iter().map(|f| f.index).collect(),
             frames,
-            off_frame: skeleton.frames.iter().map(|f| f.off_frame()).collect(),
+            off_frame: skeleton
+                .frames
+                .iter()
+                .map(|f| f.joint_flags(OFF_FRAME_FLAG))
+                .collect(),
+            lost: skeleton
+                .frames
+                .iter()
+                .map(|f| f.joint_flags(LOST_FLAG))
+                .collect(),
         })
     }
 

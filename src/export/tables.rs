@@ -2,17 +2,19 @@
 //! spreadsheet and data-frame library reads them without reshaping), and the 3D joints as an
 //! OpenSim marker file (`.trc`, tab-separated, one row per frame).
 //!
-//! Joints off the frame are estimates: both CSVs say so in an `off_frame` column, and the TRC
-//! leaves their cells empty (OpenSim's missing marker), so inverse kinematics ignores them.
+//! Joints off the frame or lost are estimates: both CSVs say so in `off_frame` and `lost`
+//! columns, and the TRC leaves their cells empty (OpenSim's missing marker), so inverse
+//! kinematics ignores them.
 
 use super::WorldSkeleton;
 use crate::formats::{PointSource, Tracks2d};
 use crate::skeleton::Joint;
 use std::fmt::Write as _;
 
-/// Tracks CSV: `frame,time_s,joint,x_px,y_px,confidence,interpolated,off_frame` (pixels, y
-/// down; time from the video's frame rate; `interpolated` is 1 for points filled in across an
-/// occlusion, `off_frame` 1 for the tracker's estimate of a joint outside the image).
+/// Tracks CSV: `frame,time_s,joint,x_px,y_px,confidence,interpolated,off_frame,lost` (pixels,
+/// y down; time from the video's frame rate; `interpolated` is 1 for points filled in across an
+/// occlusion, `off_frame` 1 for the tracker's estimate of a joint outside the image, `lost` 1
+/// for its guess in a weak run too long to fill).
 pub fn tracks_csv(tracks: &Tracks2d) -> String {
     let mut w = csv::Writer::from_writer(Vec::new());
     let header = [
@@ -24,6 +26,7 @@ pub fn tracks_csv(tracks: &Tracks2d) -> String {
         "confidence",
         "interpolated",
         "off_frame",
+        "lost",
     ];
     let _ = w.write_record(header);
     for f in &tracks.frames {
@@ -40,17 +43,29 @@ pub fn tracks_csv(tracks: &Tracks2d) -> String {
                 format!("{:.3}", p.confidence),
                 flag(p.source == PointSource::Interpolated),
                 flag(p.source == PointSource::OffFrame),
+                flag(p.source == PointSource::Lost),
             ]);
         }
     }
     finish(w)
 }
 
-/// 3D CSV: `frame,time_s,joint,x_m,y_m,z_m,off_frame` in the exports' Y-up world (metres);
-/// `off_frame` is 1 where the joint's 2D track was off the frame (an estimate).
+/// 3D CSV: `frame,time_s,joint,x_m,y_m,z_m,off_frame,lost` in the exports' Y-up world
+/// (metres); `off_frame` or `lost` is 1 where the joint's 2D track was off the frame or lost
+/// (an estimate).
 pub fn skeleton_csv(skeleton: &WorldSkeleton) -> String {
     let mut w = csv::Writer::from_writer(Vec::new());
-    let _ = w.write_record(["frame", "time_s", "joint", "x_m", "y_m", "z_m", "off_frame"]);
+    let _ = w.write_record([
+        "frame",
+        "time_s",
+        "joint",
+        "x_m",
+        "y_m",
+        "z_m",
+        "off_frame",
+        "lost",
+    ]);
+    let flag = |b: bool| if b { "1" } else { "0" }.to_owned();
     for (k, p) in skeleton.frames.iter().enumerate() {
         for j in Joint::ALL {
             let _ = w.write_record([
@@ -60,7 +75,8 @@ pub fn skeleton_csv(skeleton: &WorldSkeleton) -> String {
                 format!("{:.5}", p[j].x),
                 format!("{:.5}", p[j].y),
                 format!("{:.5}", p[j].z),
-                if skeleton.off_frame[k][j] { "1" } else { "0" }.to_owned(),
+                flag(skeleton.off_frame[k][j]),
+                flag(skeleton.lost[k][j]),
             ]);
         }
     }
@@ -76,7 +92,7 @@ fn finish(w: csv::Writer<Vec<u8>>) -> String {
 
 /// OpenSim TRC (marker trajectories, `PathFileType 4`): the 16 joints as markers named like the
 /// joints, metres, Y up, frames numbered from 1 with times from the video's start. A joint off
-/// the frame leaves its three cells empty (a missing marker).
+/// the frame or lost leaves its three cells empty (a missing marker).
 pub fn trc(skeleton: &WorldSkeleton, file_name: &str) -> String {
     let n = skeleton.frames.len();
     let rate = skeleton.fps;
@@ -105,7 +121,7 @@ pub fn trc(skeleton: &WorldSkeleton, file_name: &str) -> String {
     for (k, p) in skeleton.frames.iter().enumerate() {
         let _ = write!(out, "{}\t{:.6}", k + 1, skeleton.time_s(k));
         for j in Joint::ALL {
-            if skeleton.off_frame[k][j] {
+            if skeleton.off_frame[k][j] || skeleton.lost[k][j] {
                 out.push_str("\t\t\t");
             } else {
                 let _ = write!(out, "\t{:.5}\t{:.5}\t{:.5}", p[j].x, p[j].y, p[j].z);

@@ -10,7 +10,7 @@ mod tracks2d;
 pub use atomic::write_atomically;
 pub use error::FormatError;
 pub use marks::{MARKS_FORMAT, Marks};
-pub use skeleton3d::{Frame3d, OFF_FRAME_FLAG, SKELETON3D_FORMAT, Skeleton3d};
+pub use skeleton3d::{Frame3d, LOST_FLAG, OFF_FRAME_FLAG, SKELETON3D_FORMAT, Skeleton3d};
 pub use tracks2d::{
     FrameTracks, PointSource, SourceInfo, TRACKS2D_FORMAT, TRACKS2D_VERSION, TrackedPoint, Tracks2d,
 };

@@ -19,6 +19,10 @@ pub const SKELETON3D_FORMAT: &str = "videomocap.skeleton3d";
 /// (`off_frame:left_wrist`): its 3D position rests on the tracker's estimate.
 pub const OFF_FRAME_FLAG: &str = "off_frame:";
 
+/// The prefix of the frame flag that marks a joint whose 2D track was lost (in a weak run too
+/// long to interpolate, `lost:left_wrist`): its 3D position rests on the tracker's guess.
+pub const LOST_FLAG: &str = "lost:";
+
 /// The 16 joints of one frame in camera space.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Frame3d {
@@ -46,11 +50,11 @@ pub struct Skeleton3d {
 }
 
 impl Frame3d {
-    /// Per joint, whether the frame flags it `off_frame:<joint>`.
-    pub fn off_frame(&self) -> PerJoint<bool> {
+    /// Per joint, whether the frame has the flag `<prefix><joint>` (e.g. [`OFF_FRAME_FLAG`]).
+    pub fn joint_flags(&self, prefix: &str) -> PerJoint<bool> {
         let mut out = PerJoint::from_fn(|_| false);
         for flag in &self.flags {
-            if let Some(joint) = flag.strip_prefix(OFF_FRAME_FLAG).and_then(Joint::from_name) {
+            if let Some(joint) = flag.strip_prefix(prefix).and_then(Joint::from_name) {
                 out[joint] = true;
             }
         }

@@ -43,6 +43,9 @@ pub enum PointSource {
     /// Outside the image: the position is the tracker's estimate (the limb held at its last
     /// seen angle to its parent), its confidence 0; never interpolated across the frame.
     OffFrame,
+    /// In a weak run too long to interpolate (or at an end of the video): the position is the
+    /// tracker's guess, to be checked (a long occlusion, or a lost joint).
+    Lost,
 }
 
 /// One joint in one frame.
@@ -83,6 +86,9 @@ struct FrameFile {
     /// Version 2; omitted when no joint of the frame is off it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     off_frame: Option<Vec<bool>>,
+    /// Version 2; omitted when no joint of the frame is lost.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    lost: Option<Vec<bool>>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -128,11 +134,13 @@ impl Tracks2d {
         for f in raw.frames {
             let n = raw.joints.len();
             let off_frame = f.off_frame.unwrap_or_else(|| vec![false; n]);
+            let lost = f.lost.unwrap_or_else(|| vec![false; n]);
             for (field, found) in [
                 ("points", f.points.len()),
                 ("confidence", f.confidence.len()),
                 ("interpolated", f.interpolated.len()),
                 ("off_frame", off_frame.len()),
+                ("lost", lost.len()),
             ] {
                 if found != n {
                     return Err(FormatError::WrongLength {
@@ -185,6 +193,8 @@ impl Tracks2d {
                     Some("is marked both off_frame and interpolated")
                 } else if off_frame[col] && confidence != 0.0 {
                     Some("is marked off_frame with a confidence other than 0")
+                } else if lost[col] && (off_frame[col] || f.interpolated[col]) {
+                    Some("is marked lost and also off_frame or interpolated")
                 } else {
                     None
                 };
@@ -202,6 +212,8 @@ impl Tracks2d {
                     confidence,
                     source: if off_frame[col] {
                         PointSource::OffFrame
+                    } else if lost[col] {
+                        PointSource::Lost
                     } else if f.interpolated[col] {
                         PointSource::Interpolated
                     } else {
@@ -255,22 +267,19 @@ impl Tracks2d {
                         .iter()
                         .map(|p| p.source == PointSource::Interpolated)
                         .collect(),
-                    off_frame: f
-                        .points
-                        .0
-                        .iter()
-                        .any(|p| p.source == PointSource::OffFrame)
-                        .then(|| {
-                            f.points
-                                .0
-                                .iter()
-                                .map(|p| p.source == PointSource::OffFrame)
-                                .collect()
-                        }),
+                    off_frame: flags(f, PointSource::OffFrame),
+                    lost: flags(f, PointSource::Lost),
                 })
                 .collect(),
         }
     }
+}
+
+/// Per joint, whether its point has `source`; `None` when no point has it (the array is then
+/// left out of the file).
+fn flags(frame: &FrameTracks, source: PointSource) -> Option<Vec<bool>> {
+    let flags: Vec<bool> = frame.points.0.iter().map(|p| p.source == source).collect();
+    flags.contains(&true).then_some(flags)
 }
 
 #[cfg(test)]
@@ -329,9 +338,11 @@ mod tests {
         assert_eq!(t, sample());
     }
 
-    /// The sample with the left wrist off the frame (left of the image) in frame 1.
+    /// The sample with the left wrist off the frame (left of the image) in frame 1 and the
+    /// right wrist lost in frame 0.
     fn with_off_frame() -> Tracks2d {
         let mut t = sample();
+        t.frames[0].points[Joint::RightWrist].source = PointSource::Lost;
         t.frames[1].points[Joint::LeftWrist] = TrackedPoint {
             pos: Point2::new(-40.0, 200.0),
             confidence: 0.0,
@@ -348,10 +359,12 @@ mod tests {
         let v: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
         assert_eq!(v["version"], 2);
-        // Only the frame with an off-frame joint carries the array.
+        // Only the frame with an off-frame (lost) joint carries the array.
         assert!(v["frames"][0].get("off_frame").is_none());
         assert_eq!(v["frames"][1]["off_frame"][6], true);
         assert_eq!(v["frames"][1]["off_frame"][5], false);
+        assert!(v["frames"][1].get("lost").is_none());
+        assert_eq!(v["frames"][0]["lost"][9], true);
         assert_eq!(Tracks2d::load(&path).unwrap(), with_off_frame());
     }
 
@@ -381,7 +394,7 @@ mod tests {
         with_off_frame().save(&path).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         let base: serde_json::Value = serde_json::from_str(&text).unwrap();
-        let cases: [(&str, serde_json::Value, &str); 3] = [
+        let cases: [(&str, serde_json::Value, &str); 4] = [
             (
                 "points",
                 serde_json::json!([100.0, 200.0]),
@@ -397,9 +410,13 @@ mod tests {
                 serde_json::json!(true),
                 "both off_frame and interpolated",
             ),
+            ("lost", serde_json::json!(true), "lost and also off_frame"),
         ];
         for (field, value, says) in cases {
             let mut v = base.clone();
+            if field == "lost" {
+                v["frames"][1]["lost"] = serde_json::json!(vec![false; 16]);
+            }
             v["frames"][1][field][6] = value;
             let err = Tracks2d::parse(&v.to_string(), &path)
                 .unwrap_err()

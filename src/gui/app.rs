@@ -15,12 +15,12 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use videomocap::export::{self, WorldSkeleton};
-use videomocap::formats::{FrameTracks, Marks, PointSource, Skeleton3d};
+use videomocap::formats::{FrameTracks, Marks, Skeleton3d};
 use videomocap::lift::Root;
 use videomocap::lift::focal::default_focal;
 use videomocap::project::{History, Project};
 use videomocap::skeleton::{BONE_COUNT, Bone, Joint, PerJoint};
-use videomocap::track::{TrackJob, TrackerParams, WeakSpan};
+use videomocap::track::{TrackJob, TrackerParams, WeakSpan, weak_spans};
 use videomocap::video::VideoInfo;
 
 /// How the app is set up (tests swap the dialogs and the autosave directory).
@@ -430,10 +430,12 @@ impl App {
             self.world = None;
             return;
         };
-        self.strips = p
-            .tracks
-            .as_ref()
-            .map(|t| Strips::new(t, &self.spans, &p.keys, p.settings.tracker.weak_reliability));
+        let weak = p.settings.tracker.weak_reliability;
+        self.strips = p.tracks.as_ref().map(|t| Strips::new(t, &p.keys, weak));
+        // From the tracks, so a reopened project or an undone re-track shows its own spans.
+        self.spans = p.tracks.as_ref().map_or_else(Vec::new, |t| {
+            weak_spans(&t.frames, weak, &|i, j| p.keys.is_key(t.frames[i].index, j))
+        });
         self.world = p
             .skeleton
             .as_ref()
@@ -788,16 +790,7 @@ impl App {
                 return Some((k, PointState::Key));
             }
             let t = tracked?.points[j];
-            let state = if t.source == PointSource::Interpolated {
-                PointState::Interpolated
-            } else if t.source == PointSource::OffFrame {
-                PointState::OffFrame
-            } else if t.confidence < weak {
-                PointState::Weak
-            } else {
-                PointState::Tracked
-            };
-            Some((t.pos, state))
+            Some((t.pos, PointState::of(&t, weak)))
         })
     }
 
@@ -921,7 +914,6 @@ impl App {
                     self.status = "Tracking finished for an older edit; result dropped".to_owned();
                     return;
                 }
-                self.spans = out.spans;
                 let tracks = Arc::new(out.tracks);
                 if let Some(p) = &mut self.project {
                     p.tracks = Some(tracks);

@@ -4,6 +4,7 @@
 
 use egui::{Color32, Pos2, Rect, Sense, Stroke, Vec2};
 use nalgebra::Point2;
+use videomocap::formats::{PointSource, TrackedPoint};
 use videomocap::skeleton::{Bone, Joint, PerJoint};
 
 /// How a drawn joint was obtained.
@@ -19,9 +20,23 @@ pub enum PointState {
     Interpolated,
     /// Outside the image: the tracker's estimate.
     OffFrame,
+    /// In a weak run too long to fill: the tracker's guess.
+    Lost,
 }
 
 impl PointState {
+    /// The state of a tracked point that was not placed by hand; `weak` is the tracker's
+    /// reliability threshold.
+    pub fn of(p: &TrackedPoint, weak: f32) -> PointState {
+        match p.source {
+            PointSource::Interpolated => PointState::Interpolated,
+            PointSource::OffFrame => PointState::OffFrame,
+            PointSource::Lost => PointState::Lost,
+            PointSource::Tracked if p.confidence < weak => PointState::Weak,
+            PointSource::Tracked => PointState::Tracked,
+        }
+    }
+
     /// Colour used in the frame view and the timeline.
     pub fn colour(self) -> Color32 {
         match self {
@@ -30,6 +45,7 @@ impl PointState {
             PointState::Weak => Color32::from_rgb(240, 150, 30),
             PointState::Interpolated => Color32::from_rgb(80, 140, 255),
             PointState::OffFrame => Color32::from_rgb(170, 110, 230),
+            PointState::Lost => Color32::from_rgb(220, 50, 50),
         }
     }
 }

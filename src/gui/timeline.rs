@@ -4,12 +4,9 @@
 
 use super::frame_view::PointState;
 use egui::{Color32, Rect, Sense, Stroke, Vec2};
-use videomocap::formats::{PointSource, Tracks2d};
+use videomocap::formats::Tracks2d;
 use videomocap::skeleton::{JOINT_COUNT, Joint};
-use videomocap::track::{KeyFrames, SpanKind, WeakSpan};
-
-/// Colour of frames in a weak span that was left weak (the joint is probably lost there).
-pub const LOST: Color32 = Color32::from_rgb(220, 50, 50);
+use videomocap::track::KeyFrames;
 
 /// Per joint, runs of frames with one colour: `(first, last, colour)`.
 #[derive(Debug, Clone, Default)]
@@ -18,31 +15,17 @@ pub struct Strips {
 }
 
 impl Strips {
-    /// Strips from tracks, the weak spans and the key frames.
-    pub fn new(tracks: &Tracks2d, spans: &[WeakSpan], keys: &KeyFrames, weak: f32) -> Strips {
+    /// Strips from tracks and the key frames; `weak` is the tracker's reliability threshold.
+    pub fn new(tracks: &Tracks2d, keys: &KeyFrames, weak: f32) -> Strips {
         let runs = Joint::ALL
             .iter()
             .map(|&j| {
                 let mut runs: Vec<(usize, usize, Color32)> = Vec::new();
                 for (k, f) in tracks.frames.iter().enumerate() {
-                    let p = f.points[j];
-                    let lost = spans.iter().any(|s| {
-                        s.joint == j.name()
-                            && s.kind == SpanKind::Weak
-                            && (s.start..=s.end).contains(&f.index)
-                    });
                     let colour = if keys.is_key(f.index, j) {
                         PointState::Key.colour()
-                    } else if p.source == PointSource::OffFrame {
-                        PointState::OffFrame.colour()
-                    } else if lost {
-                        LOST
-                    } else if p.source == PointSource::Interpolated {
-                        PointState::Interpolated.colour()
-                    } else if p.confidence < weak {
-                        PointState::Weak.colour()
                     } else {
-                        PointState::Tracked.colour()
+                        PointState::of(&f.points[j], weak).colour()
                     };
                     match runs.last_mut() {
                         Some(last) if last.2 == colour && last.1 + 1 == k => last.1 = k,
@@ -123,18 +106,18 @@ pub fn show(
 mod tests {
     use super::*;
     use nalgebra::Point2;
-    use videomocap::formats::{FrameTracks, SourceInfo, TrackedPoint};
+    use videomocap::formats::{FrameTracks, PointSource, SourceInfo, TrackedPoint};
     use videomocap::skeleton::PerJoint;
 
     #[test]
-    fn strips_colour_each_state_and_off_the_frame_is_not_lost() {
-        // Left wrist: tracked, weak, interpolated, off the frame, then a weak span left weak.
+    fn strips_colour_each_state() {
+        // Left wrist: tracked, weak, interpolated, off the frame, lost.
         let states = [
             (0.9, PointSource::Tracked),
             (0.2, PointSource::Tracked),
             (0.2, PointSource::Interpolated),
             (0.0, PointSource::OffFrame),
-            (0.1, PointSource::Tracked),
+            (0.1, PointSource::Lost),
         ];
         let tracks = Tracks2d {
             source: SourceInfo {
@@ -165,14 +148,7 @@ mod tests {
                 })
                 .collect(),
         };
-        let spans = [WeakSpan {
-            joint: "left_wrist",
-            start: 4,
-            end: 4,
-            kind: SpanKind::Weak,
-            min_reliability: 0.1,
-        }];
-        let strips = Strips::new(&tracks, &spans, &KeyFrames::default(), 0.45);
+        let strips = Strips::new(&tracks, &KeyFrames::default(), 0.45);
         let colours: Vec<Color32> = strips.runs[Joint::LeftWrist.index()]
             .iter()
             .map(|r| r.2)
@@ -184,7 +160,7 @@ mod tests {
                 PointState::Weak.colour(),
                 PointState::Interpolated.colour(),
                 PointState::OffFrame.colour(),
-                LOST,
+                PointState::Lost.colour(),
             ]
         );
     }

@@ -80,6 +80,8 @@ pub enum FrameFlag {
     TooLong(Bone),
     /// The joint's 2D track was off the frame: its 3D position rests on the tracker's estimate.
     OffFrame(Joint),
+    /// The joint's 2D track was lost (a weak run too long to fill): it rests on a guess.
+    Lost(Joint),
 }
 
 impl fmt::Display for FrameFlag {
@@ -88,6 +90,7 @@ impl fmt::Display for FrameFlag {
             FrameFlag::KeyTriangleNotConverged => f.write_str("key_triangle_not_converged"),
             FrameFlag::TooLong(b) => write!(f, "too_long:{}", b.key()),
             FrameFlag::OffFrame(j) => write!(f, "{}{}", crate::formats::OFF_FRAME_FLAG, j.name()),
+            FrameFlag::Lost(j) => write!(f, "{}{}", crate::formats::LOST_FLAG, j.name()),
         }
     }
 }
@@ -301,8 +304,11 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
                     .chain(
                         Joint::ALL
                             .into_iter()
-                            .filter(|&j| f.points[j].source == PointSource::OffFrame)
-                            .map(FrameFlag::OffFrame),
+                            .filter_map(|j| match f.points[j].source {
+                                PointSource::OffFrame => Some(FrameFlag::OffFrame(j)),
+                                PointSource::Lost => Some(FrameFlag::Lost(j)),
+                                PointSource::Tracked | PointSource::Interpolated => None,
+                            }),
                     )
                     .collect(),
             })

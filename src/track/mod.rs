@@ -21,6 +21,6 @@ pub mod run;
 pub mod search;
 pub mod similarity;
 
-pub use occlusion::{SpanKind, WeakSpan};
+pub use occlusion::{SpanKind, WeakSpan, weak_spans};
 pub use params::TrackerParams;
 pub use run::{KeyFrames, TrackError, TrackJob, TrackOutput, TrackProgress, track_video};

@@ -3,6 +3,8 @@
 //! with no reliable frame on one side, are reported as weak spans and never silently filled.
 //! Runs in which the joint leaves the image are reported as off-frame spans and never filled:
 //! a straight line between the exit and the re-entry would draw the joint inside the frame.
+//! The points of runs left weak are marked lost, so the tracks alone (a saved file, a project,
+//! an undone edit) give the same spans again ([`weak_spans`]).
 //! Key frames (hand-placed joints) always count as reliable anchors.
 
 use crate::formats::{FrameTracks, PointSource};
@@ -47,43 +49,49 @@ pub struct WeakSpan {
     pub min_reliability: f32,
 }
 
-/// Fills short weak runs by interpolation and lists every weak run. `frames` must hold
-/// consecutive frame indices; `is_key(frame position, joint)` marks hand-placed joints.
+/// The runs `(first, last)` (positions in `frames`) of consecutive frames that are not
+/// `reliable`.
+fn runs(n: usize, reliable: impl Fn(usize) -> bool) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < n {
+        if reliable(i) {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        while i < n && !reliable(i) {
+            i += 1;
+        }
+        out.push((start, i - 1));
+    }
+    out
+}
+
+/// Fills short weak runs by interpolation, marks the rest lost, and lists every weak run.
+/// `frames` must hold consecutive frame indices; `is_key(frame position, joint)` marks
+/// hand-placed joints.
 pub fn fill_weak_runs(
     frames: &mut [FrameTracks],
     weak: f32,
     max_gap: usize,
     is_key: &dyn Fn(usize, Joint) -> bool,
 ) -> Vec<WeakSpan> {
-    let mut spans = Vec::new();
     let n = frames.len();
     for joint in Joint::ALL {
-        let reliable = |frames: &[FrameTracks], i: usize| {
+        let weak_runs = runs(n, |i| {
             is_key(i, joint) || frames[i].points[joint].confidence >= weak
-        };
-        let mut i = 0;
-        while i < n {
-            if reliable(frames, i) {
-                i += 1;
+        });
+        for (start, end) in weak_runs {
+            let run = &mut frames[start..=end];
+            if run
+                .iter()
+                .any(|f| f.points[joint].source == PointSource::OffFrame)
+            {
                 continue;
             }
-            let start = i;
-            while i < n && !reliable(frames, i) {
-                i += 1;
-            }
-            let end = i - 1;
-            let min_reliability = frames[start..=end]
-                .iter()
-                .map(|f| f.points[joint].confidence)
-                .fold(f32::INFINITY, f32::min);
-            let bounded = start > 0 && end + 1 < n;
             let len = end - start + 1;
-            let off_frame = frames[start..=end]
-                .iter()
-                .any(|f| f.points[joint].source == PointSource::OffFrame);
-            let kind = if off_frame {
-                SpanKind::OffFrame
-            } else if bounded && len <= max_gap {
+            if start > 0 && end + 1 < n && len <= max_gap {
                 let a = frames[start - 1].points[joint].pos;
                 let b = frames[end + 1].points[joint].pos;
                 for (k, f) in frames[start..=end].iter_mut().enumerate() {
@@ -92,16 +100,50 @@ pub fn fill_weak_runs(
                     p.pos = a + (b - a) * t;
                     p.source = PointSource::Interpolated;
                 }
-                SpanKind::Interpolated
             } else {
+                for f in run {
+                    f.points[joint].source = PointSource::Lost;
+                }
+            }
+        }
+    }
+    weak_spans(frames, weak, is_key)
+}
+
+/// Lists every weak run of tracks as [`fill_weak_runs`] left them (or as read from a file):
+/// consecutive frames of a joint that are not key frames and not tracked with reliability at
+/// least `weak`. A run is off the frame when the joint leaves the image in it, weak when it
+/// holds a lost (or, in files without states, a weak tracked) point, interpolated otherwise.
+pub fn weak_spans(
+    frames: &[FrameTracks],
+    weak: f32,
+    is_key: &dyn Fn(usize, Joint) -> bool,
+) -> Vec<WeakSpan> {
+    let mut spans = Vec::new();
+    for joint in Joint::ALL {
+        let weak_runs = runs(frames.len(), |i| {
+            let p = frames[i].points[joint];
+            is_key(i, joint) || (p.source == PointSource::Tracked && p.confidence >= weak)
+        });
+        for (start, end) in weak_runs {
+            let run = &frames[start..=end];
+            let has = |source| run.iter().any(|f| f.points[joint].source == source);
+            let kind = if has(PointSource::OffFrame) {
+                SpanKind::OffFrame
+            } else if has(PointSource::Lost) || has(PointSource::Tracked) {
                 SpanKind::Weak
+            } else {
+                SpanKind::Interpolated
             };
             spans.push(WeakSpan {
                 joint: joint.name(),
-                start: frames[start].index,
-                end: frames[end].index,
+                start: run[0].index,
+                end: run[run.len() - 1].index,
                 kind,
-                min_reliability,
+                min_reliability: run
+                    .iter()
+                    .map(|f| f.points[joint].confidence)
+                    .fold(f32::INFINITY, f32::min),
             });
         }
     }
@@ -148,8 +190,11 @@ mod tests {
         assert!((f[2].points[Joint::HeadTop].pos.x - 20.0).abs() < 1e-9);
         assert!((f[3].points[Joint::HeadTop].pos.x - 30.0).abs() < 1e-9);
         assert_eq!(f[3].points[Joint::Neck].source, PointSource::Interpolated);
-        // The long run keeps its tracked (wrong) positions and stays flagged tracked.
-        assert_eq!(f[6].points[Joint::HeadTop].source, PointSource::Tracked);
+        // The long run keeps its tracked (wrong) positions, marked lost.
+        assert_eq!(f[6].points[Joint::HeadTop].source, PointSource::Lost);
+        assert_eq!(f[6].points[Joint::HeadTop].pos.x, 160.0);
+        // The tracks alone give the same spans.
+        assert_eq!(weak_spans(&f, 0.5, &|_, _| false), spans);
     }
 
     #[test]
