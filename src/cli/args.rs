@@ -283,6 +283,10 @@ pub struct BenchArgs {
     /// Length of the 1080p clip `bench scrub` makes, minutes.
     #[arg(long, default_value_t = 20.0)]
     pub minutes: f64,
+    /// Keyframe interval of the clip `bench scrub` makes, frames (250, x264's default, is 8.3 s
+    /// at 30 fps; phone cameras write about one keyframe a second, 30).
+    #[arg(long, default_value_t = 250)]
+    pub gop: u32,
     /// Where the synthetic tracking suite is rendered (once) and kept.
     #[arg(long, default_value = "out/bench-suite")]
     pub suite_dir: PathBuf,

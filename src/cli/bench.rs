@@ -40,7 +40,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
                 global,
                 &format!("making a {w}×{h} H.264 clip of {} frames …", a.frames),
             );
-            make_clip(&file, w, h, a.frames, ClipKind::Noisy).map_err(ExitError::failed)?;
+            make_clip(&file, w, h, a.frames, ClipKind::Noisy, 250).map_err(ExitError::failed)?;
             let ours = our_decode_fps(&file).map_err(ExitError::failed)?;
             let theirs = ffmpeg_decode_fps(&file, a.frames).map_err(ExitError::failed)?;
             rows.push([
@@ -108,13 +108,15 @@ pub(super) enum ClipKind {
     Plain,
 }
 
-/// A testsrc2 clip at 30 fps, H.264, GOP 250, made by the `ffmpeg` command.
+/// A testsrc2 clip at 30 fps, H.264 with a keyframe every `gop` frames, made by the `ffmpeg`
+/// command.
 pub(super) fn make_clip(
     path: &Path,
     w: u32,
     h: u32,
     frames: usize,
     kind: ClipKind,
+    gop: u32,
 ) -> anyhow::Result<()> {
     let mut cmd = Command::new("ffmpeg");
     cmd.args([
@@ -141,7 +143,8 @@ pub(super) fn make_clip(
     let status = cmd
         .arg("-frames:v")
         .arg(frames.to_string())
-        .args(["-c:v", "libx264", "-pix_fmt", "yuv420p", "-g", "250"])
+        .args(["-c:v", "libx264", "-pix_fmt", "yuv420p", "-g"])
+        .arg(gop.max(1).to_string())
         .arg(path)
         .status()
         .context("bench needs the ffmpeg command (apt-get install ffmpeg)")?;

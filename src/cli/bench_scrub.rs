@@ -16,18 +16,31 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let dir = std::path::Path::new("out/bench-scrub");
     std::fs::create_dir_all(dir).map_err(ExitError::failed)?;
     let frames = (a.minutes * 60.0 * 30.0).round().max(2.0) as usize;
-    let file = dir.join(format!("long_1080p_{frames}.mp4"));
+    // Named as before for the default GOP, so clips made earlier are reused.
+    let file = if a.gop == 250 {
+        dir.join(format!("long_1080p_{frames}.mp4"))
+    } else {
+        dir.join(format!("long_1080p_{frames}_gop{}.mp4", a.gop))
+    };
     if !file.is_file() {
         say(
             global,
             &format!(
-                "making a 1920×1080 H.264 clip of {frames} frames ({} min, kept in {}) …",
+                "making a 1920×1080 H.264 clip of {frames} frames ({} min, keyframe every {} frames, kept in {}) …",
                 a.minutes,
+                a.gop,
                 dir.display()
             ),
         );
-        super::bench::make_clip(&file, 1920, 1080, frames, super::bench::ClipKind::Plain)
-            .map_err(ExitError::failed)?;
+        super::bench::make_clip(
+            &file,
+            1920,
+            1080,
+            frames,
+            super::bench::ClipKind::Plain,
+            a.gop,
+        )
+        .map_err(ExitError::failed)?;
     }
     let rss_before = peak_rss_mib();
     let t0 = Instant::now();
@@ -89,7 +102,11 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let rows = [
         (
             "clip",
-            format!("1920×1080, {n} frames ({:.1} min)", n as f64 / 30.0 / 60.0),
+            format!(
+                "1920×1080, {n} frames ({:.1} min), keyframe every {} frames",
+                n as f64 / 30.0 / 60.0,
+                a.gop
+            ),
         ),
         ("open (reads the frame index)", format!("{open_s:.2} s")),
         ("random seek, median", format!("{:.0} ms", pct(0.5))),

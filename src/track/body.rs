@@ -11,6 +11,7 @@ use super::head::HeadPredictor;
 use super::params::TrackerParams;
 use super::search::{AngularParams, Found, Prior, SpiralParams, angular, spiral};
 use super::similarity::{Extent, FrameView, Template};
+use crate::camera::point_in_frame;
 use crate::skeleton::{BodyPart, Joint, PerJoint, Proportions};
 use image::RgbImage;
 use nalgebra::Point2;
@@ -407,12 +408,10 @@ fn accept(part: &mut Part, found: Found, frame: FrameView, p: &TrackerParams) {
     }
 }
 
-/// Whether a point lies off the image (pixel centres at integers).
+/// Whether a point lies off the image.
 fn off_image(q: Point2<f64>, frame: FrameView) -> bool {
-    q.x < -0.5
-        || q.y < -0.5
-        || q.x > frame.width() as f64 - 0.5
-        || q.y > frame.height() as f64 - 0.5
+    // Frame sides come from u32 image sizes.
+    !point_in_frame(&q, frame.width() as u32, frame.height() as u32)
 }
 
 /// One limb chain: the upper block anchored at the root, the lower at the found middle joint.

@@ -400,6 +400,39 @@ mod tests {
     }
 
     #[test]
+    fn a_length_range_of_zero_holds_the_length() {
+        let shoulder = Point2::new(80.0, 40.0);
+        let a = bar(shoulder, Point2::new(80.0, 110.0), 16.0);
+        // The limb turned and is shorter in the next frame, but its length is held.
+        let b = bar(shoulder, Point2::new(105.0, 84.0), 16.0);
+        let block = MorphBlock::along(shoulder, Point2::new(80.0, 110.0), 16.0);
+        let t = Template::sample(
+            FrameView::new(&a),
+            &block,
+            Extent::BLOCK,
+            SimilarityWeights::default(),
+        );
+        let found = angular(
+            &t,
+            FrameView::new(&b),
+            &block,
+            &AngularParams {
+                range_theta: 0.7,
+                step_theta: 0.05,
+                range_m: 0.0,
+                m_count: 1,
+                scale_width: false,
+            },
+            &Prior::NONE,
+        );
+        assert_eq!(found.block.m, block.m);
+        assert!(
+            (found.block.theta - block.theta).abs() > 0.3,
+            "the angle was searched"
+        );
+    }
+
+    #[test]
     fn the_spiral_search_follows_a_moved_block() {
         let a = bar(Point2::new(60.0, 50.0), Point2::new(70.0, 100.0), 20.0);
         let b = bar(Point2::new(66.0, 46.0), Point2::new(76.0, 96.0), 20.0);
