@@ -296,26 +296,18 @@ pub fn rest_pose(
     p[Joint::Chest] = p[Joint::Pelvis] + len(Joint::Pelvis, Joint::Chest) * up;
     p[Joint::Neck] = p[Joint::Chest] + len(Joint::Chest, Joint::Neck) * up;
     p[Joint::HeadTop] = p[Joint::Neck] + len(Joint::Neck, Joint::HeadTop) * up;
-    for (side, shoulder, elbow, wrist, hip, knee, ankle) in [
-        (
-            1.0,
+    for side in [1.0, -1.0] {
+        // The left side's joints, mirrored for the right.
+        let on_side = |j: Joint| if side > 0.0 { j } else { j.mirrored() };
+        let [shoulder, elbow, wrist, hip, knee, ankle] = [
             Joint::LeftShoulder,
             Joint::LeftElbow,
             Joint::LeftWrist,
             Joint::LeftHip,
             Joint::LeftKnee,
             Joint::LeftAnkle,
-        ),
-        (
-            -1.0,
-            Joint::RightShoulder,
-            Joint::RightElbow,
-            Joint::RightWrist,
-            Joint::RightHip,
-            Joint::RightKnee,
-            Joint::RightAnkle,
-        ),
-    ] {
+        ]
+        .map(on_side);
         let clavicle = len(Joint::Chest, shoulder);
         let out = (0.5 * shoulder_width).min(clavicle);
         let rise = (clavicle * clavicle - out * out).max(0.0).sqrt();

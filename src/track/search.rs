@@ -369,12 +369,13 @@ mod tests {
         })
     }
 
-    #[test]
-    fn the_angular_search_finds_a_turned_and_shortened_limb() {
+    /// A 70 px limb hanging from (80, 40) that ends at `end` in the next frame, searched with
+    /// ±0.7 rad of angle and the given length range; returns the first frame's block and the
+    /// result.
+    fn search_turned_limb(end: Point2<f64>, range_m: f64, m_count: usize) -> (MorphBlock, Found) {
         let shoulder = Point2::new(80.0, 40.0);
         let a = bar(shoulder, Point2::new(80.0, 110.0), 16.0);
-        let truth = Point2::new(80.0 + 50.0 * 0.5f64.sin(), 40.0 + 50.0 * 0.5f64.cos()); // 29° turn, shortened
-        let b = bar(shoulder, truth, 16.0);
+        let b = bar(shoulder, end, 16.0);
         let block = MorphBlock::along(shoulder, Point2::new(80.0, 110.0), 16.0);
         let t = Template::sample(
             FrameView::new(&a),
@@ -389,42 +390,27 @@ mod tests {
             &AngularParams {
                 range_theta: 0.7,
                 step_theta: 0.05,
-                range_m: 0.35,
-                m_count: 5,
+                range_m,
+                m_count,
                 scale_width: false,
             },
             &Prior::NONE,
         );
+        (block, found)
+    }
+
+    #[test]
+    fn the_angular_search_finds_a_turned_and_shortened_limb() {
+        let truth = Point2::new(80.0 + 50.0 * 0.5f64.sin(), 40.0 + 50.0 * 0.5f64.cos()); // 29° turn, shortened
+        let (_, found) = search_turned_limb(truth, 0.35, 5);
         let err = (found.block.end() - truth).norm();
         assert!(err < 2.0, "elbow off by {err} px");
     }
 
     #[test]
     fn a_length_range_of_zero_holds_the_length() {
-        let shoulder = Point2::new(80.0, 40.0);
-        let a = bar(shoulder, Point2::new(80.0, 110.0), 16.0);
         // The limb turned and is shorter in the next frame, but its length is held.
-        let b = bar(shoulder, Point2::new(105.0, 84.0), 16.0);
-        let block = MorphBlock::along(shoulder, Point2::new(80.0, 110.0), 16.0);
-        let t = Template::sample(
-            FrameView::new(&a),
-            &block,
-            Extent::BLOCK,
-            SimilarityWeights::default(),
-        );
-        let found = angular(
-            &t,
-            FrameView::new(&b),
-            &block,
-            &AngularParams {
-                range_theta: 0.7,
-                step_theta: 0.05,
-                range_m: 0.0,
-                m_count: 1,
-                scale_width: false,
-            },
-            &Prior::NONE,
-        );
+        let (block, found) = search_turned_limb(Point2::new(105.0, 84.0), 0.0, 1);
         assert_eq!(found.block.m, block.m);
         assert!(
             (found.block.theta - block.theta).abs() > 0.3,
