@@ -7,6 +7,7 @@ use image::{Rgb, RgbImage};
 use rand::SeedableRng;
 use rand::seq::SliceRandom;
 use std::path::Path;
+use videomocap::video::proxy::{self, BuildOutcome};
 use videomocap::video::{EncodeParams, Mp4Writer, OpenOptions, Video};
 
 /// A frame whose content changes with `i` everywhere (moving gradient plus a counter bar).
@@ -26,17 +27,31 @@ fn test_frame(i: usize, w: u32, h: u32) -> RgbImage {
 }
 
 fn make_clip(path: &Path, frames: usize) {
+    make_clip_sized(path, frames, 160, 120);
+}
+
+fn make_clip_sized(path: &Path, frames: usize, width: u32, height: u32) {
     let params = EncodeParams {
         fps: 30,
         gop: 250,
         max_b_frames: 3,
         crf: 23,
     };
-    let mut w = Mp4Writer::create(path, 160, 120, &params).unwrap();
+    let mut w = Mp4Writer::create(path, width, height, &params).unwrap();
     for i in 0..frames {
-        w.write(&test_frame(i, 160, 120)).unwrap();
+        w.write(&test_frame(i, width, height)).unwrap();
     }
     w.finish().unwrap();
+}
+
+fn mean_abs_diff(a: &RgbImage, b: &RgbImage) -> f64 {
+    assert_eq!(a.dimensions(), b.dimensions());
+    a.as_raw()
+        .iter()
+        .zip(b.as_raw())
+        .map(|(x, y)| f64::from(x.abs_diff(*y)))
+        .sum::<f64>()
+        / a.as_raw().len() as f64
 }
 
 fn no_cache() -> OpenOptions {
@@ -180,5 +195,106 @@ fn display_rotation_is_applied_as_ffmpeg_itself_applies_it() {
             mean_diff < 6.0,
             "rotate={rotate}: mean difference {mean_diff} from ffmpeg's own"
         );
+        // The seek proxy is made from the displayed frames: turned the same way.
+        let out = dir.path().join(format!("proxy{rotate}.mp4"));
+        proxy::build(&rotated, &out, &mut |_, _| true).unwrap();
+        let mut p = proxy::open(&out, v.info()).expect("the proxy opens");
+        let shown = p.frame(0).unwrap().image;
+        let proxy_diff = mean_abs_diff(&shown, &expected);
+        assert!(
+            proxy_diff < 8.0,
+            "rotate={rotate}: proxy differs by {proxy_diff} from ffmpeg's own"
+        );
     }
+}
+
+#[test]
+fn a_seek_proxy_shows_every_frame_in_its_place_from_short_gops() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("wide gop250.mp4");
+    // Wider than the proxy's limit, so the proxy is shrunk.
+    make_clip_sized(&path, 300, 1200, 160);
+    let mut video = Video::open(&path, &no_cache()).unwrap();
+    let info = video.info().clone();
+    // Keyframes at 0 and 250: the longest run is 250 frames.
+    assert_eq!(info.keyframe_interval, 250);
+    assert!(proxy::wants_proxy(&info));
+
+    let cache = dir.path().join("proxies");
+    let out = proxy::proxy_path(&cache, &path).unwrap();
+    let mut calls = Vec::new();
+    let outcome = proxy::build(&path, &out, &mut |done, total| {
+        calls.push((done, total));
+        true
+    })
+    .unwrap();
+    assert_eq!(outcome, BuildOutcome::Built);
+    assert_eq!(calls.first(), Some(&(0, 300)));
+    assert_eq!(calls.last(), Some(&(300, 300)));
+    let mut p = proxy::open(&out, &info).expect("the proxy opens");
+    assert_eq!(p.info().frame_count, 300);
+    assert_eq!((p.info().width, p.info().height), (960, 128));
+    assert!(p.info().keyframe_interval <= proxy::PROXY_GOP as usize);
+    assert!(!proxy::wants_proxy(p.info()));
+    for i in [0usize, 1, 77, 249, 250, 251, 299] {
+        let shown = p.frame(i).unwrap().image;
+        let mut small = |j: usize| video_frame_small(&mut video, j);
+        let here = mean_abs_diff(&shown, &small(i));
+        assert!(
+            here < 8.0,
+            "frame {i}: proxy differs by {here:.1} on average"
+        );
+        for j in [i.saturating_sub(1), (i + 1).min(299)] {
+            if j != i {
+                assert!(
+                    here < mean_abs_diff(&shown, &small(j)),
+                    "proxy frame {i} looks more like frame {j}"
+                );
+            }
+        }
+    }
+}
+
+/// Frame `j` of `video` shrunk to the proxy's size.
+fn video_frame_small(video: &mut Video, j: usize) -> RgbImage {
+    let (w, h) = proxy::proxy_size(video.info().width, video.info().height);
+    image::imageops::resize(
+        &*video.frame(j).unwrap().image,
+        w,
+        h,
+        image::imageops::FilterType::Triangle,
+    )
+}
+
+#[test]
+fn a_cancelled_proxy_leaves_nothing_and_a_proxy_that_does_not_fit_is_dropped() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("gop250.mp4");
+    make_clip(&path, 300);
+    let cache = dir.path().join("proxies");
+    let out = proxy::proxy_path(&cache, &path).unwrap();
+    let outcome = proxy::build(&path, &out, &mut |done, _| done < 40).unwrap();
+    assert_eq!(outcome, BuildOutcome::Cancelled);
+    assert!(!out.exists());
+    assert_eq!(
+        std::fs::read_dir(&cache).unwrap().count(),
+        0,
+        "partial file left"
+    );
+
+    assert_eq!(
+        proxy::build(&path, &out, &mut |_, _| true).unwrap(),
+        BuildOutcome::Built
+    );
+    let mut info = Video::open(&path, &no_cache()).unwrap().info().clone();
+    assert!(proxy::open(&out, &info).is_some());
+    // A proxy of another length (say, of the file before it was re-encoded) is not used.
+    info.frame_count = 299;
+    assert!(proxy::open(&out, &info).is_none());
+    assert!(!out.exists(), "the proxy that did not fit was not removed");
+    // A video that is not one gives the usual error, naming it.
+    let bad = dir.path().join("notes.txt");
+    std::fs::write(&bad, "not a video").unwrap();
+    let err = proxy::build(&bad, &cache.join("x.mp4"), &mut |_, _| true).unwrap_err();
+    assert!(err.to_string().contains("notes.txt"), "{err}");
 }

@@ -33,6 +33,15 @@ pub fn run(path: &Path, global: &GlobalArgs) -> Result<(), ExitError> {
     println!("duration:    {:.3} s", info.duration_s);
     println!("rotation:    {}°", info.rotation_deg);
     println!("codec:       {}", info.codec);
+    println!(
+        "keyframes:   at most {} frames apart{}",
+        info.keyframe_interval,
+        if videomocap::video::proxy::wants_proxy(info) {
+            " (the app makes a seek proxy)"
+        } else {
+            ""
+        }
+    );
     Ok(())
 }
 

@@ -42,7 +42,11 @@ pub struct FfmpegSource {
     pts: Vec<i64>,
     /// Indexes (into `pts`) of the keyframes, ascending.
     keyframes: Vec<usize>,
-    scaler: Option<(ff::software::scaling::Context, ff::format::Pixel, u32, u32)>,
+    /// The converter from the decoder's pixels to RGB, and what it was made for (source format,
+    /// source size, output size).
+    scaler: Option<(ff::software::scaling::Context, ScalerKey)>,
+    /// Output size before rotation, if frames are shrunk ([`FfmpegSource::shrink_to`]).
+    shrunk: Option<(u32, u32)>,
     /// Index of the last frame the decoder produced, if it is positioned after it.
     last_decoded: Option<usize>,
     /// Whether end of stream was sent to the decoder since the last seek.
@@ -192,6 +196,7 @@ impl FfmpegSource {
             rotation_deg,
             codec,
             variable_frame_rate,
+            keyframe_interval: longest_interval(&keyframes, frame_count),
         };
         // Back to the start for decoding.
         input.seek(i64::MIN + 1, ..).ok();
@@ -203,6 +208,7 @@ impl FfmpegSource {
             pts,
             keyframes,
             scaler: None,
+            shrunk: None,
             last_decoded: None,
             eof_sent: false,
             skip_until_pts: None,
@@ -210,6 +216,20 @@ impl FfmpegSource {
         };
         me.seek_to_keyframe_before(0)?;
         Ok(me)
+    }
+
+    /// Makes every later frame come out `width × height` (as displayed, after rotation)
+    /// instead of full size: the video is scaled while its pixels are converted to RGB, which
+    /// costs less than converting at full size. The info reports the new size.
+    pub fn shrink_to(&mut self, width: u32, height: u32) {
+        let (width, height) = (width.max(1), height.max(1));
+        self.shrunk = Some(if self.info.rotation_deg % 180 == 90 {
+            (height, width)
+        } else {
+            (width, height)
+        });
+        self.info.width = width;
+        self.info.height = height;
     }
 
     fn path(&self) -> PathBuf {
@@ -348,21 +368,21 @@ impl FfmpegSource {
         frame: &ff::frame::Video,
         index: usize,
     ) -> Result<RgbImage, VideoError> {
-        let (fmt, w, h) = (frame.format(), frame.width(), frame.height());
-        let rebuild =
-            !matches!(&self.scaler, Some((_, f, sw, sh)) if *f == fmt && *sw == w && *sh == h);
-        if rebuild {
+        let (fmt, sw, sh) = (frame.format(), frame.width(), frame.height());
+        let (w, h) = self.shrunk.unwrap_or((sw, sh));
+        let key = (fmt, sw, sh, w, h);
+        if !matches!(&self.scaler, Some((_, k)) if *k == key) {
             let ctx = ff::software::scaling::Context::get(
                 fmt,
-                w,
-                h,
+                sw,
+                sh,
                 ff::format::Pixel::RGB24,
                 w,
                 h,
                 ff::software::scaling::Flags::BILINEAR,
             )
             .map_err(|e| self.decode_error(index, e))?;
-            self.scaler = Some((ctx, fmt, w, h));
+            self.scaler = Some((ctx, key));
         }
         let mut rgb = ff::frame::Video::empty();
         if let Some((ctx, ..)) = self.scaler.as_mut() {
@@ -388,6 +408,19 @@ impl FfmpegSource {
             .ok_or_else(|| self.decode_error(index, "converted frame has the wrong size"))?;
         Ok(rotate_clockwise(image, self.info.rotation_deg))
     }
+}
+
+/// What a scaler converts: source pixel format and size, output size.
+type ScalerKey = (ff::format::Pixel, u32, u32, u32, u32);
+
+/// The longest run of frames from a keyframe to the next one, or to the end.
+fn longest_interval(keyframes: &[usize], frame_count: usize) -> usize {
+    keyframes
+        .iter()
+        .zip(keyframes.iter().skip(1).chain([&frame_count]))
+        .map(|(a, b)| b.saturating_sub(*a))
+        .max()
+        .unwrap_or(frame_count)
 }
 
 /// Frame rate reported when the file gives none and has a single frame.

@@ -90,6 +90,7 @@ impl ImageSequence {
             rotation_deg: 0,
             codec,
             variable_frame_rate: false,
+            keyframe_interval: 1,
         };
         Ok(ImageSequence { files, info })
     }

@@ -11,6 +11,7 @@ mod error;
 #[cfg(feature = "ffmpeg")]
 mod ffmpeg;
 mod image_sequence;
+pub mod proxy;
 mod span;
 
 pub use cache::{DEFAULT_CACHE_BYTES, FrameCache};
@@ -48,6 +49,9 @@ pub struct VideoInfo {
     pub codec: String,
     /// Whether frame times are unevenly spaced (variable frame rate).
     pub variable_frame_rate: bool,
+    /// The longest run of frames from one keyframe to the next (or to the end): how many frames
+    /// a random seek may have to decode. 1 for image sequences.
+    pub keyframe_interval: usize,
 }
 
 /// One decoded frame.
