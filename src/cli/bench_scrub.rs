@@ -1,7 +1,8 @@
 //! `videomocap bench scrub`: what the desktop app's frame access costs on a long 1080p clip made
 //! with `ffmpeg -f lavfi`: opening (the frame index), random seeks, stepping through frames,
 //! revisiting cached frames (decode cache plus the RGB → RGBA copy the texture upload needs),
-//! tracking a 300-frame span from the middle, and the process's peak memory. The app does the same calls on its frame-loader thread.
+//! the seek proxy (its build, and seeks shown from it), tracking a 300-frame span from the
+//! middle, and the process's peak memory. The app does the same calls on its frame-loader thread.
 
 use super::args::{BenchArgs, GlobalArgs};
 use super::{ExitError, say};
@@ -48,14 +49,15 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let open_s = t0.elapsed().as_secs_f64();
     let n = video.info().frame_count;
     let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+    let targets: Vec<usize> = (0..40).map(|_| rng.random_range(0..n)).collect();
     let mut seeks: Vec<f64> = Vec::new();
-    for _ in 0..40 {
-        let k = rng.random_range(0..n);
+    for &k in &targets {
         let t = Instant::now();
         video.frame(k).map_err(ExitError::failed)?;
         seeks.push(t.elapsed().as_secs_f64() * 1000.0);
     }
     seeks.sort_by(f64::total_cmp);
+    let info = video.info().clone();
     let window = n.min(120);
     let start = (n - window) / 2;
     let t = Instant::now();
@@ -82,6 +84,38 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let rss_scrub = peak_rss_mib();
     drop(video);
 
+    // The app's seek proxy: built once in the background, then each seek shows the proxy's
+    // frame (decoded and turned into RGBA for the texture) while the full frame decodes.
+    let proxy_dir = dir.join("proxies");
+    let proxy_file =
+        videomocap::video::proxy::proxy_path(&proxy_dir, &file).map_err(ExitError::failed)?;
+    let proxy_build = if proxy_file.is_file() {
+        "reused from an earlier run (delete out/bench-scrub/proxies to time it)".to_owned()
+    } else {
+        say(global, "building the seek proxy …");
+        let t = Instant::now();
+        videomocap::video::proxy::build(&file, &proxy_file, &mut |_, _| true)
+            .map_err(ExitError::failed)?;
+        format!("{:.0} s", t.elapsed().as_secs_f64())
+    };
+    let proxy_mib = std::fs::metadata(&proxy_file)
+        .map_err(ExitError::failed)?
+        .len() as f64
+        / (1 << 20) as f64;
+    let rss_proxy = peak_rss_mib();
+    let mut proxy = videomocap::video::proxy::open(&proxy_file, &info)
+        .ok_or_else(|| ExitError::failed(anyhow::anyhow!("the proxy does not fit the clip")))?;
+    let (pw, ph) = (proxy.info().width, proxy.info().height);
+    let mut previews: Vec<f64> = Vec::new();
+    for &k in &targets {
+        let t = Instant::now();
+        let f = proxy.frame(k).map_err(ExitError::failed)?;
+        sink += f.image.as_raw().chunks_exact(3).count() * 4;
+        previews.push(t.elapsed().as_secs_f64() * 1000.0);
+    }
+    previews.sort_by(f64::total_cmp);
+    drop(proxy);
+
     // Track a 300-frame span from the middle, as a user tracking one stretch of a long clip.
     let span_len = n.min(300);
     let span_start = (n - span_len) / 2;
@@ -99,6 +133,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         span_start + span_len - 1
     );
     let pct = |q: f64| seeks[((seeks.len() - 1) as f64 * q).round() as usize];
+    let ppct = |q: f64| previews[((previews.len() - 1) as f64 * q).round() as usize];
     let rows = [
         (
             "clip",
@@ -119,6 +154,30 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             "random seeks within 150 ms",
             format!("{} of 40", seeks.iter().filter(|&&s| s <= 150.0).count()),
         ),
+        ("seek proxy: build time", proxy_build),
+        (
+            "seek proxy: size",
+            format!(
+                "{pw}×{ph}, keyframe every {} frames, {proxy_mib:.0} MiB",
+                videomocap::video::proxy::PROXY_GOP
+            ),
+        ),
+        (
+            "seek shown from the proxy, median",
+            format!("{:.0} ms", ppct(0.5)),
+        ),
+        (
+            "seek shown from the proxy, 95th pct",
+            format!("{:.0} ms", ppct(0.95)),
+        ),
+        (
+            "seek shown from the proxy, worst of 40",
+            format!("{:.0} ms", ppct(1.0)),
+        ),
+        (
+            "seeks shown from the proxy within 150 ms",
+            format!("{} of 40", previews.iter().filter(|&&s| s <= 150.0).count()),
+        ),
         (
             "step forward one frame at a time",
             format!("{step_fps:.0} frames/s"),
@@ -135,6 +194,10 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         (
             "peak memory (VmHWM) after scrubbing",
             format!("{rss_scrub:.0} MiB"),
+        ),
+        (
+            "peak memory (VmHWM) after the proxy",
+            format!("{rss_proxy:.0} MiB"),
         ),
         (
             "peak memory (VmHWM) after tracking",

@@ -4,7 +4,7 @@
 
 use super::autosave::Autosaver;
 use super::dialogs::{Dialogs, RfdDialogs};
-use super::frame_loader::{FrameLoader, LoaderEvent};
+use super::frame_loader::{FrameLoader, LoaderEvent, ProxyStatus};
 use super::frame_view::{FrameView, Overlay, PointState, ViewEvent};
 use super::jobs::{Job, JobEvent};
 use super::timeline::{self, Strips};
@@ -29,6 +29,8 @@ pub struct Config {
     pub dialogs: Box<dyn Dialogs>,
     /// Where the recovery file lives (`None`: no autosave).
     pub autosave_dir: Option<PathBuf>,
+    /// Where seek proxies of long-GOP videos are kept (`None`: no proxies).
+    pub proxy_dir: Option<PathBuf>,
 }
 
 impl Default for Config {
@@ -36,6 +38,7 @@ impl Default for Config {
         Config {
             dialogs: Box::new(RfdDialogs),
             autosave_dir: super::autosave::default_dir(),
+            proxy_dir: dirs::cache_dir().map(|d| d.join("videomocap").join("proxies")),
         }
     }
 }
@@ -108,6 +111,8 @@ pub struct App {
     recovery: Option<PathBuf>,
     current: usize,
     shown: Option<usize>,
+    /// The texture holds the seek proxy's smaller picture of `shown`; the full frame follows.
+    preview: bool,
     texture: Option<egui::TextureHandle>,
     view: FrameView,
     orbit: Orbit,
@@ -164,6 +169,7 @@ impl App {
             recovery,
             current: 0,
             shown: None,
+            preview: false,
             texture: None,
             view: FrameView::default(),
             orbit: Orbit::default(),
@@ -392,7 +398,11 @@ impl App {
 
     fn open_video(&mut self, ctx: &egui::Context, path: &Path) {
         self.close_current();
-        self.loader = Some(FrameLoader::open(path.to_owned(), ctx.clone()));
+        self.loader = Some(FrameLoader::open(
+            path.to_owned(),
+            ctx.clone(),
+            self.config.proxy_dir.clone(),
+        ));
         self.project = Some(Project::new(path.to_owned()));
         self.results_changed();
         self.view.fit();
@@ -412,6 +422,7 @@ impl App {
         self.results_changed();
         self.current = 0;
         self.shown = None;
+        self.preview = false;
         self.texture = None;
         self.marking = None;
     }
@@ -794,6 +805,14 @@ impl App {
         })
     }
 
+    /// Puts a decoded frame (full or preview) on screen.
+    fn show_frame(&mut self, ctx: &egui::Context, frame: &videomocap::video::Frame) {
+        let size = [frame.image.width() as usize, frame.image.height() as usize];
+        let image = egui::ColorImage::from_rgb(size, frame.image.as_raw());
+        self.texture = Some(ctx.load_texture("frame", image, egui::TextureOptions::LINEAR));
+        self.shown = Some(frame.index);
+    }
+
     fn go_to(&mut self, index: usize) {
         let n = self.frame_count();
         if n == 0 {
@@ -836,12 +855,22 @@ impl App {
                     self.project = None;
                 }
                 LoaderEvent::Frame(Ok(frame)) => {
-                    let size = [frame.image.width() as usize, frame.image.height() as usize];
-                    let image = egui::ColorImage::from_rgb(size, frame.image.as_raw());
-                    self.texture =
-                        Some(ctx.load_texture("frame", image, egui::TextureOptions::LINEAR));
-                    self.shown = Some(frame.index);
+                    self.show_frame(ctx, &frame);
+                    self.preview = false;
                 }
+                // A preview only stands in for the current frame until the full one comes.
+                LoaderEvent::Preview(frame)
+                    if frame.index == self.current
+                        && (self.shown != Some(frame.index) || self.preview) =>
+                {
+                    self.show_frame(ctx, &frame);
+                    self.preview = true;
+                }
+                LoaderEvent::Preview(_) => {}
+                LoaderEvent::Proxy(ProxyStatus::Failed(e)) => {
+                    self.status = format!("Fast seeking is off: {e}");
+                }
+                LoaderEvent::Proxy(_) => {}
                 LoaderEvent::Frame(Err(e)) => self.status = format!("{e}"),
             }
         }
@@ -1295,6 +1324,49 @@ impl App {
             });
     }
 
+    /// The right end of the status bar: the seek proxy's progress, and whether the frame shown
+    /// is its preview.
+    fn seek_status(&self, ui: &mut egui::Ui) {
+        let Some(loader) = &self.loader else {
+            return;
+        };
+        let gap = loader.info().map_or(0, |i| i.keyframe_interval);
+        match loader.proxy() {
+            Some(ProxyStatus::Building(done, total)) => {
+                let f = *done as f32 / (*total).max(1) as f32;
+                let paused = if self.running.is_some() {
+                    " (paused while tracking)"
+                } else {
+                    ""
+                };
+                ui.add(
+                    egui::ProgressBar::new(f)
+                        .desired_width(140.0)
+                        .text(format!("fast seeking {:.0} %{paused}", f * 100.0)),
+                )
+                .on_hover_text(format!(
+                    "Keyframes in this video are up to {gap} frames apart, so a seek decodes up \
+                     to {gap} frames. A small copy with a keyframe every {} frames is being made \
+                     once (kept in the cache folder) to show any frame at once; the full frame \
+                     follows. Tracking always reads the video itself.",
+                    videomocap::video::proxy::PROXY_GOP
+                ));
+            }
+            Some(ProxyStatus::Ready) => {
+                let text = if self.preview {
+                    "preview (full frame decoding)"
+                } else {
+                    "fast seeking"
+                };
+                ui.weak(text).on_hover_text(format!(
+                    "Keyframes in this video are up to {gap} frames apart: a seek first shows \
+                     the frame from a small copy, then the full frame."
+                ));
+            }
+            _ => {}
+        }
+    }
+
     fn progress_panel(&mut self, ui: &mut egui::Ui) {
         let Some(r) = &self.running else { return };
         let (share, per_s, left) = r.job.rate();
@@ -1550,12 +1622,18 @@ impl eframe::App for App {
             self.open_path(&ctx, p);
         }
         self.receive(&ctx);
+        if let Some(l) = &self.loader {
+            l.pause_background(self.running.is_some());
+        }
         self.handle_keys(&ctx);
         self.play(&ctx);
         egui::Panel::top("menu").show(ui, |ui| self.menu(ui, &ctx));
         egui::Panel::bottom("status").show(ui, |ui| {
             ui.horizontal(|ui| {
                 ui.label(&self.status);
+                ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+                    self.seek_status(ui);
+                });
             });
         });
         if self.running.is_some() {
@@ -1626,8 +1704,14 @@ impl eframe::App for App {
             asking: self.asking(),
         };
         let mut event = None;
+        let image_size = self
+            .video_info()
+            .map(|i| egui::vec2(i.width as f32, i.height as f32));
         egui::CentralPanel::default().show(ui, |ui| match &self.texture {
-            Some(texture) => event = self.view.show(ui, texture, &overlay),
+            Some(texture) => {
+                let size = image_size.unwrap_or_else(|| texture.size_vec2());
+                event = self.view.show(ui, texture, size, &overlay);
+            }
             None => {
                 ui.centered_and_justified(|ui| ui.label(&self.status));
             }
@@ -1702,10 +1786,43 @@ mod tests {
         let config = Config {
             dialogs: Box::new(dialogs.clone()),
             autosave_dir: Some(state.to_owned()),
+            proxy_dir: Some(state.join("proxies")),
         };
         Harness::builder()
             .with_size(egui::vec2(1400.0, 860.0))
             .build_eframe(move |cc| App::with_config(&cc.egui_ctx, video, config))
+    }
+
+    /// A video with far-apart keyframes gets a seek proxy in the cache folder, the status bar
+    /// says so, and seeks end on the full frame (the preview only stands in meanwhile).
+    #[test]
+    fn a_long_gop_video_gets_fast_seeking_and_seeks_end_on_the_full_frame() {
+        let dir = tempfile::tempdir().unwrap();
+        let clip = dir.path().join("long.mp4");
+        super::super::frame_loader::tests::long_gop_clip(&clip, 120);
+        let dialogs = PreparedDialogs::default();
+        let state = dir.path().join("state");
+        let mut h = harness(Some(clip), &dialogs, &state);
+        wait(&mut h, "the proxy", |a| {
+            a.loader.as_ref().and_then(FrameLoader::proxy) == Some(&ProxyStatus::Ready)
+        });
+        h.step();
+        h.get_by_label("fast seeking");
+        assert_eq!(std::fs::read_dir(state.join("proxies")).unwrap().count(), 1);
+        wait(&mut h, "frame 0", |a| a.shown() == Some(0) && !a.preview);
+        let fitted = h.state().frame_view().transform().expect("frame drawn");
+        h.key_press(egui::Key::End);
+        wait(&mut h, "the last frame, full size", |a| {
+            a.shown() == Some(119) && !a.preview
+        });
+        let texture = h.state().texture.as_ref().map(|t| t.size());
+        assert_eq!(texture, Some([320, 240]));
+        // The picture stays where it was: previews are drawn over the frame's own size.
+        let after = h.state().frame_view().transform().expect("frame drawn");
+        assert_eq!(
+            fitted.to_screen(Point2::new(10.0, 10.0)),
+            after.to_screen(Point2::new(10.0, 10.0))
+        );
     }
 
     #[test]

@@ -125,16 +125,17 @@ impl FrameView {
         }
     }
 
-    /// Draws the frame and the overlay; returns what the user did.
+    /// Draws the frame and the overlay; returns what the user did. `size` is the frame's size
+    /// in pixels, which the texture is stretched over (a seek preview is smaller).
     pub fn show(
         &mut self,
         ui: &mut egui::Ui,
         texture: &egui::TextureHandle,
+        size: Vec2,
         overlay: &Overlay,
     ) -> Option<ViewEvent> {
         let rect = ui.available_rect_before_wrap();
         let response = ui.allocate_rect(rect, Sense::click_and_drag());
-        let size = texture.size_vec2();
         let space = ui.input(|i| i.key_down(egui::Key::Space));
         // Zoom at the cursor: the image point under it stays put.
         if let Some(hover) = response.hover_pos() {
