@@ -49,30 +49,42 @@ pub fn show(
     keys: &KeyFrames,
 ) -> Option<usize> {
     let mut jump = None;
-    ui.horizontal(|ui| {
-        let mut index = current;
-        ui.spacing_mut().slider_width = (ui.available_width() - 190.0).max(100.0);
-        let slider = egui::Slider::new(&mut index, 0..=frames.saturating_sub(1)).text("frame");
-        if ui.add(slider).changed() {
-            jump = Some(index);
-        }
-        ui.label(format!("{:.3} s", current as f64 / fps.max(1e-9)));
-    });
+    // The strips below line up with the slider's rail: frame k is under the slider's handle
+    // at k (egui keeps the handle's centre a radius inside the rail's ends).
+    let (rail_left, rail_right) = ui
+        .horizontal(|ui| {
+            let mut index = current;
+            let rail = (ui.available_width() - 190.0).max(100.0);
+            ui.spacing_mut().slider_width = rail;
+            let left = ui.cursor().left();
+            let slider = egui::Slider::new(&mut index, 0..=frames.saturating_sub(1)).text("frame");
+            let response = ui.add(slider);
+            if response.changed() {
+                jump = Some(index);
+            }
+            ui.label(format!("{:.3} s", current as f64 / fps.max(1e-9)));
+            let radius = response.rect.height() / 2.5;
+            (left + radius, left + rail - radius)
+        })
+        .inner;
     let strip_h = 4.0;
     let width = ui.available_width();
     let height = strip_h * JOINT_COUNT as f32 + 6.0;
     let (rect, response) = ui.allocate_exact_size(Vec2::new(width, height), Sense::click());
     let painter = ui.painter_at(rect);
     painter.rect_filled(rect, 0.0, Color32::from_gray(30));
-    let x_of = |k: f32| rect.left() + k / frames.max(1) as f32 * rect.width();
+    let last = frames.saturating_sub(1).max(1) as f32;
+    let span = (rail_right - rail_left).max(1.0);
+    // Centre of frame k; a frame covers ±0.5 around it.
+    let x_of = |k: f32| rail_left + k / last * span;
     if let Some(strips) = strips {
         for (row, runs) in strips.runs.iter().enumerate() {
             let top = rect.top() + 6.0 + row as f32 * strip_h;
             for &(a, b, colour) in runs {
                 let r = Rect::from_min_max(
-                    egui::pos2(x_of(a as f32), top),
+                    egui::pos2(x_of(a as f32 - 0.5), top),
                     egui::pos2(
-                        x_of(b as f32 + 1.0).max(x_of(a as f32) + 1.0),
+                        x_of(b as f32 + 0.5).max(x_of(a as f32 - 0.5) + 1.0),
                         top + strip_h - 1.0,
                     ),
                 );
@@ -81,13 +93,13 @@ pub fn show(
         }
     }
     for &f in keys.frames.keys() {
-        let x = x_of(f as f32 + 0.5);
+        let x = x_of(f as f32);
         painter.line_segment(
             [egui::pos2(x, rect.top()), egui::pos2(x, rect.top() + 5.0)],
             Stroke::new(2.0, Color32::WHITE),
         );
     }
-    let x = x_of(current as f32 + 0.5);
+    let x = x_of(current as f32);
     painter.line_segment(
         [egui::pos2(x, rect.top()), egui::pos2(x, rect.bottom())],
         Stroke::new(1.0, Color32::YELLOW),
@@ -95,7 +107,7 @@ pub fn show(
     if response.clicked()
         && let Some(pos) = response.interact_pointer_pos()
     {
-        let k = ((pos.x - rect.left()) / rect.width() * frames as f32).floor();
+        let k = ((pos.x - rail_left) / span * last).round();
         jump = Some((k.max(0.0) as usize).min(frames.saturating_sub(1)));
     }
     response.on_hover_text("one strip per joint, top to bottom in model order: white key frame, green tracked, orange weak, blue interpolated, purple off the frame, red lost; click to jump");
