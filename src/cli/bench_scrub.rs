@@ -11,7 +11,7 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 use videomocap::formats::Marks;
 use videomocap::track::{TrackJob, TrackerParams, track_video};
-use videomocap::video::{OpenOptions, Video};
+use videomocap::video::{OpenOptions, Video, VideoError};
 
 pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let dir = std::path::Path::new("out/bench-scrub");
@@ -84,37 +84,8 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let rss_scrub = peak_rss_mib();
     drop(video);
 
-    // The app's seek proxy: built once in the background, then each seek shows the proxy's
-    // frame (decoded and turned into RGBA for the texture) while the full frame decodes.
-    let proxy_dir = dir.join("proxies");
-    let proxy_file =
-        videomocap::video::proxy::proxy_path(&proxy_dir, &file).map_err(ExitError::failed)?;
-    let proxy_build = if proxy_file.is_file() {
-        "reused from an earlier run (delete out/bench-scrub/proxies to time it)".to_owned()
-    } else {
-        say(global, "building the seek proxy …");
-        let t = Instant::now();
-        videomocap::video::proxy::build(&file, &proxy_file, &mut |_, _| true)
-            .map_err(ExitError::failed)?;
-        format!("{:.0} s", t.elapsed().as_secs_f64())
-    };
-    let proxy_mib = std::fs::metadata(&proxy_file)
-        .map_err(ExitError::failed)?
-        .len() as f64
-        / (1 << 20) as f64;
+    let proxy_rows = proxy_rows(&file, &info, &targets, global)?;
     let rss_proxy = peak_rss_mib();
-    let mut proxy = videomocap::video::proxy::open(&proxy_file, &info)
-        .ok_or_else(|| ExitError::failed(anyhow::anyhow!("the proxy does not fit the clip")))?;
-    let (pw, ph) = (proxy.info().width, proxy.info().height);
-    let mut previews: Vec<f64> = Vec::new();
-    for &k in &targets {
-        let t = Instant::now();
-        let f = proxy.frame(k).map_err(ExitError::failed)?;
-        sink += f.image.as_raw().chunks_exact(3).count() * 4;
-        previews.push(t.elapsed().as_secs_f64() * 1000.0);
-    }
-    previews.sort_by(f64::total_cmp);
-    drop(proxy);
 
     // Track a 300-frame span from the middle, as a user tracking one stretch of a long clip.
     let span_len = n.min(300);
@@ -133,8 +104,8 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         span_start + span_len - 1
     );
     let pct = |q: f64| seeks[((seeks.len() - 1) as f64 * q).round() as usize];
-    let ppct = |q: f64| previews[((previews.len() - 1) as f64 * q).round() as usize];
-    let rows = [
+    let mut rows: Vec<(String, String)> = Vec::new();
+    let head = [
         (
             "clip",
             format!(
@@ -154,30 +125,10 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             "random seeks within 150 ms",
             format!("{} of 40", seeks.iter().filter(|&&s| s <= 150.0).count()),
         ),
-        ("seek proxy: build time", proxy_build),
-        (
-            "seek proxy: size",
-            format!(
-                "{pw}×{ph}, keyframe every {} frames, {proxy_mib:.0} MiB",
-                videomocap::video::proxy::PROXY_GOP
-            ),
-        ),
-        (
-            "seek shown from the proxy, median",
-            format!("{:.0} ms", ppct(0.5)),
-        ),
-        (
-            "seek shown from the proxy, 95th pct",
-            format!("{:.0} ms", ppct(0.95)),
-        ),
-        (
-            "seek shown from the proxy, worst of 40",
-            format!("{:.0} ms", ppct(1.0)),
-        ),
-        (
-            "seeks shown from the proxy within 150 ms",
-            format!("{} of 40", previews.iter().filter(|&&s| s <= 150.0).count()),
-        ),
+    ];
+    rows.extend(head.map(|(k, v)| (k.to_owned(), v)));
+    rows.extend(proxy_rows);
+    let tail = [
         (
             "step forward one frame at a time",
             format!("{step_fps:.0} frames/s"),
@@ -204,6 +155,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             format!("{:.0} MiB", peak_rss_mib()),
         ),
     ];
+    rows.extend(tail.map(|(k, v)| (k.to_owned(), v)));
     println!("{:<40} value", "measure");
     for (k, v) in rows {
         println!("{k:<40} {v}");
@@ -212,6 +164,125 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         println!("(no frames)");
     }
     Ok(())
+}
+
+/// The app's seek proxy on this clip: built once (timed unless an earlier run left it), then
+/// each seek shows the proxy's frame (decoded and turned into RGBA for the texture) while, as in
+/// the app, the full frame decodes on another thread. Clips that the app makes no proxy for get
+/// one row saying so.
+fn proxy_rows(
+    file: &std::path::Path,
+    info: &videomocap::video::VideoInfo,
+    targets: &[usize],
+    global: &GlobalArgs,
+) -> Result<Vec<(String, String)>, ExitError> {
+    use videomocap::video::proxy;
+    if !proxy::wants_proxy(info) {
+        return Ok(vec![(
+            "seek proxy".to_owned(),
+            format!(
+                "not made: keyframes at most {} frames apart (the app makes one above {})",
+                info.keyframe_interval,
+                proxy::PROXY_MIN_KEYFRAME_INTERVAL
+            ),
+        )]);
+    }
+    let proxy_dir = file
+        .parent()
+        .unwrap_or(std::path::Path::new("."))
+        .join("proxies");
+    let proxy_file = proxy::proxy_path(&proxy_dir, file).map_err(ExitError::failed)?;
+    let proxy_build = if proxy_file.is_file() {
+        "reused from an earlier run (delete out/bench-scrub/proxies to time it)".to_owned()
+    } else {
+        say(global, "building the seek proxy …");
+        let t = Instant::now();
+        proxy::build(file, &proxy_file, &mut |_, _| true).map_err(ExitError::failed)?;
+        format!("{:.0} s", t.elapsed().as_secs_f64())
+    };
+    let proxy_mib = std::fs::metadata(&proxy_file)
+        .map_err(ExitError::failed)?
+        .len() as f64
+        / (1 << 20) as f64;
+    let mut proxy = proxy::open(&proxy_file, info)
+        .ok_or_else(|| ExitError::failed(anyhow::anyhow!("the proxy does not fit the clip")))?;
+    let (pw, ph) = (proxy.info().width, proxy.info().height);
+    // As in the app, the full frame decodes on another thread while the preview is shown.
+    let (ask, asked) = std::sync::mpsc::channel::<usize>();
+    let (answer, answers) = std::sync::mpsc::channel::<Result<f64, VideoError>>();
+    let full_file = file.to_owned();
+    let worker = std::thread::spawn(move || {
+        let mut full = match Video::open(&full_file, &OpenOptions::default()) {
+            Ok(v) => v,
+            Err(e) => return answer.send(Err(e)),
+        };
+        answer.send(Ok(0.0))?;
+        for k in asked {
+            let t = Instant::now();
+            let r = full.frame(k).map(|_| t.elapsed().as_secs_f64() * 1000.0);
+            answer.send(r)?;
+        }
+        Ok(())
+    });
+    let recv = || -> Result<f64, ExitError> {
+        answers
+            .recv()
+            .map_err(ExitError::failed)?
+            .map_err(ExitError::failed)
+    };
+    recv()?;
+    let (mut previews, mut fulls) = (Vec::new(), Vec::new());
+    for &k in targets {
+        ask.send(k).map_err(ExitError::failed)?;
+        let t = Instant::now();
+        let f = proxy.frame(k).map_err(ExitError::failed)?;
+        let rgba: Vec<u8> = f
+            .image
+            .as_raw()
+            .chunks_exact(3)
+            .flat_map(|p| [p[0], p[1], p[2], 255])
+            .collect();
+        std::hint::black_box(rgba);
+        previews.push(t.elapsed().as_secs_f64() * 1000.0);
+        fulls.push(recv()?);
+    }
+    drop(ask);
+    let _ = worker.join();
+    previews.sort_by(f64::total_cmp);
+    fulls.sort_by(f64::total_cmp);
+    drop(proxy);
+    let pct = |v: &[f64], q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
+    let within = previews.iter().filter(|&&s| s <= 150.0).count();
+    Ok(vec![
+        ("seek proxy: build time".to_owned(), proxy_build),
+        (
+            "seek proxy: size".to_owned(),
+            format!(
+                "{pw}×{ph}, keyframe every {} frames, {proxy_mib:.0} MiB",
+                proxy::PROXY_GOP
+            ),
+        ),
+        (
+            "seek shown from the proxy, median".to_owned(),
+            format!("{:.0} ms", pct(&previews, 0.5)),
+        ),
+        (
+            "seek shown from the proxy, 95th pct".to_owned(),
+            format!("{:.0} ms", pct(&previews, 0.95)),
+        ),
+        (
+            "seek shown from the proxy, worst".to_owned(),
+            format!("{:.0} ms", pct(&previews, 1.0)),
+        ),
+        (
+            "seeks shown from the proxy within 150 ms".to_owned(),
+            format!("{within} of {}", previews.len()),
+        ),
+        (
+            "  full frame meanwhile, median / worst".to_owned(),
+            format!("{:.0} ms / {:.0} ms", pct(&fulls, 0.5), pct(&fulls, 1.0)),
+        ),
+    ])
 }
 
 /// The synthetic sample's marks (640×480) scaled to a `w`×`h` frame: a figure to track (on
