@@ -292,6 +292,10 @@ fn a_cancelled_proxy_leaves_nothing_and_a_proxy_that_does_not_fit_is_dropped() {
     info.frame_count = 299;
     assert!(proxy::open(&out, &info).is_none());
     assert!(!out.exists(), "the proxy that did not fit was not removed");
+    // A cache folder that cannot be made is an error naming the proxy, not a panic.
+    let unwritable = Path::new("/proc/videomocap-no-such-dir/proxy.mp4");
+    let err = proxy::build(&path, unwritable, &mut |_, _| true).unwrap_err();
+    assert!(err.to_string().contains("proxy.mp4"), "{err}");
     // A video that is not one gives the usual error, naming it.
     let bad = dir.path().join("notes.txt");
     std::fs::write(&bad, "not a video").unwrap();
