@@ -98,17 +98,18 @@ impl<'a> FrameView<'a> {
         let y1 = (y0 + 1).min(self.height - 1);
         let row0 = y0 * self.width;
         let row1 = y1 * self.width;
-        let d = self.data;
-        let (a, b, c, e) = (
-            (row0 + x0) * 3,
-            (row0 + x1) * 3,
-            (row1 + x0) * 3,
-            (row1 + x1) * 3,
-        );
+        // One bounds check per pixel (not per channel): this is the tracker's hottest line.
+        let px = |i: usize| -> [f32; 3] {
+            match self.data.get(i * 3..i * 3 + 3) {
+                Some(&[r, g, b]) => [f32::from(r), f32::from(g), f32::from(b)],
+                _ => [0.0; 3], // not reached: x0, x1 < width and y0, y1 < height
+            }
+        };
+        let (a, b, c, e) = (px(row0 + x0), px(row0 + x1), px(row1 + x0), px(row1 + x1));
         let mut out = [0.0f32; 3];
         for (k, o) in out.iter_mut().enumerate() {
-            let top = f32::from(d[a + k]) + fx * (f32::from(d[b + k]) - f32::from(d[a + k]));
-            let bottom = f32::from(d[c + k]) + fx * (f32::from(d[e + k]) - f32::from(d[c + k]));
+            let top = a[k] + fx * (b[k] - a[k]);
+            let bottom = c[k] + fx * (e[k] - c[k]);
             *o = top + fy * (bottom - top);
         }
         out
@@ -323,17 +324,18 @@ impl Template {
             let row_x = g.start[0] + fi * g.du[0];
             let row_y = g.start[1] + fi * g.du[1];
             let base = i * self.cols;
-            let mut j = 0;
-            while j < self.cols {
+            // This row's cells and weights as slices of one length, so that indexing by `j`
+            // needs no bounds checks.
+            let cells = &self.cells[base..base + self.cols];
+            let region = &self.region[base..base + self.cols];
+            for (j, (c, r)) in cells.iter().zip(region).enumerate().step_by(step) {
                 let fj = j as f32;
                 let x = frame.bilinear(row_x + fj * g.dv[0], row_y + fj * g.dv[1]);
-                let c = &self.cells[base + j];
                 let key =
                     wr * (x[0] - c[0]).abs() + wg * (x[1] - c[1]).abs() + wb * (x[2] - c[2]).abs();
                 let ada =
                     wr * (x[0] - c[3]).abs() + wg * (x[1] - c[4]).abs() + wb * (x[2] - c[5]).abs();
-                sum += self.region[base + j] * (wk * key + wa * ada);
-                j += step;
+                sum += r * (wk * key + wa * ada);
             }
             if sum > limit {
                 return f32::INFINITY;
