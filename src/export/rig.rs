@@ -289,36 +289,13 @@ pub fn rest_pose(
     lengths: &[f64; crate::skeleton::BONE_COUNT],
     shoulder_width: f64,
 ) -> crate::skeleton::PerJoint<Point3<f64>> {
-    use crate::skeleton::{Bone, PerJoint};
-    let len = |parent: Joint, child: Joint| lengths[Bone::new(parent, child).index()];
-    let mut p = PerJoint::from_fn(|_| Point3::origin());
-    let up = Vector3::y();
-    p[Joint::Chest] = p[Joint::Pelvis] + len(Joint::Pelvis, Joint::Chest) * up;
-    p[Joint::Neck] = p[Joint::Chest] + len(Joint::Chest, Joint::Neck) * up;
-    p[Joint::HeadTop] = p[Joint::Neck] + len(Joint::Neck, Joint::HeadTop) * up;
-    for side in [1.0, -1.0] {
-        // The left side's joints, mirrored for the right.
-        let on_side = |j: Joint| if side > 0.0 { j } else { j.mirrored() };
-        let [shoulder, elbow, wrist, hip, knee, ankle] = [
-            Joint::LeftShoulder,
-            Joint::LeftElbow,
-            Joint::LeftWrist,
-            Joint::LeftHip,
-            Joint::LeftKnee,
-            Joint::LeftAnkle,
-        ]
-        .map(on_side);
-        let clavicle = len(Joint::Chest, shoulder);
-        let out = (0.5 * shoulder_width).min(clavicle);
-        let rise = (clavicle * clavicle - out * out).max(0.0).sqrt();
-        p[shoulder] = p[Joint::Chest] + Vector3::new(side * out, rise, 0.0);
-        p[elbow] = p[shoulder] + Vector3::new(side * len(shoulder, elbow), 0.0, 0.0);
-        p[wrist] = p[elbow] + Vector3::new(side * len(elbow, wrist), 0.0, 0.0);
-        p[hip] = p[Joint::Pelvis] + Vector3::new(side * len(Joint::Pelvis, hip), 0.0, 0.0);
-        p[knee] = p[hip] - len(hip, knee) * up;
-        p[ankle] = p[knee] - len(knee, ankle) * up;
-    }
-    p
+    let (out, down) = (Vector3::x(), -Vector3::y());
+    crate::skeleton::standing_pose(
+        |b| lengths[b.index()],
+        shoulder_width,
+        Point3::origin(),
+        |sign| [sign * out, sign * out, down, down],
+    )
 }
 
 #[cfg(test)]

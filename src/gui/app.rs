@@ -486,27 +486,25 @@ impl App {
 
     /// Undoes the last edit.
     pub fn undo(&mut self) {
-        if let Some(p) = self.project.take() {
-            self.project = Some(match self.history.undo(p.clone()) {
-                Some(before) => {
-                    self.status = "Undone".to_owned();
-                    before
-                }
-                None => p,
-            });
-            self.dirty = true;
-            self.autosave();
-            self.results_changed();
-        }
+        self.step_history(History::undo, "Undone");
     }
 
     /// Redoes an undone edit.
     pub fn redo(&mut self) {
+        self.step_history(History::redo, "Redone");
+    }
+
+    /// Swaps the project for the one `step` brings back from the history, if any.
+    fn step_history(
+        &mut self,
+        step: fn(&mut History<Project>, Project) -> Option<Project>,
+        done: &str,
+    ) {
         if let Some(p) = self.project.take() {
-            self.project = Some(match self.history.redo(p.clone()) {
-                Some(after) => {
-                    self.status = "Redone".to_owned();
-                    after
+            self.project = Some(match step(&mut self.history, p.clone()) {
+                Some(other) => {
+                    self.status = done.to_owned();
+                    other
                 }
                 None => p,
             });

@@ -4,7 +4,9 @@
 mod bone;
 mod joint;
 mod proportions;
+mod standing;
 
 pub use bone::{BONE_COUNT, BodyPart, Bone, Breadth};
 pub use joint::{JOINT_COUNT, Joint, PerJoint};
 pub use proportions::{DEFAULT_HEIGHT_M, Proportions, ProportionsError, SubjectModel};
+pub use standing::{LimbDirections, standing_pose};

@@ -3,7 +3,7 @@
 //! a world frame: metres, Y up, the subject facing +Z at the first frame (so its left is +X).
 
 use crate::bvh::{Bvh, BvhError, map_to_model};
-use crate::skeleton::{Bone, JOINT_COUNT, Joint, PerJoint, SubjectModel};
+use crate::skeleton::{Joint, PerJoint, SubjectModel, standing_pose};
 use nalgebra::{Point3, Rotation3, Unit, Vector3};
 use std::f64::consts::PI;
 use std::path::Path;
@@ -82,40 +82,18 @@ fn pose(
     arms: [LimbAngles; 2],
     legs: [LimbAngles; 2],
 ) -> PerJoint<Point3<f64>> {
-    let len = |a: Joint, b: Joint| subject.bone_length(Bone::new(a, b));
-    let up = Vector3::y();
-    let mut p = PerJoint([Point3::origin(); JOINT_COUNT]);
-    p[Joint::Pelvis] = pelvis;
-    p[Joint::Chest] = pelvis + up * len(Joint::Pelvis, Joint::Chest);
-    p[Joint::Neck] = p[Joint::Chest] + up * len(Joint::Chest, Joint::Neck);
-    p[Joint::HeadTop] = p[Joint::Neck] + up * len(Joint::Neck, Joint::HeadTop);
-    let half_width = subject.shoulder_width_m / 2.0;
-    for (side, sign) in [(0usize, 1.0), (1, -1.0)] {
-        // The left side's joints, mirrored for the right.
-        let on_side = |j: Joint| if side == 0 { j } else { j.mirrored() };
-        let [sh, el, wr, hip, kn, an] = [
-            Joint::LeftShoulder,
-            Joint::LeftElbow,
-            Joint::LeftWrist,
-            Joint::LeftHip,
-            Joint::LeftKnee,
-            Joint::LeftAnkle,
-        ]
-        .map(on_side);
-        let cs = len(Joint::Chest, sh);
-        let rise = (cs * cs - half_width * half_width).max(0.0).sqrt();
-        p[sh] = p[Joint::Chest] + Vector3::new(sign * half_width.min(cs), rise, 0.0);
-        let (upper, lower) = limb_directions(arms[side], sign);
-        p[el] = p[sh] + upper * len(sh, el);
-        p[wr] = p[el] + lower * len(el, wr);
-        p[hip] = pelvis + Vector3::new(sign * len(Joint::Pelvis, hip), 0.0, 0.0);
-        let (thigh, shank) = limb_directions(legs[side], sign);
-        // Knees bend backwards, elbows forwards.
-        let shank = reflect_bend(thigh, shank);
-        p[kn] = p[hip] + thigh * len(hip, kn);
-        p[an] = p[kn] + shank * len(kn, an);
-    }
-    p
+    standing_pose(
+        |b| subject.bone_length(b),
+        subject.shoulder_width_m,
+        pelvis,
+        |sign| {
+            let side = usize::from(sign < 0.0);
+            let (upper, lower) = limb_directions(arms[side], sign);
+            let (thigh, shank) = limb_directions(legs[side], sign);
+            // Knees bend backwards, elbows forwards.
+            [upper, lower, thigh, reflect_bend(thigh, shank)]
+        },
+    )
 }
 
 /// Directions of the upper and lower segments of a limb hanging from its root.
@@ -433,6 +411,7 @@ pub fn stature_of(motion: &Motion) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::skeleton::Bone;
 
     #[test]
     fn procedural_bodies_keep_their_bone_lengths() {
