@@ -130,8 +130,9 @@ fn run(gt: &GroundTruth, subject: &SubjectModel, noise: f64, refine: bool) -> Li
         subject: subject.clone(),
         params: LiftParams {
             refine,
-            // Exact tracks: no temporal smoothing, so the geometry must be exact.
-            smoothing_s: if noise == 0.0 { 0.0 } else { 0.066 },
+            // Exact tracks: no temporal smoothing, so the geometry must be exact; noisy ones
+            // get the adaptive smoothing of the default settings.
+            adaptive_smoothing: noise > 0.0,
             ..LiftParams::default()
         },
         overrides: DepthOverrides::new(),
@@ -209,7 +210,7 @@ fn with_the_true_roots_exact_tracks_give_back_every_joint() {
         subject,
         params: LiftParams {
             refine: false,
-            smoothing_s: 0.0,
+            adaptive_smoothing: false,
             ..LiftParams::default()
         },
         overrides,

@@ -17,6 +17,7 @@ pub mod focal;
 mod newton;
 pub mod propagate;
 pub mod refine;
+pub mod smoothing;
 mod solve;
 
 pub use ambiguity::{AmbiguityWeights, DepthOverrides};

@@ -9,6 +9,7 @@ use super::calibrate::{
 use super::error::LiftError;
 use super::propagate::key_depths;
 use super::refine::{RefineParams, RefineSummary, refine};
+use super::smoothing::{adaptive_sigmas, smoothed_images};
 use crate::camera::PinholeCamera;
 use crate::formats::{Frame3d, PointSource, Skeleton3d, Tracks2d};
 use crate::skeleton::{BONE_COUNT, Bone, Joint, PerJoint, SubjectModel};
@@ -22,21 +23,26 @@ use std::sync::atomic::{AtomicBool, Ordering};
 #[serde(default, deny_unknown_fields)]
 pub struct LiftParams {
     /// Run the global refinement after the per-frame solve (default false: on the synthetic
-    /// suite it lowered the error only with white 2D noise, 162 → 137 mm, and raised it with
-    /// exact tracks, 31 → 36 mm, and with the tracker's output, 152 → 156 mm; `bench lift`
-    /// reports both).
+    /// suite with true lengths it raised the error with exact tracks, 31.1 → 36.0 mm, with 2 px
+    /// white noise once the tracks are smoothed, 77.5 → 79.1 mm, and with the tracker's output,
+    /// 157.7 → 160.7 mm; `bench lift` reports both).
     pub refine: bool,
     /// A key-triangle calibration fits when its residual is below this RMS, pixels (default 1).
     pub calibration_tolerance_px: f64,
     /// A calibrated key-triangle pose is made exact by eqs. 10–11 when they then hold within this
     /// RMS residual, metres (default 0.005).
     pub propagation_tolerance_m: f64,
-    /// The per-frame solve works on tracks smoothed over time by a Gaussian of this many
-    /// seconds (default 0 = raw tracks). Measured on the synthetic suite, 0.066 s (two frames
-    /// at 30 fps) halved the error with 2 px white noise (150 → 80 mm) but raised it with exact
-    /// tracks (31 → 51 mm: a grazing key triangle turns a pixel of lag into centimetres of
-    /// depth) and with the tracker's own output (147 → 159 mm), so it is off by default.
+    /// When above 0, the per-frame solve works on tracks smoothed over time by a Gaussian of
+    /// this many seconds, the same for every joint (default 0: see `adaptive_smoothing`).
+    /// Measured on the synthetic suite, 0.066 s (two frames at 30 fps) halved the error with
+    /// 2 px white noise (150 → 80 mm) but raised it with exact tracks (31 → 51 mm: a grazing
+    /// key triangle turns a pixel of lag into centimetres of depth).
     pub smoothing_s: f64,
+    /// When `smoothing_s` is 0, smooth each joint's track by the width its own noise calls for
+    /// ([`super::smoothing`]; default true). On the synthetic suite with true lengths: 2 px
+    /// white noise 162 → 77.5 mm, exact tracks 31.1 → 31.1 mm, the tracker's output
+    /// 151.5 → 157.7 mm (its errors are drift and jumps more than white noise).
+    pub adaptive_smoothing: bool,
     /// Weights of the depth-ambiguity priors.
     pub ambiguity: AmbiguityWeights,
     /// Weights of the global refinement.
@@ -50,6 +56,7 @@ impl Default for LiftParams {
             calibration_tolerance_px: 1.0,
             propagation_tolerance_m: 0.005,
             smoothing_s: 0.0,
+            adaptive_smoothing: true,
             ambiguity: AmbiguityWeights::default(),
             refinement: RefineParams::default(),
         }
@@ -173,40 +180,6 @@ fn key_image(images: &[PerJoint<Point2<f64>>], t: usize) -> [Point2<f64>; 3] {
     KEY_JOINTS.map(|j| images[t][j])
 }
 
-/// The tracks smoothed over time by a Gaussian of `sigma` frames, each point weighted by its
-/// trust ([`super::refine::track_weight`]): the per-frame solve amplifies 2D noise (a 2 px error
-/// on a shoulder moves its depth by centimetres), and the refinement sees the raw tracks again.
-fn smoothed_images(tracks: &Tracks2d, sigma: f64) -> Vec<PerJoint<Point2<f64>>> {
-    let raw: Vec<PerJoint<Point2<f64>>> = tracks
-        .frames
-        .iter()
-        .map(|f| f.points.map(|_, p| p.pos))
-        .collect();
-    if sigma <= 0.0 {
-        return raw;
-    }
-    let reach = (3.0 * sigma).ceil() as usize;
-    let n = raw.len();
-    (0..n)
-        .map(|t| {
-            PerJoint::from_fn(|j| {
-                let mut sum = nalgebra::Vector2::zeros();
-                let mut total = 0.0;
-                let first = t.saturating_sub(reach);
-                let window = raw.iter().zip(&tracks.frames).enumerate();
-                for (u, (point, frame)) in window.skip(first).take(t + reach + 1 - first) {
-                    let d = u as f64 - t as f64;
-                    let w = (-0.5 * d * d / (sigma * sigma)).exp()
-                        * super::refine::track_weight(&frame.points[j]);
-                    sum += point[j].coords * w;
-                    total += w;
-                }
-                Point2::from(sum / total)
-            })
-        })
-        .collect()
-}
-
 /// Shoulders on top of each other or on the chest (closer than one pixel).
 fn degenerate(image: &[Point2<f64>; 3]) -> bool {
     (image[0] - image[1]).norm() < 1.0
@@ -243,7 +216,14 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
     } else {
         30.0
     };
-    let images = smoothed_images(tracks, job.params.smoothing_s * fps);
+    let sigma = if job.params.smoothing_s > 0.0 {
+        PerJoint([job.params.smoothing_s * fps; crate::skeleton::JOINT_COUNT])
+    } else if job.params.adaptive_smoothing {
+        adaptive_sigmas(tracks)
+    } else {
+        PerJoint([0.0; crate::skeleton::JOINT_COUNT])
+    };
+    let images = smoothed_images(tracks, &sigma);
     let rays: Vec<_> = images.iter().map(|im| im.map(|_, p| cam.ray(p))).collect();
     let frame_index: Vec<usize> = tracks.frames.iter().map(|f| f.index).collect();
 
