@@ -2,15 +2,16 @@
 //!
 //! Each bone solved from its parent has two roots ([`super::backproject`]). Bones are taken in
 //! groups (the head and neck, the spine, the two hips, each arm, each leg); for each group every
-//! combination of its bones' roots is a candidate, scored per frame by a prior (the neck and
-//! spine lie along the key triangle's up direction, the hips are collinear with the pelvis and
-//! parallel to the shoulders, knees bend backwards and hanging elbows forwards, upper arms and
-//! thighs weakly prefer to hang), and the
+//! combination of its bones' roots is a candidate, scored per frame by a prior built on the
+//! joints' ranges of motion (the neck and spine lie along the key triangle's up direction and
+//! bend forwards rather than backwards; the hips are collinear with the pelvis and parallel to
+//! the shoulders; knees bend backwards, in the leg's own plane; hanging elbows bend forwards;
+//! upper arms and thighs do not cross the body's middle and weakly prefer to hang a little
+//! outwards; of two arms that fit equally, the straighter), and the
 //! candidates are chained over the frames by dynamic programming (Viterbi over pairs of
 //! consecutive choices) that minimises the joints' 3D acceleration relative to the group's root
 //! plus the priors. Groups are solved centre outwards, each on the trajectory chosen for its
 //! root. A user's choice for a bone on a frame ([`DepthOverrides`]) is a hard constraint.
-
 use super::backproject::{Root, bone_roots};
 use crate::skeleton::{BONE_COUNT, Bone, Joint, PerJoint, SubjectModel};
 use nalgebra::{Point3, Vector3};
@@ -23,16 +24,27 @@ use std::collections::BTreeMap;
 pub struct AmbiguityWeights {
     /// Neck, head and spine along the key triangle's up direction.
     pub trunk_up: f64,
+    /// The head and the spine bent backwards (extension reaches about a third of flexion).
+    pub extension: f64,
     /// Hips collinear with the pelvis.
     pub hips_collinear: f64,
     /// Hip line parallel to the shoulder line.
     pub hips_parallel: f64,
     /// Knees bend backwards.
     pub knee: f64,
+    /// Knees bend in the leg's own plane, not sideways (the knee is a hinge; hip rotation
+    /// turns its plane only a little).
+    pub knee_side: f64,
     /// Elbows of hanging arms bend forwards.
     pub elbow: f64,
-    /// Upper arms and thighs hang along the trunk (a weak preference for the rest pose).
+    /// Upper arms and thighs hang along the trunk, a little outwards (a weak preference for
+    /// the rest pose).
     pub hanging: f64,
+    /// Upper arms and thighs crossing the body's middle (adduction beyond the rest pose).
+    pub medial: f64,
+    /// Elbows bent (a weak preference for the straighter of two otherwise equal arms; knees
+    /// are left out: a seated shank hangs, and its mirror is the straighter).
+    pub straight: f64,
     /// A joint off its viewing ray (its bone too short for its 2D image).
     pub miss: f64,
 }
@@ -41,15 +53,27 @@ impl Default for AmbiguityWeights {
     fn default() -> Self {
         AmbiguityWeights {
             trunk_up: 0.3,
+            extension: 1.0,
             hips_collinear: 10.0,
             hips_parallel: 1.0,
             knee: 2.0,
+            knee_side: 1.0,
             elbow: 0.5,
             hanging: 0.05,
+            medial: 1.0,
+            straight: 0.05,
             miss: 10.0,
         }
     }
 }
+
+/// How far a resting arm and leg hang outwards from straight down, radians: arms clear the
+/// hips, legs stand a little apart.
+const REST_ABDUCTION: [f64; 2] = [0.15, 0.05];
+
+/// How far an upper arm or thigh may cross inwards of straight down before [`AmbiguityWeights::
+/// medial`] counts it (the sine of the angle).
+const MEDIAL_FREE: f64 = 0.1;
 
 /// Forced root choices: `(frame index, bone) → root`, set by a user flipping a limb.
 pub type DepthOverrides = BTreeMap<(usize, Bone), Root>;
@@ -174,13 +198,28 @@ fn prior_cost(
         let len = subject.bone_length(bone);
         (p[to] - (p[from] + trunk.up * (sign * len))).norm_squared()
     };
+    // How far a bone's solved end lies behind the trunk's forward direction, as the sine of
+    // the angle, times its length: backward bending of the head or spine.
+    let behind = |bone: Bone| {
+        let (from, to) = lift_order(bone);
+        let len = subject.bone_length(bone);
+        let d = (p[to] - p[from]) / len;
+        // The pelvis hangs below the chest: it lies behind the chest's frame when the spine
+        // arches backwards.
+        let sign = if to == Pelvis { 1.0 } else { -1.0 };
+        (sign * d.dot(&trunk.forward)).max(0.0).powi(2) * len * len
+    };
     match group.prior {
         Prior::Head => {
             w.trunk_up
                 * (along_up(Bone::new(Chest, Neck), 1.0)
                     + 0.5 * along_up(Bone::new(Neck, HeadTop), 1.0))
+                + w.extension * behind(Bone::new(Neck, HeadTop))
         }
-        Prior::Spine => w.trunk_up * along_up(Bone::new(Pelvis, Chest), -1.0),
+        Prior::Spine => {
+            w.trunk_up * along_up(Bone::new(Pelvis, Chest), -1.0)
+                + w.extension * behind(Bone::new(Pelvis, Chest))
+        }
         Prior::Hips => {
             let off_line =
                 (p[LeftHip].coords + p[RightHip].coords - p[Pelvis].coords * 2.0).norm_squared();
@@ -197,20 +236,41 @@ fn prior_cost(
             let root = group.bones[0].parent;
             let middle = group.bones[0].child;
             let end = group.bones[1].child;
+            let is_leg = group.prior == Prior::Leg;
+            // The subject's own outward direction on this limb's side.
+            let outward = if matches!(root, LeftShoulder | LeftHip) {
+                trunk.left
+            } else {
+                -trunk.left
+            };
             let upper = (p[middle] - p[root]).normalize();
             let lower = p[end] - p[middle];
             // How the lower bone leaves the upper bone's line.
             let bend = lower - upper * upper.dot(&lower);
             let upper_len = (p[middle] - p[root]).norm();
-            let rest = w.hanging * ((upper + trunk.up) * upper_len).norm_squared();
-            if group.prior == Prior::Leg {
-                // A knee bends backwards: its bend must not point forwards.
-                rest + w.knee * bend.dot(&trunk.forward).max(0.0).powi(2)
+            let abduction = REST_ABDUCTION[usize::from(is_leg)];
+            let rest_dir = -trunk.up * abduction.cos() + outward * abduction.sin();
+            let rest = w.hanging * ((upper - rest_dir) * upper_len).norm_squared();
+            let medial =
+                w.medial * ((-upper.dot(&outward) - MEDIAL_FREE).max(0.0) * upper_len).powi(2);
+            let common = rest + medial;
+            if is_leg {
+                // A knee bends backwards: its bend must not point forwards, nor sideways (the
+                // hinge's axis is the trunk's left-right line turned square to the thigh).
+                let axis = trunk.left - upper * upper.dot(&trunk.left);
+                let side = if axis.norm() > 0.3 {
+                    bend.dot(&axis.normalize()).powi(2)
+                } else {
+                    0.0
+                };
+                common + w.knee * bend.dot(&trunk.forward).max(0.0).powi(2) + w.knee_side * side
             } else {
                 // An elbow of an arm hanging down bends forwards; the weight fades as the arm
                 // rises (a raised arm can bend its elbow any way by turning the upper arm).
                 let hanging = ((-upper.dot(&trunk.up) - 0.3) / 0.7).clamp(0.0, 1.0);
-                rest + w.elbow * hanging * (-bend.dot(&trunk.forward)).max(0.0).powi(2)
+                common
+                    + w.elbow * hanging * (-bend.dot(&trunk.forward)).max(0.0).powi(2)
+                    + w.straight * bend.norm_squared()
             }
         }
     }
@@ -438,6 +498,79 @@ mod tests {
         for (c, x) in chosen.iter().zip(xs) {
             assert!((c - x).abs() < 1e-12, "{chosen:?}");
         }
+    }
+
+    /// A standing body (Y up, facing +Z) with its limbs along the given directions, and the
+    /// prior of group `g` on it.
+    fn prior_of(g: usize, limbs: impl Fn(f64) -> [Vector3<f64>; 4]) -> f64 {
+        let subject = SubjectModel::default();
+        let p = crate::skeleton::standing_pose(
+            |b| subject.bone_length(b),
+            subject.shoulder_width_m,
+            Point3::new(0.0, 1.0, 0.0),
+            limbs,
+        );
+        prior_cost(
+            &GROUPS[g],
+            &p,
+            &TrunkFrame::of(&p),
+            &subject,
+            &AmbiguityWeights::default(),
+        )
+    }
+
+    #[test]
+    fn the_priors_prefer_the_anatomical_of_two_mirror_images() {
+        let down = -Vector3::y();
+        let dir = |x: f64, y: f64, z: f64| Vector3::new(x, y, z).normalize();
+        // The left arm (group 3) hanging 0.3 outwards, or crossing 0.3 inwards.
+        let out = prior_of(3, |s| {
+            [dir(0.3 * s, -1.0, 0.0), dir(0.3 * s, -1.0, 0.3), down, down]
+        });
+        let across = prior_of(3, |s| {
+            [
+                dir(-0.3 * s, -1.0, 0.0),
+                dir(-0.3 * s, -1.0, 0.3),
+                down,
+                down,
+            ]
+        });
+        assert!(out < across, "{out} {across}");
+        // The left knee (group 5) bending backwards in the leg's plane, or sideways.
+        let hinge = prior_of(5, |_| [down, down, down, dir(0.0, -1.0, -0.6)]);
+        let sideways = prior_of(5, |s| [down, down, down, dir(0.6 * s, -1.0, 0.0)]);
+        assert!(hinge < sideways, "{hinge} {sideways}");
+        // Of two forearms bent forwards, the straighter.
+        let slight = prior_of(3, |_| [down, dir(0.0, -1.0, 0.3), down, down]);
+        let strong = prior_of(3, |_| [down, dir(0.0, -1.0, 1.5), down, down]);
+        assert!(slight < strong, "{slight} {strong}");
+    }
+
+    #[test]
+    fn the_head_bent_back_costs_more_than_bent_forward() {
+        let subject = SubjectModel::default();
+        let down = -Vector3::y();
+        let mut p = crate::skeleton::standing_pose(
+            |b| subject.bone_length(b),
+            subject.shoulder_width_m,
+            Point3::new(0.0, 1.0, 0.0),
+            |_| [down; 4],
+        );
+        let cost = |p: &PerJoint<Point3<f64>>| {
+            prior_cost(
+                &GROUPS[0],
+                p,
+                &TrunkFrame::of(p),
+                &subject,
+                &AmbiguityWeights::default(),
+            )
+        };
+        let len = subject.bone_length(Bone::new(Neck, HeadTop));
+        p[HeadTop] = p[Neck] + Vector3::new(0.0, 0.8, 0.6) * len;
+        let forward = cost(&p);
+        p[HeadTop] = p[Neck] + Vector3::new(0.0, 0.8, -0.6) * len;
+        let back = cost(&p);
+        assert!(forward < back, "{forward} {back}");
     }
 
     #[test]

@@ -88,39 +88,30 @@ fn pose(
         pelvis,
         |sign| {
             let side = usize::from(sign < 0.0);
-            let (upper, lower) = limb_directions(arms[side], sign);
-            let (thigh, shank) = limb_directions(legs[side], sign);
+            let (upper, lower) = limb_directions(arms[side], sign, 1.0);
             // Knees bend backwards, elbows forwards.
-            [upper, lower, thigh, reflect_bend(thigh, shank)]
+            let (thigh, shank) = limb_directions(legs[side], sign, -1.0);
+            [upper, lower, thigh, shank]
         },
     )
 }
 
-/// Directions of the upper and lower segments of a limb hanging from its root.
-fn limb_directions(a: LimbAngles, side_sign: f64) -> (Vector3<f64>, Vector3<f64>) {
+/// Directions of the upper and lower segments of a limb hanging from its root; the lower one
+/// bends forwards (`bend_sign` 1, an elbow) or backwards (−1, a knee).
+fn limb_directions(a: LimbAngles, side_sign: f64, bend_sign: f64) -> (Vector3<f64>, Vector3<f64>) {
     let down = -Vector3::y();
     // Abduction turns about the forward axis, towards the body's own side.
     let abduct = Rotation3::from_axis_angle(&Vector3::z_axis(), side_sign * a.abduction);
     // Flexion turns about the left axis, bringing "down" towards forward (+Z).
     let flex = Rotation3::from_axis_angle(&Unit::new_normalize(-Vector3::x()), a.flexion);
-    let upper = flex * abduct * down;
-    // The bend turns the lower segment forward within the limb's sagittal plane.
-    let axis = Unit::try_new(upper.cross(&Vector3::z()), 1e-9).unwrap_or(-Vector3::x_axis());
-    let lower = Rotation3::from_axis_angle(&axis, a.bend) * upper;
+    let turn = flex * abduct;
+    let upper = turn * down;
+    // The bend turns the lower segment about the limb's hinge: the body's right-to-left axis
+    // carried along by the same turns, so the elbow or knee bends in the limb's own plane
+    // however the limb is raised (a thigh raised to the front keeps its knee a hinge).
+    let axis = Unit::new_normalize(turn * -Vector3::x());
+    let lower = Rotation3::from_axis_angle(&axis, bend_sign * a.bend) * upper;
     (upper, lower)
-}
-
-/// Mirrors the bend of a lower segment about its upper segment (knees bend backwards).
-fn reflect_bend(upper: Vector3<f64>, lower: Vector3<f64>) -> Vector3<f64> {
-    let along = upper * upper.dot(&lower);
-    let across = lower - along;
-    let z = Vector3::z();
-    let across = if across.dot(&z) > 0.0 {
-        -across
-    } else {
-        across
-    };
-    (along + across).normalize()
 }
 
 /// Turns everything above the pelvis forward about the pelvis by `pitch` radians (bending at the
@@ -445,6 +436,25 @@ mod tests {
                 let mid = nalgebra::center(&p[hip], &p[ankle]);
                 assert!(p[knee].z >= mid.z - 1e-9);
             }
+        }
+    }
+
+    #[test]
+    fn a_seated_knee_bends_in_the_legs_own_plane() {
+        // Seated at 2 s: thighs raised 1.45 rad to the front, knees bent 1.5 rad. The shank
+        // hangs down from the knee and bends about the hinge, not sideways.
+        let s = SubjectModel::default();
+        let m = procedural(ProceduralMotion::SitDown, &s, 61, 30.0);
+        let p = &m.frames[60];
+        for (hip, knee, ankle) in [
+            (Joint::LeftHip, Joint::LeftKnee, Joint::LeftAnkle),
+            (Joint::RightHip, Joint::RightKnee, Joint::RightAnkle),
+        ] {
+            let thigh = (p[knee] - p[hip]).normalize();
+            let shank = p[ankle] - p[knee];
+            let bend = shank - thigh * thigh.dot(&shank);
+            assert!(bend.y < -0.8 * bend.norm(), "{hip}: {bend:?}");
+            assert!(bend.x.abs() < 0.1 * bend.norm(), "{hip}: {bend:?}");
         }
     }
 
