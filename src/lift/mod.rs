@@ -1,6 +1,7 @@
 //! 3D reconstruction (VBA, Pan et al., "Reconstruction of 3D human motion skeleton"): from
 //! 2D tracks to a metric skeleton per frame in the camera's space.
 //!
+//! Each joint's 2D track is first smoothed by the width its own noise calls for ([`smoothing`]).
 //! The key triangle (both shoulders and the chest) calibrates the camera on the best frame
 //! ([`calibrate`], eqs. 6–9) and is carried to the other frames by its constant side lengths
 //! ([`propagate`], eqs. 10–11); every other joint is placed on its viewing ray at its bone's

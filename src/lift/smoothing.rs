@@ -44,8 +44,7 @@ pub fn noise_and_motion(track: &[Point2<f64>]) -> Option<(f64, f64)> {
 }
 
 /// [`WIDTH_FACTOR`] times the Gaussian width (frames) that minimises a 2D track's expected
-/// squared error, at most
-/// [`MAX_ADAPTIVE_SIGMA`]; 0 for a track without noise.
+/// squared error, at most [`MAX_ADAPTIVE_SIGMA`]; 0 for a track without noise.
 pub fn adaptive_sigma(noise_px: f64, motion_px: f64) -> f64 {
     if noise_px <= 0.0 {
         return 0.0;

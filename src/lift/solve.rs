@@ -23,9 +23,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 #[serde(default, deny_unknown_fields)]
 pub struct LiftParams {
     /// Run the global refinement after the per-frame solve (default false: on the synthetic
-    /// suite with true lengths it raised the error with exact tracks, 31.1 → 36.0 mm, with 2 px
-    /// white noise once the tracks are smoothed, 77.5 → 79.1 mm, and with the tracker's output,
-    /// 157.7 → 160.7 mm; `bench lift` reports both).
+    /// suite with true lengths it raised the error with exact tracks, 20.4 → 24.4 mm, with 2 px
+    /// white noise once the tracks are smoothed, 63.5 → 64.2 mm, and with the tracker's output,
+    /// 149.6 → 152.9 mm; `bench lift` reports both).
     pub refine: bool,
     /// A key-triangle calibration fits when its residual is below this RMS, pixels (default 1).
     pub calibration_tolerance_px: f64,
