@@ -320,13 +320,19 @@ mod tests {
         assert_eq!(Tracks2d::load(&path).unwrap(), sample());
     }
 
-    #[test]
-    fn joints_may_come_in_another_order() {
+    /// Tracks saved to `t.json` in a fresh folder (kept alive by the first value), and the
+    /// file read back as plain JSON.
+    fn saved_json(t: &Tracks2d) -> (tempfile::TempDir, std::path::PathBuf, serde_json::Value) {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("t.json");
-        sample().save(&path).unwrap();
-        let mut v: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        t.save(&path).unwrap();
+        let v = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        (dir, path, v)
+    }
+
+    #[test]
+    fn joints_may_come_in_another_order() {
+        let (_dir, path, mut v) = saved_json(&sample());
         // Swap the first two columns everywhere.
         v["joints"].as_array_mut().unwrap().swap(0, 1);
         for f in v["frames"].as_array_mut().unwrap() {
@@ -353,11 +359,7 @@ mod tests {
 
     #[test]
     fn off_frame_points_round_trip_as_version_2() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("t.json");
-        with_off_frame().save(&path).unwrap();
-        let v: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        let (_dir, path, v) = saved_json(&with_off_frame());
         assert_eq!(v["version"], 2);
         // Only the frame with an off-frame (lost) joint carries the array.
         assert!(v["frames"][0].get("off_frame").is_none());
@@ -370,11 +372,7 @@ mod tests {
 
     #[test]
     fn version_1_is_read_and_a_newer_version_refused() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("t.json");
-        sample().save(&path).unwrap();
-        let mut v: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        let (_dir, path, mut v) = saved_json(&sample());
         v["version"] = serde_json::json!(1);
         assert_eq!(Tracks2d::parse(&v.to_string(), &path).unwrap(), sample());
         v["version"] = serde_json::json!(3);
