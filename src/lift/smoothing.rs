@@ -101,6 +101,20 @@ pub fn adaptive_sigmas(tracks: &Tracks2d) -> PerJoint<f64> {
     out
 }
 
+/// The median over joints of the tracks' white-noise deviation, pixels (0 below five frames):
+/// how noisy the 2D input is as a whole.
+pub fn median_noise_px(tracks: &Tracks2d) -> f64 {
+    let mut noise: Vec<f64> = Joint::ALL
+        .iter()
+        .filter_map(|&j| {
+            let track: Vec<Point2<f64>> = tracks.frames.iter().map(|f| f.points[j].pos).collect();
+            noise_and_motion(&track).map(|(n, _)| n)
+        })
+        .collect();
+    noise.sort_by(f64::total_cmp);
+    noise.get(noise.len() / 2).copied().unwrap_or(0.0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -23,9 +23,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 #[serde(default, deny_unknown_fields)]
 pub struct LiftParams {
     /// Run the global refinement after the per-frame solve (default false: on the synthetic
-    /// suite with true lengths it raised the error with exact tracks, 20.4 → 24.4 mm, with 2 px
-    /// white noise once the tracks are smoothed, 63.5 → 64.2 mm, and with the tracker's output,
-    /// 149.6 → 152.9 mm; `bench lift` reports both).
+    /// suite with true lengths it lowers the error only with 2 px white noise, 63.5 → 61.5 mm,
+    /// and raises it with exact tracks, 20.4 → 21.6 mm, and with the tracker's output,
+    /// 149.6 → 153.6 mm; `bench lift` reports both).
     pub refine: bool,
     /// A key-triangle calibration fits when its residual is below this RMS, pixels (default 1).
     pub calibration_tolerance_px: f64,
@@ -509,6 +509,7 @@ pub fn lift(
             &per.resolved.points,
             &job.subject,
             job.tracks.source.fps,
+            super::smoothing::median_noise_px(job.tracks),
             &job.params.refinement,
             &mut |done, total| {
                 progress(&LiftProgress {
