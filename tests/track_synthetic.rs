@@ -180,3 +180,49 @@ fn the_track_command_writes_tracks_that_load() {
     assert_eq!(t.frames.len(), 8);
     assert_eq!((t.source.width, t.source.height), (320, 240));
 }
+
+/// A person taller than the working stature in an MP4: the decoder delivers working-size frames
+/// while tracking, and the video is full size again afterwards.
+#[cfg(feature = "ffmpeg")]
+#[test]
+fn a_tall_person_is_tracked_on_frames_the_decoder_shrinks() {
+    let dir = tempfile::tempdir().unwrap();
+    let params = SynthParams {
+        motion: MotionSource::Procedural(ProceduralMotion::Wave),
+        frames: 20,
+        view: View::Frontal,
+        width: 320,
+        height: 240,
+        focal_px: 300.0,
+        person_px: 200.0,
+        output: VideoOutput::Mp4,
+        ..SynthParams::default()
+    };
+    render_clip(&params, dir.path(), &mut |_, _| {}, &AtomicBool::new(false)).unwrap();
+    let gt = GroundTruth::load(&dir.path().join("gt.json")).unwrap();
+    let marks = Marks::load(&dir.path().join("marks.json")).unwrap();
+    let mut video = Video::open(&dir.path().join("video.mp4"), &OpenOptions::default()).unwrap();
+    let tracker = TrackerParams {
+        working_stature_px: 110.0,
+        ..TrackerParams::default()
+    };
+    let out = track_video(
+        &mut video,
+        &TrackJob::from_marks(&marks, tracker, 1),
+        &mut |_| {},
+        &AtomicBool::new(false),
+    )
+    .unwrap();
+    assert_eq!(out.shrink, 2);
+    assert_eq!((video.info().width, video.info().height), (320, 240));
+    assert_eq!(video.frame(3).unwrap().image.dimensions(), (320, 240));
+    // Tracks are in video pixels, at the accuracy of the full-size test above.
+    assert_eq!(out.tracks.source.width, 320);
+    let s = score_tracks(&gt, &out.tracks).unwrap();
+    assert!(
+        s.overall.pck02() >= 0.85,
+        "PCK@0.2 {:.3}, mean {:.1} px",
+        s.overall.pck02(),
+        s.overall.mean_px()
+    );
+}

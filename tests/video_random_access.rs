@@ -302,3 +302,23 @@ fn a_cancelled_proxy_leaves_nothing_and_a_proxy_that_does_not_fit_is_dropped() {
     let err = proxy::build(&bad, &cache.join("x.mp4"), &mut |_, _| true).unwrap_err();
     assert!(err.to_string().contains("notes.txt"), "{err}");
 }
+
+#[test]
+fn a_video_can_deliver_shrunk_frames_and_full_ones_again() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("clip.mp4");
+    make_clip_sized(&path, 12, 320, 240);
+    let mut video = Video::open(&path, &OpenOptions::default()).unwrap();
+    let full = video.frame(5).unwrap().image;
+    assert!(video.output_size(Some((160, 120))));
+    assert_eq!((video.info().width, video.info().height), (160, 120));
+    let small = video.frame(5).unwrap().image;
+    assert_eq!(small.dimensions(), (160, 120));
+    // The same picture as shrinking the full frame (the cache did not hand back the old size).
+    let reference = image::imageops::thumbnail(&*full, 160, 120);
+    let diff = mean_abs_diff(&small, &reference);
+    assert!(diff < 12.0, "{diff}");
+    assert!(video.output_size(None));
+    assert_eq!(video.frame(5).unwrap().image.dimensions(), (320, 240));
+    assert_eq!(video.frame(11).unwrap().image.dimensions(), (320, 240));
+}

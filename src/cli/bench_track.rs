@@ -446,12 +446,18 @@ fn speed(
     };
     let mut video = Video::open(&dir.join("video.mp4"), &options).map_err(ExitError::failed)?;
     let n = video.info().frame_count;
+    // Frames in memory are full size: the tracker shrinks them itself (FFmpeg's scaling while
+    // decoding would empty the cache).
+    let params = TrackerParams {
+        decoder_scaling: decoding,
+        ..params
+    };
+    let job = TrackJob::from_marks(&marks, params, threads);
     if !decoding {
         for i in 0..n {
             let _: Arc<_> = video.frame(i).map_err(ExitError::failed)?.image;
         }
     }
-    let job = TrackJob::from_marks(&marks, params, threads);
     let t0 = Instant::now();
     track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false))
         .map_err(ExitError::failed)?;

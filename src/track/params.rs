@@ -54,6 +54,10 @@ pub struct TrackerParams {
     /// most this tall, pixels (speed on large videos; the sampling grids are capped anyway).
     /// Default 480.
     pub working_stature_px: f64,
+    /// Have FFmpeg deliver frames at the working scale, converting them to RGB at that size
+    /// (at 1080×1920 cheaper than converting at full size and shrinking). The video's frame
+    /// cache is emptied when tracking starts and ends. Default true.
+    pub decoder_scaling: bool,
     /// Limb and head blocks are this many times the body part's breadth from the proportions,
     /// so their margins (eq. 5's b2) hold the part's outline against the background. Default 1.0.
     pub block_width_scale: f64,
@@ -83,6 +87,7 @@ impl Default for TrackerParams {
             weak_reliability: 0.45,
             max_gap_s: 0.5,
             working_stature_px: 480.0,
+            decoder_scaling: true,
             block_width_scale: 1.0,
             parallel: true,
         }

@@ -15,7 +15,7 @@ use super::params::TrackerParams;
 use crate::camera::point_in_frame;
 use crate::formats::{FrameTracks, PointSource, SourceInfo, TrackedPoint, Tracks2d};
 use crate::skeleton::{JOINT_COUNT, Joint, PerJoint, Proportions};
-use crate::video::{Video, VideoError};
+use crate::video::{Video, VideoError, VideoInfo};
 use image::RgbImage;
 use nalgebra::Point2;
 use std::collections::BTreeMap;
@@ -168,6 +168,10 @@ impl Scale {
 }
 
 /// Tracks the video from its key frames.
+///
+/// When the person is taller than the working stature, `decoder_scaling` is on and the backend
+/// can scale while it converts pixels, the video delivers working-size frames during tracking (at 1080×1920 that
+/// costs less than converting at full size and shrinking) and full-size ones again afterwards.
 pub fn track_video(
     video: &mut Video,
     job: &TrackJob,
@@ -175,6 +179,42 @@ pub fn track_video(
     cancel: &AtomicBool,
 ) -> Result<TrackOutput, TrackError> {
     let info = video.info().clone();
+    let out = track_at_working_scale(video, &info, job, progress, cancel);
+    if (video.info().width, video.info().height) != (info.width, info.height) {
+        video.output_size(None);
+    }
+    out
+}
+
+/// The first key frame with all 16 joints, and its pose.
+fn first_full_key(job: &TrackJob) -> Option<(usize, PerJoint<Point2<f64>>)> {
+    job.keys.frames.iter().find_map(|(f, joints)| {
+        let all: Option<Vec<Point2<f64>>> = joints.0.iter().copied().collect();
+        all.map(|v| (*f, PerJoint::from_fn(|j| v[j.index()])))
+    })
+}
+
+/// The integer shrink factor that brings the marked person to at most the working stature, and
+/// the frame size it gives.
+fn working_scale(
+    job: &TrackJob,
+    pose: &PerJoint<Point2<f64>>,
+    width: u32,
+    height: u32,
+) -> (u32, (u32, u32)) {
+    let stature = stature_px(pose, &Proportions::default());
+    let shrink = (stature / job.params.working_stature_px).ceil().max(1.0) as u32;
+    (shrink, ((width / shrink).max(2), (height / shrink).max(2)))
+}
+
+/// [`track_video`] with the video's full-size info.
+fn track_at_working_scale(
+    video: &mut Video,
+    info: &VideoInfo,
+    job: &TrackJob,
+    progress: &mut (dyn FnMut(&TrackProgress) + Send),
+    cancel: &AtomicBool,
+) -> Result<TrackOutput, TrackError> {
     let n = info.frame_count;
     if n < 2 {
         return Err(TrackError::TooShort {
@@ -189,24 +229,19 @@ pub fn track_video(
             frames: n,
         });
     }
-    let (first_key, first_pose) = job
-        .keys
-        .frames
-        .iter()
-        .find_map(|(f, joints)| {
-            let all: Option<Vec<Point2<f64>>> = joints.0.iter().copied().collect();
-            all.map(|v| (*f, PerJoint::from_fn(|j| v[j.index()])))
-        })
-        .ok_or(TrackError::NoFullKeyFrame)?;
-    let proportions = Proportions::default();
-    let stature = stature_px(&first_pose, &proportions);
-    let shrink = (stature / job.params.working_stature_px).ceil().max(1.0) as u32;
-    let (ww, wh) = ((info.width / shrink).max(2), (info.height / shrink).max(2));
+    let (first_key, first_pose) = first_full_key(job).ok_or(TrackError::NoFullKeyFrame)?;
+    let (shrink, (ww, wh)) = working_scale(job, &first_pose, info.width, info.height);
     let scale = Scale {
         sx: f64::from(info.width) / f64::from(ww),
         sy: f64::from(info.height) / f64::from(wh),
         width: ww,
         height: wh,
+    };
+    // Frames come out at the working size if the backend can make them so.
+    let decoded = if shrink > 1 && job.params.decoder_scaling && video.output_size(Some((ww, wh))) {
+        (ww, wh)
+    } else {
+        (info.width, info.height)
     };
     let mut params = job.params;
     params.parallel = params.parallel && job.threads > 1;
@@ -240,8 +275,8 @@ pub fn track_video(
         params,
         keys: &job.keys,
         path: info.path.clone(),
-        width: info.width,
-        height: info.height,
+        width: decoded.0,
+        height: decoded.1,
         threads: job.threads,
         damaged: Vec::new(),
         done: 0,
@@ -386,6 +421,7 @@ struct PassContext<'a, 'p> {
     params: TrackerParams,
     keys: &'a KeyFrames,
     path: PathBuf,
+    /// The size frames arrive at from the video (full or, when it scales, working size).
     width: u32,
     height: u32,
     threads: usize,

@@ -47,6 +47,11 @@ pub struct FfmpegSource {
     scaler: Option<(ff::software::scaling::Context, ScalerKey)>,
     /// Output size before rotation, if frames are shrunk ([`FfmpegSource::shrink_to`]).
     shrunk: Option<(u32, u32)>,
+    /// The displayed size at full scale (what [`VideoSource::output_size`] goes back to).
+    full_size: (u32, u32),
+    /// The coded size of the first frame: a shrunk frame of another size is refused rather
+    /// than scaled to fit (unshrunk, its size tells the caller).
+    coded_size: (u32, u32),
     /// Index of the last frame the decoder produced, if it is positioned after it.
     last_decoded: Option<usize>,
     /// Whether end of stream was sent to the decoder since the last seek.
@@ -209,6 +214,8 @@ impl FfmpegSource {
             keyframes,
             scaler: None,
             shrunk: None,
+            full_size: (info.width, info.height),
+            coded_size: (coded_w, coded_h),
             last_decoded: None,
             eof_sent: false,
             skip_until_pts: None,
@@ -369,6 +376,15 @@ impl FfmpegSource {
         index: usize,
     ) -> Result<RgbImage, VideoError> {
         let (fmt, sw, sh) = (frame.format(), frame.width(), frame.height());
+        if self.shrunk.is_some() && (sw, sh) != self.coded_size {
+            return Err(self.decode_error(
+                index,
+                format!(
+                    "the frame is {sw}×{sh}, the video's first frame {}×{}",
+                    self.coded_size.0, self.coded_size.1
+                ),
+            ));
+        }
         let (w, h) = self.shrunk.unwrap_or((sw, sh));
         let key = (fmt, sw, sh, w, h);
         if !matches!(&self.scaler, Some((_, k)) if *k == key) {
@@ -448,6 +464,17 @@ fn is_variable(pts: &[i64]) -> bool {
 unsafe impl Send for FfmpegSource {}
 
 impl VideoSource for FfmpegSource {
+    fn output_size(&mut self, size: Option<(u32, u32)>) -> bool {
+        match size {
+            Some((w, h)) => self.shrink_to(w, h),
+            None => {
+                self.shrunk = None;
+                (self.info.width, self.info.height) = self.full_size;
+            }
+        }
+        true
+    }
+
     fn info(&self) -> &VideoInfo {
         &self.info
     }

@@ -74,6 +74,12 @@ pub trait VideoSource: Send {
     fn time_of(&self, index: usize) -> f64;
     /// Decodes frame `index` (display order) to RGB8.
     fn decode(&mut self, index: usize) -> Result<RgbImage, VideoError>;
+    /// Makes later frames come out `size` (as displayed), or full size again with `None`, if
+    /// the backend can scale while it converts pixels (cheaper than shrinking the full frame
+    /// afterwards); returns whether it did. The info then reports the new size.
+    fn output_size(&mut self, _size: Option<(u32, u32)>) -> bool {
+        false
+    }
 }
 
 /// Options for [`Video::open`].
@@ -123,6 +129,24 @@ impl Video {
             cache: FrameCache::new(cache_bytes, frame_bytes),
             source,
         }
+    }
+
+    /// Asks the backend to deliver frames at `size` (`None`: full size) while it converts
+    /// them ([`VideoSource::output_size`]); when the size changes the cache is emptied, since
+    /// its frames have the old size. Returns whether the backend did it.
+    pub fn output_size(&mut self, size: Option<(u32, u32)>) -> bool {
+        let before = (self.info().width, self.info().height);
+        if !self.source.output_size(size) {
+            return false;
+        }
+        let info = self.source.info();
+        if (info.width, info.height) == before {
+            return true;
+        }
+        let frame_bytes = info.width as usize * info.height as usize * 3;
+        let budget = self.cache.capacity_frames() * self.cache.frame_bytes();
+        self.cache = FrameCache::new(budget, frame_bytes);
+        true
     }
 
     /// Metadata of the video.

@@ -46,6 +46,15 @@ impl VideoSource for SpanSource {
         &self.info
     }
 
+    fn output_size(&mut self, size: Option<(u32, u32)>) -> bool {
+        if !self.inner.output_size(size) {
+            return false;
+        }
+        self.info.width = self.inner.info().width;
+        self.info.height = self.inner.info().height;
+        true
+    }
+
     fn time_of(&self, index: usize) -> f64 {
         self.inner.time_of(self.start + index) - self.inner.time_of(self.start)
     }
