@@ -6,7 +6,8 @@
 //!   interpolated point counts half), `σ = reprojection_sigma_px`;
 //! - every bone (and the shoulder line) at its length, `σ = length_sigma_m`;
 //! - the pelvis halfway between the hips (the model's definition), `σ = length_sigma_m`;
-//! - every joint's acceleration, `σ = acceleration_sigma_mps2 · Δt²`;
+//! - every joint's acceleration, `σ = a · Δt²` with `a` from the tracks' noise (adaptive, the
+//!   default) or `acceleration_sigma_mps2`;
 //! - each length near its starting value (`σ = length_prior` of it) and their sum at its
 //!   starting value (a monocular camera cannot see scale: the subject's height sets it).
 //!
@@ -64,7 +65,8 @@ impl Default for RefineParams {
 /// The adaptive refinement's acceleration deviation (m/s²) is this over the tracks' noise
 /// (pixels): jitter needs a firm hand, exact tracks almost none. On the synthetic suite with true
 /// lengths it gave 63.5 → 61.5 mm MPJPE with 2 px noise and 20.4 → 21.6 mm with exact tracks
-/// (30: 66.3 and 23.5; 100: 63.1 and 20.9; the fixed 100 m/s²: 64.2 and 24.4).
+/// (without the floor below, 30 gave 66.3 and 23.5 and 100 gave 63.1 and 20.9; the fixed
+/// 100 m/s² gives 64.2 and 24.4).
 pub const ACCELERATION_TIMES_NOISE: f64 = 60.0;
 
 /// The firmest acceleration deviation the adaptive refinement uses, m/s² (reached at 2 px of
@@ -134,9 +136,7 @@ struct Problem<'a> {
     weights: &'a [PerJoint<f64>],
     start_lengths: [f64; LENGTHS],
     params: RefineParams,
-    /// 2D deviation of a fully trusted point, pixels.
-    sigma_px: f64,
-    /// Acceleration deviation, metres per frame².
+    /// Acceleration deviation, metres per frame² ([`acceleration_sigma_m`]).
     accel_sigma_m: f64,
 }
 
@@ -214,7 +214,7 @@ impl Problem<'_> {
                 let c = Self::col(t, j);
                 let q = Self::point(x, t, j);
                 let z = q.z.max(1e-3);
-                let s = self.weights[t][j].sqrt() / self.sigma_px;
+                let s = self.weights[t][j].sqrt() / p.reprojection_sigma_px;
                 let u = f * q.x / z + self.cam.cx - self.images[t][j].x;
                 let v = f * q.y / z + self.cam.cy - self.images[t][j].y;
                 emit(
@@ -316,19 +316,20 @@ impl Problem<'_> {
     }
 }
 
-/// Each joint's 2D deviation (pixels) and acceleration deviation (metres per frame²): fixed
-/// from the parameters, or read from the joint's own track when `params.adaptive`.
-fn sigmas(track_noise_px: f64, params: &RefineParams, dt: f64) -> (f64, f64) {
+/// The acceleration deviation in metres per frame²: from the tracks' noise when
+/// `params.adaptive`, else `params.acceleration_sigma_mps2`.
+fn acceleration_sigma_m(track_noise_px: f64, params: &RefineParams, dt: f64) -> f64 {
     let accel = if params.adaptive {
         (ACCELERATION_TIMES_NOISE / track_noise_px.max(MIN_NOISE_PX)).max(MIN_ACCELERATION_MPS2)
     } else {
         params.acceleration_sigma_mps2
     };
-    (params.reprojection_sigma_px, accel * dt * dt)
+    accel * dt * dt
 }
 
-/// Refines a sequence; `start` is the per-frame solve, `fps` sets Δt. With `params.adaptive`,
-/// `images` should be the raw tracks (their noise is read from them).
+/// Refines a sequence; `start` is the per-frame solve, `fps` sets Δt, and `track_noise_px` is
+/// the tracks' white noise ([`super::smoothing::median_noise_px`]) for the adaptive
+/// acceleration term.
 #[allow(clippy::too_many_arguments)]
 pub fn refine(
     cam: &PinholeCamera,
@@ -349,15 +350,13 @@ pub fn refine(
     } else {
         1.0 / 30.0
     };
-    let (sigma_px, accel_sigma_m) = sigmas(track_noise_px, params, dt);
     let problem = Problem {
         cam,
         images,
         weights,
         start_lengths,
         params: *params,
-        sigma_px,
-        accel_sigma_m,
+        accel_sigma_m: acceleration_sigma_m(track_noise_px, params, dt),
     };
     let m = problem.unknowns();
     let mut x = Problem::pack(start, &start_lengths);
@@ -446,10 +445,10 @@ mod tests {
     fn the_adaptive_acceleration_term_is_firmer_for_noisier_tracks() {
         let params = RefineParams::default();
         let dt = 1.0 / 30.0;
-        let (_, exact) = sigmas(0.0, &params, dt);
-        let (_, half) = sigmas(0.5, &params, dt);
-        let (_, noisy) = sigmas(2.0, &params, dt);
-        let (_, very) = sigmas(8.0, &params, dt);
+        let exact = acceleration_sigma_m(0.0, &params, dt);
+        let half = acceleration_sigma_m(0.5, &params, dt);
+        let noisy = acceleration_sigma_m(2.0, &params, dt);
+        let very = acceleration_sigma_m(8.0, &params, dt);
         assert!(exact > half && half > noisy, "{exact} {half} {noisy}");
         assert!((exact - 600.0 * dt * dt).abs() < 1e-9, "{exact}");
         assert!(
@@ -460,7 +459,7 @@ mod tests {
             adaptive: false,
             ..params
         };
-        assert_eq!(sigmas(2.0, &fixed, dt).1, 100.0 * dt * dt);
+        assert_eq!(acceleration_sigma_m(2.0, &fixed, dt), 100.0 * dt * dt);
     }
 
     /// Central finite differences of every residual against the analytic rows.
@@ -493,7 +492,6 @@ mod tests {
             weights: &weights,
             start_lengths,
             params: RefineParams::default(),
-            sigma_px: 1.5,
             accel_sigma_m: 20.0 / 900.0,
         };
         let m = problem.unknowns();

@@ -181,7 +181,8 @@ pub fn track_video(
     let info = video.info().clone();
     let out = track_at_working_scale(video, &info, job, progress, cancel);
     if (video.info().width, video.info().height) != (info.width, info.height) {
-        video.output_size(None);
+        // Back to the size the caller had (full size unless it shrank the video itself).
+        video.output_size(Some((info.width, info.height)));
     }
     out
 }
