@@ -465,7 +465,8 @@ unsafe impl Send for FfmpegSource {}
 
 impl VideoSource for FfmpegSource {
     fn output_size(&mut self, size: Option<(u32, u32)>) -> bool {
-        match size {
+        // Asking for the full size is asking for no scaling (and no check of the coded size).
+        match size.filter(|s| *s != self.full_size) {
             Some((w, h)) => self.shrink_to(w, h),
             None => {
                 self.shrunk = None;
