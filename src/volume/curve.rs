@@ -225,6 +225,42 @@ fn interpolate(
     }
 }
 
+/// Where the head probably is when the curve could not be named (wrong leaf count): the tip
+/// of the shortest limb of the refined tree, measured in input space through its nodes'
+/// centroids. [`super::handles`] looks for loops from there.
+pub fn head_tip_guess(
+    mut tree: ShellTree,
+    input: &[Point3<f64>],
+    params: &CurveParams,
+) -> Option<Point3<f64>> {
+    adjust_tree_nodes(&mut tree, params);
+    let centroid = |k: usize| -> Option<Point3<f64>> {
+        let m = &tree.nodes[k].members;
+        (!m.is_empty()).then(|| {
+            Point3::from(m.iter().map(|&i| input[i].coords).sum::<Vector3<f64>>() / m.len() as f64)
+        })
+    };
+    let mut order = Vec::new();
+    subtree(&tree, tree.root, &mut order);
+    order
+        .iter()
+        .filter(|&&k| tree.nodes[k].children.is_empty() && k != tree.root)
+        .filter_map(|&leaf| {
+            let tip = centroid(leaf)?;
+            let (mut cur, mut length) = (leaf, 0.0);
+            while let Some(p) = tree.nodes[cur].parent {
+                length += (centroid(p)? - centroid(cur)?).norm();
+                if p == tree.root || leaves_below(&tree, p) >= 2 {
+                    break;
+                }
+                cur = p;
+            }
+            Some((length, tip))
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, tip)| tip)
+}
+
 /// Refines the tree and names its limbs. `coords` are the embedded points, `input` their input
 /// positions (same indexing).
 pub fn skeleton_curve(

@@ -40,6 +40,9 @@ pub struct Embedding {
     /// Graph degree of each kept point (interior voxels have a full neighbourhood; fewer
     /// neighbours means the point lies on the surface).
     pub degree: Vec<u32>,
+    /// Graph edges removed to open loops ([`Neighbours::open_handles`]); 0 when none were
+    /// looked for or found.
+    pub cut_edges: usize,
 }
 
 /// Why a frame could not be embedded.
@@ -52,14 +55,49 @@ pub enum IsomapProblem {
 }
 
 /// Adjacency in compressed rows: neighbours of `i` are `targets[starts[i]..starts[i + 1]]`.
-struct Graph {
+pub(super) struct Graph {
     starts: Vec<u32>,
     targets: Vec<u32>,
     weights: Vec<f32>,
 }
 
 impl Graph {
-    fn neighbours(&self, i: usize) -> impl Iterator<Item = (usize, f32)> + '_ {
+    /// Number of nodes.
+    pub(super) fn len(&self) -> usize {
+        self.starts.len() - 1
+    }
+
+    /// Number of directed edges (each undirected edge counts twice).
+    pub(super) fn targets_len(&self) -> usize {
+        self.targets.len()
+    }
+
+    /// The longest edge.
+    pub(super) fn longest_edge(&self) -> f32 {
+        self.weights.iter().copied().fold(0.0, f32::max)
+    }
+
+    /// The same graph without the edges `cut` says to remove (asked once per direction).
+    pub(super) fn without(&self, cut: impl Fn(usize, usize) -> bool) -> Graph {
+        let mut g = Graph {
+            starts: Vec::with_capacity(self.starts.len()),
+            targets: Vec::with_capacity(self.targets.len()),
+            weights: Vec::with_capacity(self.weights.len()),
+        };
+        g.starts.push(0);
+        for i in 0..self.len() {
+            for (j, w) in self.neighbours(i) {
+                if !cut(i, j) {
+                    g.targets.push(j as u32);
+                    g.weights.push(w);
+                }
+            }
+            g.starts.push(g.targets.len() as u32);
+        }
+        g
+    }
+
+    pub(super) fn neighbours(&self, i: usize) -> impl Iterator<Item = (usize, f32)> + '_ {
         let (a, b) = (self.starts[i] as usize, self.starts[i + 1] as usize);
         self.targets[a..b]
             .iter()
@@ -144,15 +182,20 @@ fn largest_component(g: &Graph, n: usize) -> Vec<usize> {
 }
 
 /// Geodesic distances from `source` to every node (Dijkstra with a binary heap; f32 keys are
-/// compared by their bits, which orders non-negative floats correctly).
-fn dijkstra(
+/// compared by their bits, which orders non-negative floats correctly), and each node's
+/// predecessor on its shortest path when `parents` is given (`u32::MAX` for the source).
+pub(super) fn dijkstra(
     g: &Graph,
     source: usize,
     dist: &mut [f32],
     heap: &mut BinaryHeap<Reverse<(u32, u32)>>,
+    mut parents: Option<&mut [u32]>,
 ) {
     dist.fill(f32::INFINITY);
     heap.clear();
+    if let Some(p) = parents.as_deref_mut() {
+        p.fill(u32::MAX);
+    }
     dist[source] = 0.0;
     heap.push(Reverse((0f32.to_bits(), source as u32)));
     while let Some(Reverse((d_bits, i))) = heap.pop() {
@@ -165,37 +208,93 @@ fn dijkstra(
             let nd = d + w;
             if nd < dist[j] {
                 dist[j] = nd;
+                if let Some(p) = parents.as_deref_mut() {
+                    p[j] = i as u32;
+                }
                 heap.push(Reverse((nd.to_bits(), j as u32)));
             }
         }
     }
 }
 
+/// The neighbourhood graph of a frame's largest connected component, ready to embed.
+pub struct Neighbours {
+    /// Indices (into the input) of the points kept.
+    kept: Vec<usize>,
+    /// Their positions.
+    points: Vec<Point3<f64>>,
+    graph: Graph,
+    /// Edges removed by [`Neighbours::open_handles`].
+    cut_edges: usize,
+}
+
+impl Neighbours {
+    /// Builds the graph of `points` and keeps its largest connected component.
+    pub fn new(points: &[Point3<f64>], params: &IsomapParams) -> Result<Self, IsomapProblem> {
+        let min_points = params.landmarks.max(4) + 1;
+        if points.len() < min_points {
+            return Err(IsomapProblem::TooFewPoints(points.len(), min_points));
+        }
+        let full = build_graph(points, params.neighbourhood);
+        let kept = largest_component(&full, points.len());
+        if kept.len() < min_points {
+            return Err(IsomapProblem::TooFewPoints(kept.len(), min_points));
+        }
+        let sub: Vec<Point3<f64>> = kept.iter().map(|&i| points[i]).collect();
+        let graph = if kept.len() == points.len() {
+            full
+        } else {
+            build_graph(&sub, params.neighbourhood)
+        };
+        Ok(Neighbours {
+            kept,
+            points: sub,
+            graph,
+            cut_edges: 0,
+        })
+    }
+
+    /// Positions of the points kept, in the embedding's order.
+    pub fn points(&self) -> &[Point3<f64>] {
+        &self.points
+    }
+
+    /// Opens the graph's loops as seen from the kept point nearest `head`
+    /// ([`super::handles`]); returns how many edges were removed (0: no loop).
+    pub fn open_handles(&mut self, head: Point3<f64>) -> usize {
+        let source = (0..self.points.len()).min_by(|&a, &b| {
+            (self.points[a] - head)
+                .norm_squared()
+                .total_cmp(&(self.points[b] - head).norm_squared())
+        });
+        let Some((opened, cut)) = source.and_then(|s| super::handles::cut_handles(&self.graph, s))
+        else {
+            return 0;
+        };
+        self.graph = opened;
+        self.cut_edges += cut;
+        cut
+    }
+}
+
 /// Embeds `points` in three dimensions.
 pub fn embed(points: &[Point3<f64>], params: &IsomapParams) -> Result<Embedding, IsomapProblem> {
+    embed_graph(&Neighbours::new(points, params)?, params)
+}
+
+/// Embeds a built neighbourhood graph in three dimensions.
+pub fn embed_graph(nb: &Neighbours, params: &IsomapParams) -> Result<Embedding, IsomapProblem> {
     let landmarks = params.landmarks.max(4);
-    let min_points = landmarks + 1;
-    if points.len() < min_points {
-        return Err(IsomapProblem::TooFewPoints(points.len(), min_points));
-    }
-    let full = build_graph(points, params.neighbourhood);
-    let kept = largest_component(&full, points.len());
-    if kept.len() < min_points {
-        return Err(IsomapProblem::TooFewPoints(kept.len(), min_points));
-    }
-    let sub: Vec<Point3<f64>> = kept.iter().map(|&i| points[i]).collect();
-    let g = if kept.len() == points.len() {
-        full
-    } else {
-        build_graph(&sub, params.neighbourhood)
-    };
-    let n = sub.len();
+    let g = &nb.graph;
+    let n = nb.points.len();
+    let kept = nb.kept.clone();
+    let cut_edges = nb.cut_edges;
 
     // Landmarks by max-min: each new landmark is the point farthest (geodesically) from those
     // chosen so far, started from the point farthest from point 0.
     let mut heap = BinaryHeap::new();
     let mut scratch = vec![0f32; n];
-    dijkstra(&g, 0, &mut scratch, &mut heap);
+    dijkstra(g, 0, &mut scratch, &mut heap, None);
     let farthest = |d: &[f32]| {
         d.iter()
             .enumerate()
@@ -208,7 +307,7 @@ pub fn embed(points: &[Point3<f64>], params: &IsomapParams) -> Result<Embedding,
     while rows.len() < landmarks {
         let Some(&l) = chosen.last() else { break };
         let mut row = vec![0f32; n];
-        dijkstra(&g, l, &mut row, &mut heap);
+        dijkstra(g, l, &mut row, &mut heap, None);
         for (m, d) in nearest.iter_mut().zip(&row) {
             *m = m.min(*d);
         }
@@ -268,6 +367,7 @@ pub fn embed(points: &[Point3<f64>], params: &IsomapParams) -> Result<Embedding,
         kept,
         coords,
         degree,
+        cut_edges,
     })
 }
 

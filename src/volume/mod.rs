@@ -10,6 +10,7 @@ pub mod bodies;
 pub mod carve;
 pub mod cloud;
 pub mod curve;
+mod handles;
 pub mod isomap;
 pub mod sequence;
 pub mod shells;
@@ -126,7 +127,10 @@ pub fn point_spacing(points: &[Point3<f64>]) -> f64 {
     d.get(d.len() / 2).copied().unwrap_or(0.0)
 }
 
-/// The volume-to-posture procedure on one frame.
+/// The volume-to-posture procedure on one frame. Beyond the paper, when a limb touches the body
+/// (a hand on the hip) and so closes a loop, the loop is opened where it touches, as seen from
+/// the head the first pass found, and the frame is done again; the second result is kept when
+/// it gives a pose.
 pub fn process_frame(
     points: &[Point3<f64>],
     params: &VolumeParams,
@@ -140,9 +144,49 @@ pub fn process_frame(
         neighbourhood: Neighbourhood::Radius(spacing * params.radius_spacings),
         landmarks: params.landmarks,
     };
-    let embedding = isomap::embed(points, &iso)?;
+    let mut graph = isomap::Neighbours::new(points, &iso)?;
+    let graph_s = start.elapsed().as_secs_f64();
+    let first = embed_and_fit(&graph, &iso, params)?;
+    // Isomap's share: the neighbourhood graph and every embedding (not the loop opening).
+    let mut isomap_s = graph_s + first.isomap_s;
+    let mut result = first.result;
+    if let Some(head) = first.head
+        && graph.open_handles(head) > 0
+    {
+        // A second pass that fails keeps the first one's answer.
+        if let Ok(second) = embed_and_fit(&graph, &iso, params) {
+            isomap_s += second.isomap_s;
+            if second.result.is_ok() {
+                result = second.result;
+            }
+        }
+    }
+    result.map(|mut r| {
+        let total = start.elapsed().as_secs_f64();
+        r.seconds = [isomap_s, total - isomap_s];
+        r
+    })
+}
+
+/// One pass of the procedure on a built graph.
+struct Pass {
+    /// The frame's result (`seconds` not yet filled in).
+    result: Result<FrameResult, FrameProblem>,
+    /// Where the head is: the curve's head tip, or a guess when the curve could not be named.
+    head: Option<Point3<f64>>,
+    /// Seconds spent embedding.
+    isomap_s: f64,
+}
+
+fn embed_and_fit(
+    graph: &isomap::Neighbours,
+    iso: &IsomapParams,
+    params: &VolumeParams,
+) -> Result<Pass, FrameProblem> {
+    let start = Instant::now();
+    let embedding = isomap::embed_graph(graph, iso)?;
     let isomap_s = start.elapsed().as_secs_f64();
-    let kept: Vec<Point3<f64>> = embedding.kept.iter().map(|&i| points[i]).collect();
+    let kept: Vec<Point3<f64>> = graph.points().to_vec();
     let full = {
         let mut d: Vec<u32> = embedding.degree.clone();
         d.sort_unstable();
@@ -154,14 +198,27 @@ pub fn process_frame(
         .map(|&d| f64::from(d) < 0.8 * f64::from(full))
         .collect();
     let tree = shells::build(&embedding.coords, &params.shells);
-    let curve = curve::skeleton_curve(tree, &embedding.coords, &kept, &params.curve)?;
+    let curve = match curve::skeleton_curve(tree.clone(), &embedding.coords, &kept, &params.curve) {
+        Ok(c) => c,
+        Err(e) => {
+            return Ok(Pass {
+                result: Err(e.into()),
+                head: curve::head_tip_guess(tree, &kept, &params.curve),
+                isomap_s,
+            });
+        }
+    };
     let fit = bodies::fit(&curve, &kept, &surface, &params.bodies);
-    let total = start.elapsed().as_secs_f64();
-    Ok(FrameResult {
-        points: kept,
-        curve,
-        fit,
-        seconds: [isomap_s, total - isomap_s],
+    let head = curve.head.last().map(|&i| curve.points[i]);
+    Ok(Pass {
+        result: Ok(FrameResult {
+            points: kept,
+            curve,
+            fit,
+            seconds: [0.0; 2],
+        }),
+        head,
+        isomap_s,
     })
 }
 

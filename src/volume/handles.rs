@@ -1,0 +1,295 @@
+//! Handles in the neighbourhood graph (beyond the paper). A hand resting on the hip, or two
+//! hands clasped over the head, joins a limb to the body at both ends: geodesics then short-cut
+//! through the contact, Isomap folds the limb into the trunk and the shells lose it (the
+//! paper's §5 leaves volumes with cycles to future work).
+//!
+//! Swept outwards from the head, the level sets of the geodesic distance on a tree-shaped body
+//! only ever split. A level-set component fed by two branches that parted several bands earlier
+//! is a loop closing; its points are split by the branch their shortest path came through, and
+//! the graph edges between the two sides are removed. Seen from the head, a limb's two routes
+//! meet where it touches the body, not where it is attached, so the loop opens at the contact.
+//! Every shortest-path edge is kept, so the graph stays connected and the geodesic distances
+//! from the head do not change.
+
+use super::isomap::{Graph, dijkstra};
+use std::collections::BinaryHeap;
+
+/// Bands (each as wide as the longest graph edge) a loop must span at least, from where its two
+/// sides part to where they meet, to be opened; shorter ones are the voxel grid's staircase.
+const MIN_LOOP_BANDS: u32 = 2;
+
+/// The same as a share of the farthest geodesic distance from the head (about the stature), so
+/// that fine voxels (many narrow bands) do not open the staircase of their own surface.
+const MIN_LOOP_SHARE: f32 = 0.08;
+
+/// One branch of the sweep: a run of level-set components between a split and the next.
+struct Branch {
+    parent: Option<usize>,
+    /// Band in which the branch began.
+    born: u32,
+}
+
+/// Whether branch `b` is `a` or descends from it.
+fn descends(branches: &[Branch], mut b: usize, a: usize) -> bool {
+    loop {
+        if b == a {
+            return true;
+        }
+        match branches[b].parent {
+            Some(p) => b = p,
+            None => return false,
+        }
+    }
+}
+
+/// The band where the lineages of branches `a` and `b` parted.
+fn parted_at(branches: &[Branch], a: usize, b: usize) -> u32 {
+    let mut x = a;
+    loop {
+        if descends(branches, b, x) {
+            // `x` is the common ancestor; they parted where its children began.
+            let mut child_born = u32::MAX;
+            for mut y in [a, b] {
+                while let Some(p) = branches[y].parent {
+                    if p == x {
+                        child_born = child_born.min(branches[y].born);
+                        break;
+                    }
+                    y = p;
+                }
+            }
+            return if child_born == u32::MAX {
+                branches[x].born
+            } else {
+                child_born
+            };
+        }
+        match branches[x].parent {
+            Some(p) => x = p,
+            None => return 0,
+        }
+    }
+}
+
+/// Opens the loops of `g` seen from `source`: the graph without the edges that close them, and
+/// how many edges (counted once) were removed; `None` when there is no loop.
+pub(super) fn cut_handles(g: &Graph, source: usize) -> Option<(Graph, usize)> {
+    let n = g.len();
+    let mut dist = vec![0f32; n];
+    let mut parent = vec![u32::MAX; n];
+    dijkstra(
+        g,
+        source,
+        &mut dist,
+        &mut BinaryHeap::new(),
+        Some(&mut parent),
+    );
+    let band = g.longest_edge().max(f32::MIN_POSITIVE);
+    let level: Vec<u32> = dist
+        .iter()
+        .map(|d| {
+            if d.is_finite() {
+                (d / band) as u32
+            } else {
+                u32::MAX
+            }
+        })
+        .collect();
+    let mut order: Vec<usize> = (0..n).filter(|&i| level[i] != u32::MAX).collect();
+    order.sort_by(|&a, &b| dist[a].total_cmp(&dist[b]));
+    let top = order.last().map_or(0, |&i| level[i]) as usize;
+    let far = order.last().map_or(0.0, |&i| dist[i]);
+    let min_loop = MIN_LOOP_BANDS.max((MIN_LOOP_SHARE * far / band).ceil() as u32);
+    let mut by_level: Vec<Vec<usize>> = vec![Vec::new(); top + 1];
+    for &i in &order {
+        by_level[level[i] as usize].push(i);
+    }
+
+    let mut branches = vec![Branch {
+        parent: None,
+        born: 0,
+    }];
+    let mut branch = vec![usize::MAX; n];
+    // The branch each point's shortest path arrived through (its lowest-band ancestor's).
+    let mut incoming = vec![usize::MAX; n];
+    let mut component = vec![usize::MAX; n];
+    let mut merges: Vec<(usize, usize)> = Vec::new();
+    let mut stack = Vec::new();
+    for (k, nodes) in by_level.iter().enumerate() {
+        let k = k as u32;
+        // Components of this band (edges between its points), each in order of distance.
+        let mut comps: Vec<Vec<usize>> = Vec::new();
+        for &s in nodes {
+            if component[s] != usize::MAX {
+                continue;
+            }
+            let id = comps.len();
+            component[s] = id;
+            let mut members = vec![s];
+            stack.push(s);
+            while let Some(i) = stack.pop() {
+                for (j, _) in g.neighbours(i) {
+                    if level[j] == k && component[j] == usize::MAX {
+                        component[j] = id;
+                        members.push(j);
+                        stack.push(j);
+                    }
+                }
+            }
+            members.sort_by(|&a, &b| dist[a].total_cmp(&dist[b]));
+            comps.push(members);
+        }
+        // Pieces: a component, or the parts of a closing loop, each fed by one branch.
+        let mut pieces: Vec<(usize, Vec<usize>)> = Vec::new();
+        for members in comps {
+            for &v in &members {
+                let p = parent[v];
+                incoming[v] = if p == u32::MAX {
+                    0
+                } else if level[p as usize] < k {
+                    branch[p as usize]
+                } else {
+                    incoming[p as usize]
+                };
+            }
+            let mut feeds: Vec<usize> = members.iter().map(|&v| incoming[v]).collect();
+            feeds.sort_unstable();
+            feeds.dedup();
+            let closing = feeds.len() >= 2
+                && feeds
+                    .iter()
+                    .skip(1)
+                    .any(|&b| k.saturating_sub(parted_at(&branches, feeds[0], b)) >= min_loop);
+            if closing {
+                for (a, &fa) in feeds.iter().enumerate() {
+                    for &fb in &feeds[a + 1..] {
+                        merges.push((fa, fb));
+                    }
+                    pieces.push((
+                        fa,
+                        members
+                            .iter()
+                            .copied()
+                            .filter(|&v| incoming[v] == fa)
+                            .collect(),
+                    ));
+                }
+            } else {
+                // A short loop (the grid's staircase): the piece goes on as its first feeder.
+                pieces.push((feeds[0], members));
+            }
+        }
+        // A branch feeding one piece goes on; feeding several, it splits.
+        for (b, members) in &pieces {
+            let fed = pieces.iter().filter(|(c, _)| c == b).count();
+            let id = if fed == 1 {
+                *b
+            } else {
+                branches.push(Branch {
+                    parent: Some(*b),
+                    born: k,
+                });
+                branches.len() - 1
+            };
+            for &v in members {
+                branch[v] = id;
+            }
+        }
+    }
+    if merges.is_empty() {
+        return None;
+    }
+    merges.sort_unstable();
+    merges.dedup();
+    let cut = |i: usize, j: usize| {
+        let (a, b) = (branch[i], branch[j]);
+        a != b
+            && a != usize::MAX
+            && b != usize::MAX
+            && merges.iter().any(|&(x, y)| {
+                (descends(&branches, a, x) && descends(&branches, b, y))
+                    || (descends(&branches, a, y) && descends(&branches, b, x))
+            })
+    };
+    let opened = g.without(cut);
+    let removed = (g.targets_len() - opened.targets_len()) / 2;
+    (removed > 0).then_some((opened, removed))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::isomap::{IsomapParams, Neighbourhood, Neighbours, embed_graph};
+    use nalgebra::{Point3, Vector3};
+
+    /// A tube of 3 × 3 points per step along `path`.
+    fn tube(path: &[Point3<f64>], step: f64) -> Vec<Point3<f64>> {
+        let mut pts = Vec::new();
+        for c in path {
+            for dx in [-1.0, 0.0, 1.0] {
+                for dz in [-1.0, 0.0, 1.0] {
+                    pts.push(c + Vector3::new(dx, 0.0, dz) * step);
+                }
+            }
+        }
+        pts
+    }
+
+    fn params(step: f64) -> IsomapParams {
+        IsomapParams {
+            neighbourhood: Neighbourhood::Radius(step * 1.8),
+            landmarks: 10,
+        }
+    }
+
+    /// A 1 m trunk with a 0.9 m arm leaving its top, hanging down beside it and turning in so
+    /// that its hand rests on the trunk's lower end: seen from the top, the loop is opened where
+    /// the arm meets the hand, and the arm's lower end is then a whole arm and trunk away from
+    /// the trunk's end (geodesically) instead of a hand's width.
+    #[test]
+    fn a_limb_resting_on_the_body_is_cut_free_where_it_touches() {
+        let step = 0.03;
+        let mut path = Vec::new();
+        let steps = |a: f64| (a / step).round() as usize;
+        for i in 0..=steps(1.0) {
+            path.push(Point3::new(0.0, 1.0 - i as f64 * step, 0.0)); // trunk, top down
+        }
+        let trunk_end = path.len() - 1;
+        for i in 1..=steps(0.15) {
+            path.push(Point3::new(i as f64 * step, 1.0, 0.0)); // shoulder, outwards
+        }
+        for i in 1..=steps(0.9) {
+            path.push(Point3::new(0.15, 1.0 - i as f64 * step, 0.0)); // arm, down
+        }
+        let arm_end = path.len() - 1;
+        for i in 1..steps(0.15) {
+            path.push(Point3::new(0.15 - i as f64 * step, 0.1, 0.0)); // hand, inwards
+        }
+        let pts = tube(&path, step);
+        let p = params(step);
+        let mut nb = Neighbours::new(&pts, &p).unwrap();
+        let before = embed_graph(&nb, &p).unwrap();
+        // The tube's centre points are index 9·k + 4.
+        let (a, b) = (9 * trunk_end + 4, 9 * arm_end + 4);
+        let gap = |e: &super::super::isomap::Embedding| (e.coords[a] - e.coords[b]).norm();
+        assert!(gap(&before) < 0.3, "closed loop: {}", gap(&before));
+        let cut = nb.open_handles(Point3::new(0.0, 1.0, 0.0));
+        assert!(cut > 0);
+        let after = embed_graph(&nb, &p).unwrap();
+        assert_eq!(after.cut_edges, cut);
+        assert!(gap(&after) > 0.6, "opened loop: {}", gap(&after));
+    }
+
+    /// A tree (an L-shaped tube with a side branch) has no loop: nothing is cut.
+    #[test]
+    fn a_tree_is_left_alone() {
+        let step = 0.03;
+        let mut path: Vec<Point3<f64>> = (0..30)
+            .map(|i| Point3::new(0.0, -(i as f64) * step, 0.0))
+            .collect();
+        path.extend((1..20).map(|i| Point3::new(i as f64 * step, -0.87, 0.0)));
+        path.extend((1..15).map(|i| Point3::new(-(i as f64) * step, -0.3, 0.0)));
+        let pts = tube(&path, step);
+        let mut nb = Neighbours::new(&pts, &params(step)).unwrap();
+        assert_eq!(nb.open_handles(Point3::new(0.0, 0.0, 0.0)), 0);
+    }
+}
