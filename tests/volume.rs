@@ -5,33 +5,43 @@ use assert_cmd::Command;
 use nalgebra::{Point3, Vector3};
 use rand::SeedableRng;
 use std::sync::atomic::AtomicBool;
-use videomocap::eval::volume::score_volume;
+use videomocap::eval::volume::{VolumeScore, score_volume};
 use videomocap::formats::Skeleton3d;
 use videomocap::skeleton::SubjectModel;
 use videomocap::synth::{
-    ProceduralMotion, VoxelParams, procedural, stature_of, volume_truth, voxelise,
+    Motion, ProceduralMotion, VoxelParams, procedural, stature_of, volume_truth, voxelise,
 };
 use videomocap::volume::cloud::write_ply;
 use videomocap::volume::{
-    FrameProblem, SequenceError, VolumeParams, assemble, process_directory, process_frame,
+    Assembled, FrameProblem, SequenceError, VolumeParams, assemble, process_directory,
+    process_frame,
 };
 
-#[test]
-fn marching_at_40_mm_is_within_one_and_a_half_voxels() {
-    let motion = procedural(ProceduralMotion::March, &SubjectModel::default(), 16, 10.0);
-    let stature = stature_of(&motion);
+/// Voxelises `motion` at 40 mm (frame i seeded with `seed + i`), runs the pipeline on every
+/// frame and scores the assembled skeleton against the truth.
+fn run_at_40_mm(motion: &Motion) -> (VolumeScore, Assembled) {
+    let stature = stature_of(motion);
     let voxel = VoxelParams::default();
-    let mut rng = rand::rngs::StdRng::seed_from_u64(5);
     let params = VolumeParams::default();
     let results: Vec<_> = motion
         .frames
         .iter()
-        .map(|j| process_frame(&voxelise(j, stature, &voxel, &mut rng), &params))
+        .enumerate()
+        .map(|(i, j)| {
+            let mut rng = rand::rngs::StdRng::seed_from_u64(voxel.seed + i as u64);
+            process_frame(&voxelise(j, stature, &voxel, &mut rng), &params)
+        })
         .collect();
     let names: Vec<String> = (0..results.len()).map(|i| i.to_string()).collect();
     let a = assemble(&results, &names, motion.fps);
     let ok = results.iter().filter(|r| r.is_ok()).count();
-    let s = score_volume(&volume_truth(&motion), &a.skeleton, ok);
+    (score_volume(&volume_truth(motion), &a.skeleton, ok), a)
+}
+
+#[test]
+fn marching_at_40_mm_is_within_one_and_a_half_voxels() {
+    let motion = procedural(ProceduralMotion::March, &SubjectModel::default(), 16, 10.0);
+    let (s, a) = run_at_40_mm(&motion);
     assert!(s.topology() >= 0.95, "topology {}", s.topology());
     assert!(s.mean_mm() <= 1.5 * 40.0, "mean error {} mm", s.mean_mm());
     assert!(s.consistency() >= 0.95, "labels {}", s.consistency());
@@ -50,22 +60,7 @@ fn marching_at_40_mm_is_within_one_and_a_half_voxels() {
 #[test]
 fn a_hand_resting_on_the_hip_does_not_hide_the_arm() {
     let motion = procedural(ProceduralMotion::Wave, &SubjectModel::default(), 20, 15.0);
-    let stature = stature_of(&motion);
-    let voxel = VoxelParams::default();
-    let params = VolumeParams::default();
-    let results: Vec<_> = motion
-        .frames
-        .iter()
-        .enumerate()
-        .map(|(i, j)| {
-            let mut rng = rand::rngs::StdRng::seed_from_u64(voxel.seed + i as u64);
-            process_frame(&voxelise(j, stature, &voxel, &mut rng), &params)
-        })
-        .collect();
-    let names: Vec<String> = (0..results.len()).map(|i| i.to_string()).collect();
-    let a = assemble(&results, &names, motion.fps);
-    let ok = results.iter().filter(|r| r.is_ok()).count();
-    let s = score_volume(&volume_truth(&motion), &a.skeleton, ok);
+    let (s, _) = run_at_40_mm(&motion);
     assert!(s.topology() >= 0.95, "topology {}", s.topology());
     assert!(s.mean_mm() <= 2.0 * 40.0, "mean error {} mm", s.mean_mm());
 }
