@@ -226,14 +226,9 @@ fn interpolate(
 }
 
 /// Where the head probably is when the curve could not be named (wrong leaf count): the tip
-/// of the shortest limb of the refined tree, measured in input space through its nodes'
-/// centroids. [`super::handles`] looks for loops from there.
-pub fn head_tip_guess(
-    mut tree: ShellTree,
-    input: &[Point3<f64>],
-    params: &CurveParams,
-) -> Option<Point3<f64>> {
-    adjust_tree_nodes(&mut tree, params);
+/// of the shortest limb of `tree` (refined by [`adjust_tree_nodes`]), measured in input space
+/// through its nodes' centroids. [`super::handles`] looks for loops from there.
+pub fn head_tip_guess(tree: &ShellTree, input: &[Point3<f64>]) -> Option<Point3<f64>> {
     let centroid = |k: usize| -> Option<Point3<f64>> {
         let m = &tree.nodes[k].members;
         (!m.is_empty()).then(|| {
@@ -241,7 +236,7 @@ pub fn head_tip_guess(
         })
     };
     let mut order = Vec::new();
-    subtree(&tree, tree.root, &mut order);
+    subtree(tree, tree.root, &mut order);
     order
         .iter()
         .filter(|&&k| tree.nodes[k].children.is_empty() && k != tree.root)
@@ -250,7 +245,7 @@ pub fn head_tip_guess(
             let (mut cur, mut length) = (leaf, 0.0);
             while let Some(p) = tree.nodes[cur].parent {
                 length += (centroid(p)? - centroid(cur)?).norm();
-                if p == tree.root || leaves_below(&tree, p) >= 2 {
+                if p == tree.root || leaves_below(tree, p) >= 2 {
                     break;
                 }
                 cur = p;
@@ -261,22 +256,20 @@ pub fn head_tip_guess(
         .map(|(_, tip)| tip)
 }
 
-/// Refines the tree and names its limbs. `coords` are the embedded points, `input` their input
-/// positions (same indexing).
+/// Names the limbs of `tree` (refined by [`adjust_tree_nodes`]). `coords` are the embedded
+/// points, `input` their input positions (same indexing).
 pub fn skeleton_curve(
-    mut tree: ShellTree,
+    tree: &ShellTree,
     coords: &[Vector3<f64>],
     input: &[Point3<f64>],
-    params: &CurveParams,
 ) -> Result<SkeletonCurve, CurveProblem> {
-    adjust_tree_nodes(&mut tree, params);
-    let leaves = live_leaves(&tree);
+    let leaves = live_leaves(tree);
     if leaves != 5 {
         return Err(CurveProblem::WrongLeafCount(leaves));
     }
     // Live nodes → curve points.
     let mut order = Vec::new();
-    subtree(&tree, tree.root, &mut order);
+    subtree(tree, tree.root, &mut order);
     let mut index = vec![usize::MAX; tree.nodes.len()];
     for (i, &k) in order.iter().enumerate() {
         index[k] = i;
@@ -305,7 +298,7 @@ pub fn skeleton_curve(
         let mut cur = k;
         let attach = loop {
             match tree.nodes[cur].parent {
-                Some(p) if p != tree.root && leaves_below(&tree, p) < 2 => {
+                Some(p) if p != tree.root && leaves_below(tree, p) < 2 => {
                     chain.push(index[p]);
                     cur = p;
                 }

@@ -197,13 +197,14 @@ fn embed_and_fit(
         .iter()
         .map(|&d| f64::from(d) < 0.8 * f64::from(full))
         .collect();
-    let tree = shells::build(&embedding.coords, &params.shells);
-    let curve = match curve::skeleton_curve(tree.clone(), &embedding.coords, &kept, &params.curve) {
+    let mut tree = shells::build(&embedding.coords, &params.shells);
+    curve::adjust_tree_nodes(&mut tree, &params.curve);
+    let curve = match curve::skeleton_curve(&tree, &embedding.coords, &kept) {
         Ok(c) => c,
         Err(e) => {
             return Ok(Pass {
                 result: Err(e.into()),
-                head: curve::head_tip_guess(tree, &kept, &params.curve),
+                head: curve::head_tip_guess(&tree, &kept),
                 isomap_s,
             });
         }
