@@ -256,6 +256,95 @@ pub fn head_tip_guess(tree: &ShellTree, input: &[Point3<f64>]) -> Option<Point3<
         .map(|(_, tip)| tip)
 }
 
+/// Names the five limbs, given as (curve points outwards, the point they leave from) with their
+/// lengths along the curve: the indices of the head, the two arms and the two legs.
+///
+/// §4: the shortest branch is the head and the two nearest it the arms. Beyond the paper, when
+/// the limbs leave two branch nodes, geometry tells the chest from the pelvis: a limb's reach is
+/// its length times the cosine between its leaf direction and the axis pointing away from the
+/// other node; the pelvis is the node whose two farthest-reaching limbs reach farther (legs are
+/// long and point away from the chest), and those two are the legs. The head is the chest limb
+/// that best continues the pelvis→chest axis for its length (cosine − length / longest limb). A
+/// third limb at the pelvis is an arm whose hand rests on the hip (it joins the hip there in
+/// voxels). With one branch node, or a lone limb at a node: the head is the shortest of three
+/// limbs leaving one node when there is such a node (a raised arm can be shorter than the legs
+/// but a leg is not), else the shortest; the arms are the limbs leaving the head's node first,
+/// then those nearest the head.
+fn name_limbs(limbs: &[(Vec<usize>, usize)], length: &[f64], points: &[Point3<f64>]) -> [usize; 5] {
+    let tip = |k: usize| points[*limbs[k].0.last().unwrap_or(&limbs[k].1)];
+    let mut nodes: Vec<usize> = limbs.iter().map(|l| l.1).collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    let at =
+        |node: usize| -> Vec<usize> { (0..limbs.len()).filter(|&k| limbs[k].1 == node).collect() };
+    if let [n0, n1] = nodes[..]
+        && at(n0).len() >= 2
+        && at(n1).len() >= 2
+        && let Some(axis) = (points[n0] - points[n1]).try_normalize(1e-9)
+    {
+        // cos(k, away): limb k's leaf direction against `away`.
+        let cos = |k: usize, away: &Vector3<f64>| {
+            (tip(k) - points[limbs[k].1])
+                .try_normalize(1e-9)
+                .map_or(0.0, |d| d.dot(away))
+        };
+        // The limbs at `node` by reach away from the other node, farthest first.
+        let by_reach = |node: usize, away: Vector3<f64>| {
+            let mut g = at(node);
+            g.sort_by(|&a, &b| (length[b] * cos(b, &away)).total_cmp(&(length[a] * cos(a, &away))));
+            let reach: f64 = g.iter().take(2).map(|&k| length[k] * cos(k, &away)).sum();
+            (g, reach)
+        };
+        let (g0, r0) = by_reach(n0, axis);
+        let (g1, r1) = by_reach(n1, -axis);
+        let (pelvis, chest, up) = if r0 >= r1 {
+            (g0, at(n1), -axis)
+        } else {
+            (g1, at(n0), axis)
+        };
+        let longest = length.iter().copied().fold(f64::MIN_POSITIVE, f64::max);
+        let continues = |k: usize| cos(k, &up) - length[k] / longest;
+        let head = chest
+            .iter()
+            .copied()
+            .max_by(|&a, &b| continues(a).total_cmp(&continues(b)))
+            .unwrap_or(chest[0]);
+        let mut arms = chest
+            .iter()
+            .chain(&pelvis[2..])
+            .copied()
+            .filter(|&k| k != head);
+        if let (Some(a1), Some(a2)) = (arms.next(), arms.next()) {
+            return [head, a1, a2, pelvis[0], pelvis[1]];
+        }
+    }
+    let shortest = |among: &[usize]| {
+        among
+            .iter()
+            .copied()
+            .min_by(|&a, &b| length[a].total_cmp(&length[b]))
+            .unwrap_or(0)
+    };
+    let three = nodes.iter().map(|&n| at(n)).find(|g| g.len() == 3);
+    let all: Vec<usize> = (0..limbs.len()).collect();
+    let head = shortest(three.as_deref().unwrap_or(&all));
+    let head_start = points[limbs[head].0[0]];
+    let head_attach = limbs[head].1;
+    // Limbs leaving the head's branch node first, then by distance from the head.
+    let rank = |k: usize| {
+        (
+            limbs[k].1 != head_attach,
+            (points[limbs[k].0[0]] - head_start).norm(),
+        )
+    };
+    let mut rest: Vec<usize> = all.into_iter().filter(|&k| k != head).collect();
+    rest.sort_by(|&a, &b| {
+        let (ra, rb) = (rank(a), rank(b));
+        ra.0.cmp(&rb.0).then(ra.1.total_cmp(&rb.1))
+    });
+    [head, rest[0], rest[1], rest[2], rest[3]]
+}
+
 /// Names the limbs of `tree` (refined by [`adjust_tree_nodes`]). `coords` are the embedded
 /// points, `input` their input positions (same indexing).
 pub fn skeleton_curve(
@@ -318,40 +407,14 @@ pub fn skeleton_curve(
         })
     };
     // §4: the shortest branch is the head and the two nearest it the arms. Beyond the paper:
-    // when three limbs leave one branch node (the chest), the head is the shortest of those
-    // three, which stays right when a raised arm is shorter than the legs but a leg is not.
-    let mut groups: Vec<(usize, Vec<usize>)> = Vec::new();
-    for (i, (_, attach)) in limbs.iter().enumerate() {
-        match groups.iter_mut().find(|(a, _)| a == attach) {
-            Some((_, g)) => g.push(i),
-            None => groups.push((*attach, vec![i])),
-        }
+    // see `name_limbs`.
+    if limbs.len() != 5 {
+        return Err(CurveProblem::WrongLeafCount(limbs.len()));
     }
-    let shortest = |among: &[usize]| {
-        among
-            .iter()
-            .copied()
-            .min_by(|&a, &b| length(&limbs[a]).total_cmp(&length(&limbs[b])))
-            .unwrap_or(0)
-    };
-    let all: Vec<usize> = (0..limbs.len()).collect();
-    let head_at = match groups.iter().find(|(_, g)| g.len() == 3) {
-        Some((_, g)) => shortest(g),
-        None => shortest(&all),
-    };
-    let head = limbs.remove(head_at);
-    let head_start = points[head.0[0]];
-    let head_attach = head.1;
-    // Limbs leaving the head's branch node first, then by distance from the head.
-    let rank = |l: &(Vec<usize>, usize)| (l.1 != head_attach, (points[l.0[0]] - head_start).norm());
-    limbs.sort_by(|a, b| {
-        let (ra, rb) = (rank(a), rank(b));
-        ra.0.cmp(&rb.0).then(ra.1.total_cmp(&rb.1))
-    });
-    // limbs: two arms then two legs (invariant: exactly four remain, checked by the leaf count).
-    let [arm1, arm2, leg1, leg2]: [(Vec<usize>, usize); 4] = limbs
-        .try_into()
-        .map_err(|l: Vec<_>| CurveProblem::WrongLeafCount(l.len() + 1))?;
+    let lengths: Vec<f64> = limbs.iter().map(length).collect();
+    let [h, a1, a2, l1, l2] = name_limbs(&limbs, &lengths, &points);
+    let mut take = |k: usize| std::mem::take(&mut limbs[k]);
+    let (head, arm1, arm2, leg1, leg2) = (take(h), take(a1), take(a2), take(l1), take(l2));
     Ok(SkeletonCurve {
         root: index[tree.root],
         chest: head.1,
@@ -363,4 +426,59 @@ pub fn skeleton_curve(
         parents,
         members,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Names limbs given as (leaf, branch node) pairs; node 0 is the chest and node 1 the
+    /// pelvis, at shoulder and hip height of a standing 1.75 m body.
+    fn named(leaves: &[(f64, f64, usize)]) -> [usize; 5] {
+        let mut points = vec![Point3::new(0.0, 1.3, 0.0), Point3::new(0.0, 0.9, 0.0)];
+        let mut limbs = Vec::new();
+        let mut lengths = Vec::new();
+        for &(x, y, attach) in leaves {
+            points.push(Point3::new(x, y, 0.0));
+            limbs.push((vec![points.len() - 1], attach));
+            lengths.push((points[points.len() - 1] - points[attach]).norm());
+        }
+        name_limbs(&limbs, &lengths, &points)
+    }
+
+    fn sorted(mut v: [usize; 2]) -> [usize; 2] {
+        v.sort_unstable();
+        v
+    }
+
+    #[test]
+    fn a_hand_stub_at_the_hip_is_not_the_head() {
+        // Head, a raised arm, two legs, and the other hand, which joins the hip in voxels: its
+        // stub leaves the pelvis node and is the shortest limb (the paper's rule names it head).
+        let n = named(&[
+            (0.0, 1.65, 0),
+            (-0.5, 1.7, 0),
+            (0.12, 0.05, 1),
+            (-0.12, 0.05, 1),
+            (0.25, 0.8, 1),
+        ]);
+        assert_eq!(n[0], 0, "head");
+        assert_eq!(sorted([n[1], n[2]]), [1, 4], "arms");
+        assert_eq!(sorted([n[3], n[4]]), [2, 3], "legs");
+    }
+
+    #[test]
+    fn arms_overhead_leave_the_head_and_legs_alone() {
+        // Jumping jacks at the top: both arms up beside the head, legs apart.
+        let n = named(&[
+            (-0.3, 1.95, 0),
+            (0.0, 1.65, 0),
+            (0.3, 1.95, 0),
+            (0.25, 0.05, 1),
+            (-0.25, 0.05, 1),
+        ]);
+        assert_eq!(n[0], 1, "head");
+        assert_eq!(sorted([n[1], n[2]]), [0, 2], "arms");
+        assert_eq!(sorted([n[3], n[4]]), [3, 4], "legs");
+    }
 }
