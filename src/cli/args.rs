@@ -64,6 +64,8 @@ pub enum Command {
     Run(RunArgs),
     /// Second pipeline: point volumes to kinematic motion.
     Volume(VolumeArgs),
+    /// Carve voxel grids from calibrated cameras and silhouette masks, for `volume`.
+    Carve(CarveArgs),
     /// Render a synthetic clip with ground truth.
     Synth(SynthArgs),
     /// Measure decoding and rendering speed and print a table.
@@ -195,6 +197,26 @@ pub struct VolumeArgs {
     pub fps: f64,
 }
 
+/// `carve`.
+#[derive(Debug, Args)]
+#[command(
+    after_help = "Example:\n  videomocap synth --motion wave --frames 30 --fps 15 --volume --views 4 -o out/vol\n  videomocap carve out/vol/carve -o out/carved\n  videomocap volume out/carved --fps 15 --out-dir out/carved-result"
+)]
+pub struct CarveArgs {
+    /// Set-up directory: cameras.json (with bounds_m, the box to carve) and masks/<camera>/
+    /// holding one silhouette per frame (PNG or JPEG; grey level ≥ 128 = person).
+    pub setup: PathBuf,
+    /// Output directory: one .voxels.json grid per frame.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Voxel size, millimetres.
+    #[arg(long, default_value_t = 40.0)]
+    pub voxel_mm: f64,
+    /// Masks that must contain a voxel for it to stay (default: every camera).
+    #[arg(long)]
+    pub min_votes: Option<usize>,
+}
+
 /// `synth`.
 #[derive(Debug, Args)]
 pub struct SynthArgs {
@@ -261,6 +283,11 @@ pub struct SynthArgs {
     /// Share of body voxels removed at random for --volume (holes), 0–1.
     #[arg(long, default_value_t = 0.0)]
     pub holes: f64,
+    /// With --volume, also write a carving set-up in OUTPUT/carve for `videomocap carve`: this
+    /// many cameras (--width × --height) on a ring around the body, cameras.json and each
+    /// camera's silhouette masks.
+    #[arg(long, default_value_t = 0, requires = "volume")]
+    pub views: usize,
     /// Output directory.
     #[arg(short, long)]
     pub output: PathBuf,

@@ -7,6 +7,7 @@ mod bench_lift;
 mod bench_scrub;
 mod bench_track;
 mod bench_volume;
+mod carve;
 mod export;
 mod info;
 mod lift;
@@ -62,6 +63,7 @@ pub fn run(command: Command, global: &GlobalArgs) -> Result<(), ExitError> {
         Command::Export(a) => export::run(&a, global),
         Command::Run(a) => run::run(&a, global),
         Command::Volume(a) => volume::run(&a, global),
+        Command::Carve(a) => carve::run(&a, global),
         Command::StressWrite(a) => stress_write::run(&a),
         Command::Gui { .. } => Err(ExitError::bad_input(anyhow::anyhow!(
             "the desktop app is opened by main, not by the CLI"

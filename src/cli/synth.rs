@@ -8,7 +8,7 @@ use std::sync::atomic::AtomicBool;
 use videomocap::camera::PinholeCamera;
 use videomocap::synth::{
     MotionSource, ProceduralMotion, SensorEffects, SynthError, SynthParams, VideoOutput, View,
-    VoxelParams, load_motion, render_clip, write_volume_sequence,
+    VoxelParams, load_motion, render_clip, write_carving_setup, write_volume_sequence,
 };
 
 /// Horizontal field of view of the synthetic camera when none is given (a phone's main camera
@@ -155,6 +155,24 @@ fn volume(a: &SynthArgs, params: &SynthParams, global: &GlobalArgs) -> Result<()
     })
     .map_err(ExitError::failed)?;
     bar.finish_and_clear();
+    if a.views > 0 {
+        let dir = a.output.join("carve");
+        let bar = progress_bar(global, motion.frames.len() as u64, "silhouettes");
+        write_carving_setup(&motion, &dir, a.views, (a.width, a.height), &|done, _| {
+            bar.set_position(done as u64)
+        })
+        .map_err(ExitError::failed)?;
+        bar.finish_and_clear();
+        say(
+            global,
+            &format!(
+                "wrote a carving set-up of {} cameras to {} (videomocap carve {} -o DIR)",
+                a.views,
+                dir.display(),
+                dir.display()
+            ),
+        );
+    }
     say(
         global,
         &format!(

@@ -143,3 +143,38 @@ pub fn score_volume(truth: &Skeleton3d, result: &Skeleton3d, topology_ok: usize)
     }
     s
 }
+
+/// Carves `motion` from `views` synthetic silhouettes (640×480 cameras around the body, see
+/// [`crate::synth::write_carving_setup`]) at `voxel_m`, runs the volume pipeline on the grids
+/// and scores it against the truth; also returns the mean occupied voxels per frame. Every file
+/// lives in a temporary directory. What the carving test and `bench volume` measure.
+pub fn carve_and_score(
+    motion: &crate::synth::Motion,
+    views: usize,
+    voxel_m: f64,
+    params: &crate::volume::VolumeParams,
+) -> Result<(VolumeScore, f64), crate::volume::SequenceError> {
+    use crate::volume::carve::{carve_sequence, open_setup};
+    use crate::volume::{VolumeError, process_directory};
+    use std::sync::atomic::AtomicBool;
+    let dir = tempfile::tempdir().map_err(|e| VolumeError::Io {
+        path: std::env::temp_dir(),
+        source: e,
+    })?;
+    let (setup_dir, grids) = (dir.path().join("setup"), dir.path().join("grids"));
+    crate::synth::write_carving_setup(motion, &setup_dir, views, (640, 480), &|_, _| {})?;
+    let setup = open_setup(&setup_dir)?;
+    let never = AtomicBool::new(false);
+    let counts = carve_sequence(&setup, voxel_m, None, &grids, &|_, _| {}, &never)?;
+    let p = process_directory(&grids, params, motion.fps, &|_, _| {}, &never)?;
+    let ok = p.results.iter().filter(|r| r.is_ok()).count();
+    let voxels = counts.iter().sum::<usize>() as f64 / counts.len().max(1) as f64;
+    Ok((
+        score_volume(
+            &crate::synth::volume_truth(motion),
+            &p.assembled.skeleton,
+            ok,
+        ),
+        voxels,
+    ))
+}

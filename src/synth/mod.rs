@@ -13,7 +13,10 @@ pub use motion::{
     Motion, ProceduralMotion, from_bvh, normalise_orientation, procedural, stature_of,
 };
 pub use render::{Rendered, SensorEffects, background, render_frame};
-pub use volume::{VoxelParams, truth as volume_truth, voxelise, write_volume_sequence};
+pub use volume::{
+    VoxelParams, ring_cameras, silhouette, truth as volume_truth, voxelise, write_carving_setup,
+    write_volume_sequence,
+};
 
 use crate::bvh::BvhError;
 use crate::camera::PinholeCamera;

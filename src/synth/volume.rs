@@ -9,9 +9,12 @@ use crate::camera::PinholeCamera;
 use crate::formats::{Frame3d, Skeleton3d};
 use crate::skeleton::{Bone, PerJoint};
 use crate::volume::VolumeError;
+use crate::volume::carve::{CalibratedCamera, CamerasFile};
 use crate::volume::cloud::write_ply;
-use nalgebra::{Point3, Vector3};
+use image::GrayImage;
+use nalgebra::{Matrix3, Point3, Vector3};
 use rand::{Rng, SeedableRng};
+use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -102,6 +105,145 @@ pub fn write_volume_sequence(
     }
     truth(motion).save(&dir.join("truth.skeleton3d.json"))?;
     Ok(points_total)
+}
+
+/// Cameras around `centre`, looking down at it at 20° from `distance` metres, their directions
+/// spread evenly over half a turn from straight in front (+Z): a camera opposite another sees
+/// nearly the same silhouette, so half a turn gives the carving the most; `width`×`height`
+/// pixels, 60° horizontal field of view.
+pub fn ring_cameras(
+    views: usize,
+    centre: Point3<f64>,
+    distance: f64,
+    width: u32,
+    height: u32,
+) -> Vec<CalibratedCamera> {
+    let f = f64::from(width) / 2.0 / (30f64.to_radians()).tan();
+    (0..views)
+        .map(|k| {
+            let a = k as f64 * std::f64::consts::PI / views as f64;
+            let e = 20f64.to_radians();
+            let eye =
+                centre + Vector3::new(a.sin() * e.cos(), e.sin(), a.cos() * e.cos()) * distance;
+            let fwd = (centre - eye).normalize();
+            let right = fwd.cross(&Vector3::y()).normalize();
+            let down = fwd.cross(&right);
+            let r = Matrix3::from_rows(&[right.transpose(), down.transpose(), fwd.transpose()]);
+            let t = -(r * eye.coords);
+            CalibratedCamera {
+                name: format!("cam{k}"),
+                width,
+                height,
+                fx: f,
+                fy: f,
+                cx: (f64::from(width) - 1.0) / 2.0,
+                cy: (f64::from(height) - 1.0) / 2.0,
+                rotation: std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)])),
+                translation: [t.x, t.y, t.z],
+            }
+        })
+        .collect()
+}
+
+/// The silhouette of a body given as voxel centres of edge `voxel_m` (non-zero = person): each
+/// centre drawn as a disc as wide as its voxel's projected half-diagonal.
+pub fn silhouette(points: &[Point3<f64>], voxel_m: f64, cam: &CalibratedCamera) -> GrayImage {
+    let mut img = GrayImage::new(cam.width, cam.height);
+    let r = Matrix3::from_fn(|i, j| cam.rotation[i][j]);
+    let t = Vector3::from(cam.translation);
+    for p in points {
+        let z = (r * p.coords + t).z;
+        let Some((u, v)) = cam.project(p) else {
+            continue;
+        };
+        let rad = (cam.fx * 0.87 * voxel_m / z).max(0.5);
+        let (x0, x1) = ((u - rad).floor().max(0.0), (u + rad).ceil());
+        let (y0, y1) = ((v - rad).floor().max(0.0), (v + rad).ceil());
+        let mut y = y0;
+        while y <= y1 && y < f64::from(cam.height) {
+            let mut x = x0;
+            while x <= x1 && x < f64::from(cam.width) {
+                if (x - u).hypot(y - v) <= rad {
+                    img.put_pixel(x as u32, y as u32, image::Luma([255]));
+                }
+                x += 1.0;
+            }
+            y += 1.0;
+        }
+    }
+    img
+}
+
+/// Writes a carving set-up of `motion` into `dir` for `videomocap carve`: `views` cameras of
+/// `width`×`height` pixels on a ring around the space the body moves in (see [`ring_cameras`]),
+/// `cameras.json` with that box, and `masks/<camera>/frame_NNNN.png`, the body's silhouettes
+/// (from 10 mm voxels), frames in parallel; `progress(done, total)` after each frame.
+pub fn write_carving_setup(
+    motion: &Motion,
+    dir: &Path,
+    views: usize,
+    (width, height): (u32, u32),
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<(), VolumeError> {
+    let stature = stature_of(motion);
+    let (mut lo, mut hi) = (
+        Point3::from(Vector3::repeat(f64::MAX)),
+        Point3::from(Vector3::repeat(f64::MIN)),
+    );
+    for j in &motion.frames {
+        let (a, b) = Body::new(j, stature).bounds();
+        lo = lo.inf(&a);
+        hi = hi.sup(&b);
+    }
+    let margin = Vector3::repeat(0.2);
+    let (lo, hi) = (lo - margin, hi + margin);
+    let centre = nalgebra::center(&lo, &hi);
+    // Far enough that the box's bounding sphere fills at most 90 % of the shorter image side.
+    let radius = (hi - lo).norm() / 2.0;
+    let half_fov =
+        (f64::from(height.min(width)) / f64::from(width) * 30f64.to_radians().tan()).atan();
+    let distance = radius / (0.9 * half_fov).sin();
+    let cameras = ring_cameras(views, centre, distance, width, height);
+    let io = |path: &Path| {
+        let path = path.to_owned();
+        move |e: std::io::Error| VolumeError::Io { path, source: e }
+    };
+    for c in &cameras {
+        let d = dir.join("masks").join(&c.name);
+        std::fs::create_dir_all(&d).map_err(io(&d))?;
+    }
+    CamerasFile::new(cameras.clone(), Some([lo.coords.into(), hi.coords.into()]))
+        .save(&dir.join("cameras.json"))?;
+    let fine = VoxelParams {
+        voxel_m: 0.01,
+        ..VoxelParams::default()
+    };
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    motion
+        .frames
+        .par_iter()
+        .enumerate()
+        .try_for_each(|(i, joints)| {
+            // No noise or holes: the generator is never drawn from.
+            let mut rng = rand::rngs::StdRng::seed_from_u64(fine.seed);
+            let pts = voxelise(joints, stature, &fine, &mut rng);
+            for c in &cameras {
+                let path = dir
+                    .join("masks")
+                    .join(&c.name)
+                    .join(format!("frame_{i:04}.png"));
+                silhouette(&pts, fine.voxel_m, c).save(&path).map_err(|e| {
+                    VolumeError::Invalid {
+                        path: path.clone(),
+                        problem: format!("cannot write the mask: {e}"),
+                    }
+                })?;
+            }
+            let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            progress(n, motion.frames.len());
+            Ok::<(), VolumeError>(())
+        })?;
+    Ok(())
 }
 
 /// The motion's joints as a skeleton3d (world frame; the camera is nominal).

@@ -1,7 +1,8 @@
 //! Voxel carving (paper §2, after Penny et al.): calibrated cameras and one silhouette mask per
 //! camera; each voxel's pixel in every camera is looked up once (the paper's lookup table), a
 //! voxel is kept when enough silhouettes contain it, and only the largest connected component
-//! survives (§5's clean-up).
+//! survives (§5's clean-up). A carving set-up on disk is a directory holding `cameras.json`
+//! (with the box to carve) and `masks/<camera name>/`, one mask image per frame.
 
 use super::VolumeError;
 use super::voxel::VoxelGrid;
@@ -9,7 +10,7 @@ use crate::formats::{check_header, parse_json, read_text};
 use image::GrayImage;
 use nalgebra::{Matrix3, Point3, Vector3};
 use serde::{Deserialize, Serialize};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The `format` tag of camera calibration files.
 pub const CAMERAS_FORMAT: &str = "videomocap.cameras";
@@ -47,17 +48,45 @@ impl CalibratedCamera {
     }
 }
 
-#[derive(Serialize, Deserialize)]
-struct CamerasFile {
+/// A `cameras.json` file: the cameras and, for carving, the box the person moves in.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CamerasFile {
+    /// Always [`CAMERAS_FORMAT`] when written.
     #[serde(default)]
-    format: Option<String>,
+    pub format: Option<String>,
+    /// Format version (1).
     #[serde(default)]
-    version: Option<u32>,
-    cameras: Vec<CalibratedCamera>,
+    pub version: Option<u32>,
+    /// The calibrated cameras.
+    pub cameras: Vec<CalibratedCamera>,
+    /// The box to carve: its lowest and highest corners, world metres (needed by `carve`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bounds_m: Option<[[f64; 3]; 2]>,
+}
+
+impl CamerasFile {
+    /// A file of the current format and version.
+    pub fn new(cameras: Vec<CalibratedCamera>, bounds_m: Option<[[f64; 3]; 2]>) -> CamerasFile {
+        CamerasFile {
+            format: Some(CAMERAS_FORMAT.to_owned()),
+            version: Some(1),
+            cameras,
+            bounds_m,
+        }
+    }
+
+    /// Writes the file atomically.
+    pub fn save(&self, path: &Path) -> Result<(), VolumeError> {
+        let text = serde_json::to_string_pretty(self).map_err(|e| VolumeError::Invalid {
+            path: path.to_owned(),
+            problem: e.to_string(),
+        })?;
+        Ok(crate::formats::write_atomically(path, text.as_bytes())?)
+    }
 }
 
 /// Reads and checks a `cameras.json` file.
-pub fn load_cameras(path: &Path) -> Result<Vec<CalibratedCamera>, VolumeError> {
+pub fn load_cameras(path: &Path) -> Result<CamerasFile, VolumeError> {
     let raw: CamerasFile = parse_json(&read_text(path)?, path)?;
     check_header(path, CAMERAS_FORMAT, raw.format.as_deref(), raw.version)?;
     let invalid = |problem: String| VolumeError::Invalid {
@@ -80,7 +109,146 @@ pub fn load_cameras(path: &Path) -> Result<Vec<CalibratedCamera>, VolumeError> {
             )));
         }
     }
-    Ok(raw.cameras)
+    if let Some([lo, hi]) = raw.bounds_m
+        && !(lo.iter().chain(&hi).all(|v| v.is_finite()) && (0..3).all(|k| lo[k] < hi[k]))
+    {
+        return Err(invalid(
+            "bounds_m must be [[lowest x, y, z], [highest x, y, z]], finite, lowest < highest"
+                .into(),
+        ));
+    }
+    Ok(raw)
+}
+
+/// A mask pixel at or above this grey level is the person (JPEG masks blur their edges).
+const MASK_ON: u8 = 128;
+
+/// The most voxels a carving grid may have (as in `.voxels.json`).
+const MAX_VOXELS: usize = 1 << 28;
+
+/// A carving set-up read from disk: cameras, the box, and each frame's mask files.
+#[derive(Debug, Clone)]
+pub struct CarvingSetup {
+    /// The `cameras.json` it was read from (named in errors).
+    pub cameras_path: PathBuf,
+    /// The cameras, in `cameras.json` order.
+    pub cameras: Vec<CalibratedCamera>,
+    /// The box to carve (lowest, highest corner).
+    pub bounds: [Point3<f64>; 2],
+    /// Per frame, one mask file per camera (same order as `cameras`).
+    pub frames: Vec<Vec<PathBuf>>,
+}
+
+/// Mask images: what `image` reads without loss of the silhouette.
+fn is_mask(p: &Path) -> bool {
+    p.extension().and_then(|e| e.to_str()).is_some_and(|e| {
+        ["png", "bmp", "pgm", "tif", "tiff"].contains(&e.to_ascii_lowercase().as_str())
+    })
+}
+
+/// Reads a carving set-up: `dir/cameras.json` (with `bounds_m`) and `dir/masks/<name>/` per
+/// camera, the same number of masks in each (natural name order: frame k is the k-th file).
+pub fn open_setup(dir: &Path) -> Result<CarvingSetup, VolumeError> {
+    let cameras_path = dir.join("cameras.json");
+    let file = load_cameras(&cameras_path)?;
+    let [lo, hi] = file.bounds_m.ok_or_else(|| VolumeError::Invalid {
+        path: cameras_path.clone(),
+        problem: "no bounds_m: carving needs the box to carve, \"bounds_m\": [[x0, y0, z0], [x1, y1, z1]] (metres)".into(),
+    })?;
+    let mut per_camera: Vec<Vec<PathBuf>> = Vec::new();
+    for cam in &file.cameras {
+        let d = dir.join("masks").join(&cam.name);
+        let entries = std::fs::read_dir(&d).map_err(|e| VolumeError::Io {
+            path: d.clone(),
+            source: e,
+        })?;
+        let mut files: Vec<PathBuf> = entries
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.is_file() && is_mask(p))
+            .collect();
+        files.sort_by(|a, b| natord::compare(&a.to_string_lossy(), &b.to_string_lossy()));
+        if files.is_empty() {
+            return Err(VolumeError::Invalid {
+                path: d,
+                problem: "no mask images here (PNG or JPEG; grey level ≥ 128 = person)".into(),
+            });
+        }
+        if let Some(first) = per_camera.first()
+            && first.len() != files.len()
+        {
+            return Err(VolumeError::Invalid {
+                path: d,
+                problem: format!(
+                    "{} masks, but camera \"{}\" has {}: every camera needs one per frame",
+                    files.len(),
+                    file.cameras[0].name,
+                    first.len()
+                ),
+            });
+        }
+        per_camera.push(files);
+    }
+    let frames = (0..per_camera.first().map_or(0, Vec::len))
+        .map(|k| per_camera.iter().map(|f| f[k].clone()).collect())
+        .collect();
+    Ok(CarvingSetup {
+        cameras_path,
+        cameras: file.cameras,
+        bounds: [Point3::from(lo), Point3::from(hi)],
+        frames,
+    })
+}
+
+impl CarvingSetup {
+    /// The empty grid covering the box at `voxel_m`; refused when it would exceed 2^28 voxels.
+    pub fn grid(&self, voxel_m: f64) -> Result<VoxelGrid, VolumeError> {
+        let [lo, hi] = self.bounds;
+        let n = |k: usize| ((hi[k] - lo[k]) / voxel_m).ceil().max(1.0);
+        let dims = [n(0), n(1), n(2)];
+        if voxel_m.is_nan() || voxel_m <= 0.0 || dims.iter().product::<f64>() > MAX_VOXELS as f64 {
+            return Err(VolumeError::Invalid {
+                path: self.cameras_path.clone(),
+                problem: format!(
+                    "a {:.0} mm grid over bounds_m would have {:.0} voxels (at most {MAX_VOXELS})",
+                    voxel_m * 1000.0,
+                    dims.iter().product::<f64>()
+                ),
+            });
+        }
+        let origin = lo + Vector3::repeat(voxel_m / 2.0);
+        Ok(VoxelGrid::new(origin, voxel_m, dims.map(|d| d as usize)))
+    }
+
+    /// Frame `k`'s masks, one per camera; a mask that cannot be read or is not its camera's
+    /// size is an error naming it.
+    pub fn read_masks(&self, k: usize) -> Result<Vec<GrayImage>, VolumeError> {
+        self.frames[k]
+            .iter()
+            .zip(&self.cameras)
+            .map(|(path, cam)| {
+                let img = image::open(path)
+                    .map_err(|e| VolumeError::Invalid {
+                        path: path.clone(),
+                        problem: format!("cannot read the mask: {e}"),
+                    })?
+                    .into_luma8();
+                if img.dimensions() != (cam.width, cam.height) {
+                    return Err(VolumeError::Invalid {
+                        path: path.clone(),
+                        problem: format!(
+                            "the mask is {}×{}, camera \"{}\" is {}×{}",
+                            img.width(),
+                            img.height(),
+                            cam.name,
+                            cam.width,
+                            cam.height
+                        ),
+                    });
+                }
+                Ok(img)
+            })
+            .collect()
+    }
 }
 
 /// A carving set-up: the grid and, per camera, the pixel each voxel centre falls on.
@@ -126,7 +294,7 @@ impl Carver {
     }
 
     /// Carves one frame: a voxel is occupied when at least `min_votes` masks (one per camera,
-    /// same order, non-zero = person) contain its centre; then the largest component is kept.
+    /// same order, grey level ≥ 128 = person) contain its centre; then the largest component is kept.
     pub fn carve(&self, masks: &[GrayImage], min_votes: usize) -> VoxelGrid {
         let mut grid = self.template.clone();
         for (i, o) in grid.occupied.iter_mut().enumerate() {
@@ -141,7 +309,7 @@ impl Carver {
                         && mask.width() == **w
                         && mask
                             .get_pixel_checked(px % **w, px / **w)
-                            .is_some_and(|p| p[0] > 0)
+                            .is_some_and(|p| p[0] >= MASK_ON)
                 })
                 .count();
             *o = votes >= min_votes;
@@ -149,6 +317,58 @@ impl Carver {
         grid.keep_largest_component();
         grid
     }
+}
+
+/// Carves every frame of `setup` at `voxel_m` (a voxel stays when `min_votes` masks contain it;
+/// `None` = all cameras) into `out_dir/<first camera's mask name>.voxels.json`, frames in
+/// parallel, calling `progress(done, total)`; returns each frame's occupied voxel count. Stops
+/// at the first unreadable or wrongly sized mask, naming it; `cancel` stops between frames.
+pub fn carve_sequence(
+    setup: &CarvingSetup,
+    voxel_m: f64,
+    min_votes: Option<usize>,
+    out_dir: &Path,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    cancel: &std::sync::atomic::AtomicBool,
+) -> Result<Vec<usize>, VolumeError> {
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let cameras = setup.cameras.len();
+    let votes = min_votes.unwrap_or(cameras);
+    if votes == 0 || votes > cameras {
+        return Err(VolumeError::Invalid {
+            path: setup.cameras_path.clone(),
+            problem: format!(
+                "the vote threshold must be 1 to {cameras} (one per camera), got {votes}"
+            ),
+        });
+    }
+    let carver = Carver::new(setup.grid(voxel_m)?, &setup.cameras);
+    std::fs::create_dir_all(out_dir).map_err(|e| VolumeError::Io {
+        path: out_dir.to_owned(),
+        source: e,
+    })?;
+    let done = AtomicUsize::new(0);
+    let total = setup.frames.len();
+    (0..total)
+        .into_par_iter()
+        .map(|k| {
+            if cancel.load(Ordering::Relaxed) {
+                return Err(VolumeError::Invalid {
+                    path: out_dir.to_owned(),
+                    problem: "cancelled".into(),
+                });
+            }
+            let grid = carver.carve(&setup.read_masks(k)?, votes);
+            let stem = setup.frames[k][0].file_stem().map_or_else(
+                || format!("frame_{k:04}"),
+                |s| s.to_string_lossy().into_owned(),
+            );
+            grid.save(&out_dir.join(format!("{stem}.voxels.json")))?;
+            progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+            Ok(grid.count())
+        })
+        .collect()
 }
 
 #[cfg(test)]

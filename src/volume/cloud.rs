@@ -53,10 +53,15 @@ pub fn list_frames(dir: &Path) -> Result<Vec<PathBuf>, VolumeError> {
         .collect();
     files.sort_by(|a, b| natord::compare(&a.to_string_lossy(), &b.to_string_lossy()));
     if files.is_empty() {
+        let problem = if dir.join("cameras.json").is_file() {
+            "no point clouds here, but cameras.json: carve this set-up first \
+             (videomocap carve DIR -o GRIDS), then open GRIDS"
+        } else {
+            "no point clouds here (expected .ply, .xyz, .txt or .voxels.json files)"
+        };
         return Err(VolumeError::Invalid {
             path: dir.to_owned(),
-            problem: "no point clouds here (expected .ply, .xyz, .txt or .voxels.json files)"
-                .into(),
+            problem: problem.into(),
         });
     }
     Ok(files)
