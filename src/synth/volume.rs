@@ -125,22 +125,7 @@ pub fn ring_cameras(
             let e = 20f64.to_radians();
             let eye =
                 centre + Vector3::new(a.sin() * e.cos(), e.sin(), a.cos() * e.cos()) * distance;
-            let fwd = (centre - eye).normalize();
-            let right = fwd.cross(&Vector3::y()).normalize();
-            let down = fwd.cross(&right);
-            let r = Matrix3::from_rows(&[right.transpose(), down.transpose(), fwd.transpose()]);
-            let t = -(r * eye.coords);
-            CalibratedCamera {
-                name: format!("cam{k}"),
-                width,
-                height,
-                fx: f,
-                fy: f,
-                cx: (f64::from(width) - 1.0) / 2.0,
-                cy: (f64::from(height) - 1.0) / 2.0,
-                rotation: std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)])),
-                translation: [t.x, t.y, t.z],
-            }
+            CalibratedCamera::look_at(format!("cam{k}"), eye, centre, (width, height), f)
         })
         .collect()
 }

@@ -40,6 +40,33 @@ pub struct CalibratedCamera {
 }
 
 impl CalibratedCamera {
+    /// A camera at `eye` looking at `target` with the world's +Y up in its image (Y-up world),
+    /// `focal_px` on both axes, the principal point at the image centre.
+    pub fn look_at(
+        name: String,
+        eye: Point3<f64>,
+        target: Point3<f64>,
+        (width, height): (u32, u32),
+        focal_px: f64,
+    ) -> CalibratedCamera {
+        let fwd = (target - eye).normalize();
+        let right = fwd.cross(&Vector3::y()).normalize();
+        let down = fwd.cross(&right);
+        let r = Matrix3::from_rows(&[right.transpose(), down.transpose(), fwd.transpose()]);
+        let t = -(r * eye.coords);
+        CalibratedCamera {
+            name,
+            width,
+            height,
+            fx: focal_px,
+            fy: focal_px,
+            cx: (f64::from(width) - 1.0) / 2.0,
+            cy: (f64::from(height) - 1.0) / 2.0,
+            rotation: std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)])),
+            translation: [t.x, t.y, t.z],
+        }
+    }
+
     /// The pixel (x right, y down) a world point projects to, if in front of the camera.
     pub fn project(&self, p: &Point3<f64>) -> Option<(f64, f64)> {
         let r = Matrix3::from_fn(|i, j| self.rotation[i][j]);
@@ -377,6 +404,8 @@ mod tests {
 
     /// A 30 cm ball seen by four cameras around it: carving gives the ball (its visual hull),
     /// a little fatter than the ball but never missing any of it.
+    use std::f64::consts::FRAC_1_SQRT_2;
+
     #[test]
     fn four_views_carve_a_ball() {
         let centre = Point3::new(0.0, 1.0, 0.0);
@@ -385,29 +414,11 @@ mod tests {
             .map(|k| {
                 let a = k as f64 * std::f64::consts::FRAC_PI_2;
                 let eye = Point3::new(3.0 * a.sin(), 1.0, 3.0 * a.cos());
-                let fwd = (centre - eye).normalize();
-                let right = fwd.cross(&Vector3::y()).normalize();
-                let down = fwd.cross(&right);
-                let r = Matrix3::from_rows(&[right.transpose(), down.transpose(), fwd.transpose()]);
-                let t = -(r * eye.coords);
-                CalibratedCamera {
-                    name: format!("c{k}"),
-                    width: 200,
-                    height: 200,
-                    fx: 300.0,
-                    fy: 300.0,
-                    cx: 100.0,
-                    cy: 100.0,
-                    rotation: [
-                        [r[(0, 0)], r[(0, 1)], r[(0, 2)]],
-                        [r[(1, 0)], r[(1, 1)], r[(1, 2)]],
-                        [r[(2, 0)], r[(2, 1)], r[(2, 2)]],
-                    ],
-                    translation: [t.x, t.y, t.z],
-                }
+                CalibratedCamera::look_at(format!("c{k}"), eye, centre, (200, 200), 300.0)
             })
             .collect();
-        // Silhouettes: pixels whose ray passes within `radius` of the centre.
+        // Silhouettes: pixels whose square touches the ball's disc (the carver looks up the
+        // pixel a voxel centre rounds to, so a pixel counts when any of it is inside).
         let masks: Vec<GrayImage> = cams
             .iter()
             .map(|c| {
@@ -415,7 +426,8 @@ mod tests {
                 let dist = 3.0;
                 let r_px = c.fx * radius / (dist * dist - radius * radius).sqrt();
                 GrayImage::from_fn(c.width, c.height, |x, y| {
-                    let inside = (f64::from(x) - cu).hypot(f64::from(y) - cv) <= r_px;
+                    let inside =
+                        (f64::from(x) - cu).hypot(f64::from(y) - cv) <= r_px + FRAC_1_SQRT_2;
                     image::Luma([if inside { 255 } else { 0 }])
                 })
             })
