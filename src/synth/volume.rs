@@ -130,7 +130,7 @@ pub fn ring_cameras(
         .collect()
 }
 
-/// The silhouette of a body given as voxel centres of edge `voxel_m` (non-zero = person): each
+/// The silhouette of a body given as voxel centres of edge `voxel_m` (255 = person): each
 /// centre drawn as a disc as wide as its voxel's projected half-diagonal.
 pub fn silhouette(points: &[Point3<f64>], voxel_m: f64, cam: &CalibratedCamera) -> GrayImage {
     let mut img = GrayImage::new(cam.width, cam.height);

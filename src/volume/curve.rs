@@ -257,7 +257,8 @@ pub fn head_tip_guess(tree: &ShellTree, input: &[Point3<f64>]) -> Option<Point3<
 }
 
 /// Names the five limbs, given as (curve points outwards, the point they leave from) with their
-/// lengths along the curve: the indices of the head, the two arms and the two legs.
+/// lengths along the curve: the indices of the head, the two arms and the two legs. Invariant:
+/// exactly five limbs, each with at least one curve point (`skeleton_curve` checks the count).
 ///
 /// §4: the shortest branch is the head and the two nearest it the arms. Beyond the paper, when
 /// the limbs leave two branch nodes, geometry tells the chest from the pelvis: a limb's reach is
