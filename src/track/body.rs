@@ -52,8 +52,11 @@ struct Part {
     /// The colour model.
     template: Template,
     reliability: f32,
-    /// Longest plausible image length of the bone, pixels (proportions × marked stature).
+    /// Longest plausible image length of the bone, pixels: `marked_max_len` times the head's
+    /// zoom since the marking (never below 1).
     max_len: f64,
+    /// The same on the marked frame (proportions × marked stature).
+    marked_max_len: f64,
     /// How far along its bone the part is sampled.
     extent: Extent,
 }
@@ -130,6 +133,8 @@ pub struct BodyTracker {
     /// Chest, shoulders and hips in the trunk block's (u, v) coordinates.
     trunk_points: [(f64, f64); 5],
     predictor: HeadPredictor,
+    /// The head block's length on the marked frame, pixels.
+    marked_head_m: f64,
     /// The head's displacement over the last frame, pixels.
     head_velocity: nalgebra::Vector2<f64>,
     prev_image: Arc<RgbImage>,
@@ -170,6 +175,7 @@ impl BodyTracker {
                 template: Template::sample(frame, &block, extent(kind), w),
                 reliability: 1.0,
                 max_len: (1.2 * fraction * stature).max(block.m * 1.05),
+                marked_max_len: (1.2 * fraction * stature).max(block.m * 1.05),
                 extent: extent(kind),
             }
         };
@@ -182,6 +188,7 @@ impl BodyTracker {
             ),
             BodyPart::Head,
         );
+        let pose_head_m = head.block.m;
         let trunk_block = MorphBlock::along(
             pose[Joint::Neck],
             pose[Joint::Pelvis],
@@ -215,6 +222,7 @@ impl BodyTracker {
             limbs,
             trunk_points,
             predictor: HeadPredictor::default(),
+            marked_head_m: pose_head_m,
             head_velocity: nalgebra::Vector2::zeros(),
             prev_image: image,
         }
@@ -314,6 +322,15 @@ impl BodyTracker {
         self.predictor.adapt(motion.displacement, moved);
         self.head_velocity = moved;
         accept(&mut self.head, found, frame, &p);
+
+        // Beyond the paper: a person walking towards the camera grows in the image. The head
+        // block zooms with them (the spiral searches its length), so every bone's length limit
+        // grows by the head's zoom since the marking; without this the trunk and limbs stop at
+        // their marked-size limits and the hips and feet are left behind.
+        let zoom = (self.head.block.m / self.marked_head_m.max(1e-9)).max(1.0);
+        for part in std::iter::once(&mut self.trunk).chain(self.limbs.iter_mut().flatten()) {
+            part.max_len = part.marked_max_len * zoom;
+        }
 
         // Trunk, anchored at the neck.
         let neck = self.head.block.end();
