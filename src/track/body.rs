@@ -2,7 +2,9 @@
 //! prediction + spiral search), then the trunk anchored at the tracked neck, then each limb
 //! chain shoulder→elbow→wrist and hip→knee→ankle, every child block anchored at its tracked
 //! parent joint and its search centred on a motion prediction (the bone's angular velocity
-//! relative to its parent). The four limb chains are independent and run in parallel.
+//! relative to its parent). The four limb chains are independent and run in parallel. Beyond
+//! the paper, a patch around the hips holds the pelvis when the spine bends
+//! (`BodyTracker::hips_hold`), and the bones' length limits follow the head's zoom.
 //!
 //! Works in one image scale (the caller converts to and from video pixels).
 
@@ -130,6 +132,8 @@ pub struct BodyTracker {
     trunk: Part,
     /// Per chain: the upper and lower part.
     limbs: [[Part; 2]; 4],
+    /// The hip patch: a block centred on the pelvis (see `BodyTracker::hips_hold`).
+    hips: Part,
     /// Chest, shoulders and hips in the trunk block's (u, v) coordinates.
     trunk_points: [(f64, f64); 5],
     predictor: HeadPredictor,
@@ -195,6 +199,23 @@ impl BodyTracker {
             width(BodyPart::Trunk),
         );
         let trunk = part(trunk_block, BodyPart::Trunk);
+        let hips = {
+            let block = hip_patch(
+                pose[Joint::Pelvis],
+                trunk_block.theta,
+                trunk_block.m,
+                trunk_block.n,
+            );
+            Part {
+                block,
+                prev_theta: block.theta,
+                template: Template::sample(frame, &block, Extent::BLOCK, w),
+                reliability: 1.0,
+                max_len: block.m,
+                marked_max_len: block.m,
+                extent: Extent::BLOCK,
+            }
+        };
         let trunk_points = TRUNK_JOINTS.map(|j| trunk_block.to_block(pose[j]));
         let limb_parts = [
             [BodyPart::LeftUpperArm, BodyPart::LeftForearm],
@@ -219,6 +240,7 @@ impl BodyTracker {
             params,
             head,
             trunk,
+            hips,
             limbs,
             trunk_points,
             predictor: HeadPredictor::default(),
@@ -350,6 +372,9 @@ impl BodyTracker {
             &prior(&self.trunk, &trunk_pred, &p),
         );
         accept(&mut self.trunk, found, frame, &p);
+        if p.hip_patch {
+            self.hips_hold(frame, neck, &p);
+        }
         let pose_now = self.pose();
 
         // Limbs, each chain from its root joint on the trunk; chains in parallel.
@@ -372,6 +397,70 @@ impl BodyTracker {
         }
         self.prev_image = image;
         self.pose()
+    }
+}
+
+/// The hip patch around `pelvis`: as wide as the trunk, reaching 0.3 of the trunk's length above
+/// and below the pelvis along the trunk's angle `theta`.
+fn hip_patch(pelvis: Point2<f64>, theta: f64, trunk_m: f64, trunk_n: f64) -> MorphBlock {
+    let half = 0.3 * trunk_m;
+    let dir = nalgebra::Vector2::new(theta.cos(), theta.sin());
+    MorphBlock {
+        origin: pelvis - dir * half,
+        m: 2.0 * half,
+        n: trunk_n,
+        theta,
+    }
+}
+
+impl BodyTracker {
+    /// Beyond the paper: the trunk is one rigid block hung from the neck, so when the spine
+    /// bends (a bow, a reach) the block keeps its angle and the pelvis swings away with the
+    /// neck, while the hips in fact stay. The hip patch, sampled on the key frame, is searched
+    /// by the head's spiral from where it was; when it matches clearly better there than where
+    /// the trunk put the pelvis, the trunk is re-hung from the neck to the patch's centre.
+    fn hips_hold(&mut self, frame: FrameView, neck: Point2<f64>, p: &TrackerParams) {
+        let t = self.trunk.block;
+        let at_trunk = hip_patch(t.end(), t.theta, t.m, t.n);
+        let c_trunk = self
+            .hips
+            .template
+            .cost(frame, &at_trunk, false, f32::INFINITY);
+        let found = spiral(
+            &self.hips.template,
+            frame,
+            &self.hips.block,
+            &SpiralParams {
+                step_px: p.head_step_px,
+                d_theta: p.head_d_theta_deg.to_radians(),
+                d_m: 0.0,
+                max_rings: p.head_max_rings,
+            },
+        );
+        let centre = found.block.to_image(0.5, 0.0);
+        let len = (centre - neck).norm();
+        if found.cost + p.hip_margin < c_trunk && len > 0.5 * t.m && len <= self.trunk.max_len {
+            let block = MorphBlock::along(neck, centre, t.n);
+            let cost = self
+                .trunk
+                .template
+                .cost(frame, &block, false, f32::INFINITY);
+            // The trunk was accepted this frame already: keep its angle history.
+            let prev = self.trunk.prev_theta;
+            accept(&mut self.trunk, Found { block, cost }, frame, p);
+            self.trunk.prev_theta = prev;
+            accept(&mut self.hips, found, frame, p);
+        } else {
+            accept(
+                &mut self.hips,
+                Found {
+                    block: at_trunk,
+                    cost: c_trunk,
+                },
+                frame,
+                p,
+            );
+        }
     }
 }
 

@@ -63,6 +63,12 @@ pub struct TrackerParams {
     pub block_width_scale: f64,
     /// Track the four limb chains in parallel.
     pub parallel: bool,
+    /// Track a patch around the hips and re-hang the trunk from the neck to it when it matches
+    /// clearly better than where the rigid trunk put the pelvis (a bending spine). Default true.
+    pub hip_patch: bool,
+    /// How much lower (8-bit levels) the hip patch's cost must be for the trunk to follow it.
+    /// Default 3.
+    pub hip_margin: f32,
 }
 
 impl Default for TrackerParams {
@@ -90,6 +96,8 @@ impl Default for TrackerParams {
             decoder_scaling: true,
             block_width_scale: 1.0,
             parallel: true,
+            hip_patch: true,
+            hip_margin: 3.0,
         }
     }
 }
