@@ -93,23 +93,28 @@ pub struct SpiralParams {
 }
 
 /// The morph variants tried at each point of the spiral: {θ−Δθ, θ, θ+Δθ} × {m−Δm, m, m+Δm},
-/// n scaled with m (the head zooms as a whole).
-fn variants(b: &MorphBlock, p: &SpiralParams) -> [MorphBlock; 9] {
-    let mut out = [*b; 9];
-    let mut k = 0;
-    for dt in [0.0, -p.d_theta, p.d_theta] {
-        for dm in [0.0, -p.d_m, p.d_m] {
-            let s = 1.0 + dm;
-            out[k] = MorphBlock {
-                m: b.m * s,
-                n: b.n * s,
-                theta: b.theta + dt,
-                ..*b
-            };
-            k += 1;
-        }
-    }
-    out
+/// n scaled with m (the head zooms as a whole); with Δm = 0 only the three angles.
+fn variants(b: &MorphBlock, p: &SpiralParams) -> impl Iterator<Item = MorphBlock> {
+    let b = *b;
+    let scales: &[f64] = if p.d_m == 0.0 {
+        &[0.0]
+    } else {
+        &[0.0, -1.0, 1.0]
+    };
+    let d_m = p.d_m;
+    [0.0, -p.d_theta, p.d_theta]
+        .into_iter()
+        .flat_map(move |dt| {
+            scales.iter().map(move |k| {
+                let s = 1.0 + k * d_m;
+                MorphBlock {
+                    m: b.m * s,
+                    n: b.n * s,
+                    theta: b.theta + dt,
+                    ..b
+                }
+            })
+        })
 }
 
 /// The spiral search of Fig. 6 around `predicted` (origin, m, n, θ): ring by ring outwards,
