@@ -533,7 +533,7 @@ fn track_limb(
 ) {
     let mut parent = trunk_angles;
     let mut anchor = root;
-    for part in parts.iter_mut() {
+    for (k, part) in parts.iter_mut().enumerate() {
         let before = (part.block.theta, part.prev_theta);
         let pred = predict_anchored(part, anchor, Some(parent), p.velocity_damping);
         let narrow = AngularParams {
@@ -556,6 +556,13 @@ fn track_limb(
         } else {
             narrow
         };
+        // Beyond the paper: a forearm or shank never folds back onto its upper segment (elbows
+        // and knees flex to about 150°; seen from the side, the image angle is the true one).
+        // A lower segment found folded further than `fold_limit_deg` is a lock on the wrong
+        // thing (the other leg, the floor); it is held like a joint off the image.
+        let folded = |b: &MorphBlock| {
+            k == 1 && wrap_angle(b.theta - parent[0]).abs() > p.fold_limit_deg.to_radians()
+        };
         let mut found = angular(&part.template, frame, &pred, &narrow, &prior);
         let weak = reliability(found.cost, p.reliability_c0) < p.weak_reliability;
         if weak && predicted_off {
@@ -569,16 +576,24 @@ fn track_limb(
             anchor = part.block.end();
             continue;
         }
-        if weak {
+        if weak || folded(&found.block) {
             let wide = AngularParams {
                 range_theta: p.wide_range_deg.to_radians(),
                 step_theta: 2.0 * p.coarse_step_deg.to_radians(),
                 ..narrow
             };
             let again = angular(&part.template, frame, &pred, &wide, &prior);
-            if again.cost < found.cost {
+            if again.cost < found.cost && !folded(&again.block) || folded(&found.block) {
                 found = again;
             }
+        }
+        if folded(&found.block) {
+            part.prev_theta = part.block.theta;
+            part.block = predict_anchored(part, anchor, Some(parent), 0.0);
+            part.reliability = 0.0;
+            parent = [part.block.theta, before.0, before.1];
+            anchor = part.block.end();
+            continue;
         }
         accept(part, found, frame, p);
         parent = [part.block.theta, before.0, before.1];

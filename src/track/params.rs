@@ -69,6 +69,10 @@ pub struct TrackerParams {
     /// How much lower (8-bit levels) the hip patch's cost must be for the trunk to follow it.
     /// Default 3.
     pub hip_margin: f32,
+    /// A forearm or shank turned further than this from its upper segment's direction in the
+    /// image (degrees) is folded back onto it, which elbows and knees cannot do: the match is
+    /// refused and the joint held. Default 165 (180 turns the check off).
+    pub fold_limit_deg: f64,
 }
 
 impl Default for TrackerParams {
@@ -98,6 +102,7 @@ impl Default for TrackerParams {
             parallel: true,
             hip_patch: true,
             hip_margin: 3.0,
+            fold_limit_deg: 165.0,
         }
     }
 }
