@@ -4,7 +4,7 @@
 use assert_cmd::Command;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
-use videomocap::eval::score_tracks;
+use videomocap::eval::{ClipScore, score_tracks};
 use videomocap::formats::{Marks, PointSource, Tracks2d};
 use videomocap::skeleton::Joint;
 use videomocap::synth::{
@@ -30,6 +30,17 @@ fn render(dir: &Path, motion: ProceduralMotion, frames: usize, view: View) {
 
 fn job(marks: &Marks, threads: usize) -> TrackJob {
     TrackJob::from_marks(marks, TrackerParams::default(), threads)
+}
+
+/// Tracks the clip rendered into `dir` (PNG frames) from its marks with `params`, two threads,
+/// and scores it against the clip's truth.
+fn track_rendered(dir: &Path, params: TrackerParams) -> ClipScore {
+    let gt = GroundTruth::load(&dir.join("gt.json")).unwrap();
+    let marks = Marks::load(&dir.join("marks.json")).unwrap();
+    let mut video = Video::open(&dir.join("frames"), &OpenOptions::default()).unwrap();
+    let job = TrackJob::from_marks(&marks, params, 2);
+    let out = track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false)).unwrap();
+    score_tracks(&gt, &out.tracks).unwrap()
 }
 
 #[test]
@@ -242,16 +253,7 @@ fn a_person_walking_towards_the_camera_is_followed_as_they_grow() {
         (a[0] - b[0]).hypot(a[1] - b[1])
     };
     let growth = stature(119) / stature(0);
-    let marks = Marks::load(&dir.path().join("marks.json")).unwrap();
-    let mut video = Video::open(&dir.path().join("frames"), &OpenOptions::default()).unwrap();
-    let out = track_video(
-        &mut video,
-        &job(&marks, 2),
-        &mut |_| {},
-        &AtomicBool::new(false),
-    )
-    .unwrap();
-    let s = score_tracks(&gt, &out.tracks).unwrap();
+    let s = track_rendered(dir.path(), TrackerParams::default());
     assert!(growth > 1.4, "the person grows {growth:.2}×");
     assert!(
         s.overall.pck02() >= 0.85,
@@ -268,14 +270,14 @@ fn a_person_walking_towards_the_camera_is_followed_as_they_grow() {
 fn a_bow_from_the_side_keeps_the_pelvis_where_the_hips_are() {
     let dir = tempfile::tempdir().unwrap();
     render(dir.path(), ProceduralMotion::Bend, 60, View::Side);
-    let gt = GroundTruth::load(&dir.path().join("gt.json")).unwrap();
-    let marks = Marks::load(&dir.path().join("marks.json")).unwrap();
     let pelvis_error = |hip_patch: bool| {
-        let mut video = Video::open(&dir.path().join("frames"), &OpenOptions::default()).unwrap();
-        let mut job = job(&marks, 2);
-        job.params.hip_patch = hip_patch;
-        let out = track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false)).unwrap();
-        let s = score_tracks(&gt, &out.tracks).unwrap();
+        let s = track_rendered(
+            dir.path(),
+            TrackerParams {
+                hip_patch,
+                ..TrackerParams::default()
+            },
+        );
         (s.per_joint[Joint::Pelvis].mean_px(), s.overall.pck02())
     };
     let (without, _) = pelvis_error(false);
@@ -308,14 +310,14 @@ fn a_running_shank_never_folds_back_onto_its_thigh() {
         ..SynthParams::default()
     };
     render_clip(&params, dir.path(), &mut |_, _| {}, &AtomicBool::new(false)).unwrap();
-    let gt = GroundTruth::load(&dir.path().join("gt.json")).unwrap();
-    let marks = Marks::load(&dir.path().join("marks.json")).unwrap();
     let run = |fold_limit_deg: f64| {
-        let mut video = Video::open(&dir.path().join("frames"), &OpenOptions::default()).unwrap();
-        let mut job = job(&marks, 2);
-        job.params.fold_limit_deg = fold_limit_deg;
-        let out = track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false)).unwrap();
-        let s = score_tracks(&gt, &out.tracks).unwrap();
+        let s = track_rendered(
+            dir.path(),
+            TrackerParams {
+                fold_limit_deg,
+                ..TrackerParams::default()
+            },
+        );
         (s.per_joint[Joint::LeftAnkle].mean_px(), s.overall.pck02())
     };
     let (ankle_off, pck_off) = run(180.0);

@@ -566,37 +566,35 @@ fn track_limb(
         let mut found = angular(&part.template, frame, &pred, &narrow, &prior);
         let weak = reliability(found.cost, p.reliability_c0) < p.weak_reliability;
         if weak && predicted_off {
-            // The joint left the frame: nothing to match, so the part keeps its angle to its
-            // parent (no angular velocity, which would spin it) until its prediction is back
-            // on the image.
-            part.prev_theta = part.block.theta;
-            part.block = predict_anchored(part, anchor, Some(parent), 0.0);
-            part.reliability = 0.0;
-            parent = [part.block.theta, before.0, before.1];
-            anchor = part.block.end();
-            continue;
-        }
-        if weak || folded(&found.block) {
-            let wide = AngularParams {
-                range_theta: p.wide_range_deg.to_radians(),
-                step_theta: 2.0 * p.coarse_step_deg.to_radians(),
-                ..narrow
-            };
-            let again = angular(&part.template, frame, &pred, &wide, &prior);
-            if again.cost < found.cost && !folded(&again.block) || folded(&found.block) {
-                found = again;
+            // The joint left the frame: nothing to match until its prediction is back.
+            hold(part, anchor, parent);
+        } else {
+            if weak || folded(&found.block) {
+                let wide = AngularParams {
+                    range_theta: p.wide_range_deg.to_radians(),
+                    step_theta: 2.0 * p.coarse_step_deg.to_radians(),
+                    ..narrow
+                };
+                let again = angular(&part.template, frame, &pred, &wide, &prior);
+                if again.cost < found.cost && !folded(&again.block) || folded(&found.block) {
+                    found = again;
+                }
+            }
+            if folded(&found.block) {
+                hold(part, anchor, parent);
+            } else {
+                accept(part, found, frame, p);
             }
         }
-        if folded(&found.block) {
-            part.prev_theta = part.block.theta;
-            part.block = predict_anchored(part, anchor, Some(parent), 0.0);
-            part.reliability = 0.0;
-            parent = [part.block.theta, before.0, before.1];
-            anchor = part.block.end();
-            continue;
-        }
-        accept(part, found, frame, p);
         parent = [part.block.theta, before.0, before.1];
         anchor = part.block.end();
     }
+}
+
+/// Holds a part at its angle to its parent (no angular velocity, which would spin it) with
+/// reliability 0: a joint off the image, or a match refused.
+fn hold(part: &mut Part, anchor: Point2<f64>, parent: [f64; 3]) {
+    part.prev_theta = part.block.theta;
+    part.block = predict_anchored(part, anchor, Some(parent), 0.0);
+    part.reliability = 0.0;
 }
