@@ -2,7 +2,7 @@
 //! CSV of the 2D tracks and of the 3D joints, and OpenSim's TRC. Camera space is first turned
 //! into a Y-up world ([`world`]); every file here is in that world.
 //!
-//! The BVH reader lives in [`crate::bvh`]; [`write_bvh`] reads its own output back with it and
+//! The BVH reader lives in [`crate::bvh`]; [`bvh`] reads its own output back with it and
 //! reports how far forward kinematics lands from the input.
 
 mod bvh_writer;

@@ -177,7 +177,7 @@ fn up_from_contacts(contacts: &[Point3<f64>], trunk: Vector3<f64>) -> (Vector3<f
 }
 
 /// Stature from the median lengths of the vertical chain head_top–neck–chest–pelvis and the
-/// longer leg's thigh + shank (see [`CHAIN_FRACTION`]).
+/// longer leg's thigh + shank (see `CHAIN_FRACTION`).
 pub fn stature_m(frames: &[PerJoint<Point3<f64>>]) -> f64 {
     let length = |a: Joint, b: Joint| {
         let mut v: Vec<f64> = frames.iter().map(|f| (f[a] - f[b]).norm()).collect();

@@ -227,7 +227,7 @@ fn interpolate(
 
 /// Where the head probably is when the curve could not be named (wrong leaf count): the tip
 /// of the shortest limb of `tree` (refined by [`adjust_tree_nodes`]), measured in input space
-/// through its nodes' centroids. [`super::handles`] looks for loops from there.
+/// through its nodes' centroids. The loop opening (`volume::handles`) starts from there.
 pub fn head_tip_guess(tree: &ShellTree, input: &[Point3<f64>]) -> Option<Point3<f64>> {
     let centroid = |k: usize| -> Option<Point3<f64>> {
         let m = &tree.nodes[k].members;

@@ -260,7 +260,7 @@ impl Neighbours {
     }
 
     /// Opens the graph's loops as seen from the kept point nearest `head`
-    /// ([`super::handles`]); returns how many edges were removed (0: no loop).
+    /// (`volume::handles`); returns how many edges were removed (0: no loop).
     pub fn open_handles(&mut self, head: Point3<f64>) -> usize {
         let source = (0..self.points.len()).min_by(|&a, &b| {
             (self.points[a] - head)
