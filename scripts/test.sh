@@ -7,4 +7,5 @@ export PATH="$HOME/.cargo/bin:$PATH"
 cargo fmt --check
 cargo clippy --all-targets --quiet -- -D warnings
 cargo check --no-default-features --quiet
+RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
 cargo test
