@@ -1287,6 +1287,8 @@ impl App {
                     .on_hover_text(format!("Frames are shrunk so the person is about this tall while tracking (faster, smoother); default {} px", d.working_stature_px));
                 ui.add(egui::Slider::new(&mut t.limb_range_deg, 5.0..=90.0).text("limb search (°)"))
                     .on_hover_text(format!("How far a limb may turn between frames in the search; default {}°", d.limb_range_deg));
+                ui.checkbox(&mut t.hip_patch, "hold the hips when the back bends")
+                    .on_hover_text(format!("A patch around the hips holds the pelvis when the spine bends (a bow, a reach), and the trunk is re-hung from the neck to it; default {}", if d.hip_patch { "on" } else { "off" }));
                 if ui.button("Defaults").clicked() {
                     *t = d;
                 }
@@ -2089,6 +2091,25 @@ mod tests {
         );
         assert_eq!(Project::load(&saved).unwrap().keys, expected.keys);
         wait(&mut h, "the other folder", |a| a.frame_count() == 1);
+    }
+
+    /// The tracker's hip patch can be turned off from the Parameters panel, and that is an
+    /// undoable project setting.
+    #[test]
+    fn the_hip_patch_is_switched_in_the_tracker_settings() {
+        let dir = tempfile::tempdir().unwrap();
+        let dialogs = PreparedDialogs::default();
+        let mut h = harness(None, &dialogs, &dir.path().join("state"));
+        h.state_mut().project = Some(Project::new(dir.path().join("v.mp4")));
+        h.run();
+        assert!(h.state().project().unwrap().settings.tracker.hip_patch);
+        h.get_by_label("Tracker").click();
+        h.run();
+        h.get_by_label("hold the hips when the back bends").click();
+        h.run();
+        assert!(!h.state().project().unwrap().settings.tracker.hip_patch);
+        h.state_mut().undo();
+        assert!(h.state().project().unwrap().settings.tracker.hip_patch);
     }
 
     /// A slider drag changes the settings many times but is one undo step.
