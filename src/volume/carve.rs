@@ -166,11 +166,11 @@ pub struct CarvingSetup {
     pub frames: Vec<Vec<PathBuf>>,
 }
 
-/// Mask images: what `image` reads without loss of the silhouette.
+/// Mask images: PNG or JPEG (what the `image` build reads).
 fn is_mask(p: &Path) -> bool {
-    p.extension().and_then(|e| e.to_str()).is_some_and(|e| {
-        ["png", "bmp", "pgm", "tif", "tiff"].contains(&e.to_ascii_lowercase().as_str())
-    })
+    p.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| ["png", "jpg", "jpeg"].contains(&e.to_ascii_lowercase().as_str()))
 }
 
 /// Reads a carving set-up: `dir/cameras.json` (with `bounds_m`) and `dir/masks/<name>/` per
@@ -405,6 +405,30 @@ mod tests {
     /// A 30 cm ball seen by four cameras around it: carving gives the ball (its visual hull),
     /// a little fatter than the ball but never missing any of it.
     use std::f64::consts::FRAC_1_SQRT_2;
+
+    /// JPEG masks count as frames (the documented PNG or JPEG); other files do not.
+    #[test]
+    fn a_set_up_with_jpeg_masks_opens() {
+        let dir = tempfile::tempdir().unwrap();
+        let cam = CalibratedCamera::look_at(
+            "c0".into(),
+            Point3::new(0.0, 1.0, 3.0),
+            Point3::new(0.0, 1.0, 0.0),
+            (40, 30),
+            50.0,
+        );
+        CamerasFile::new(vec![cam], Some([[-1.0, 0.0, -1.0], [1.0, 2.0, 1.0]]))
+            .save(&dir.path().join("cameras.json"))
+            .unwrap();
+        let masks = dir.path().join("masks/c0");
+        std::fs::create_dir_all(&masks).unwrap();
+        GrayImage::new(40, 30).save(masks.join("f1.jpg")).unwrap();
+        GrayImage::new(40, 30).save(masks.join("f2.JPEG")).unwrap();
+        std::fs::write(masks.join("notes.txt"), "x").unwrap();
+        let setup = open_setup(dir.path()).unwrap();
+        assert_eq!(setup.frames.len(), 2);
+        assert_eq!(setup.read_masks(1).unwrap()[0].dimensions(), (40, 30));
+    }
 
     #[test]
     fn four_views_carve_a_ball() {
