@@ -157,10 +157,7 @@ pub fn carve_and_score(
     use crate::volume::carve::{carve_sequence, open_setup};
     use crate::volume::{VolumeError, process_directory};
     use std::sync::atomic::AtomicBool;
-    let dir = tempfile::tempdir().map_err(|e| VolumeError::Io {
-        path: std::env::temp_dir(),
-        source: e,
-    })?;
+    let dir = tempfile::tempdir().map_err(VolumeError::io(&std::env::temp_dir()))?;
     let (setup_dir, grids) = (dir.path().join("setup"), dir.path().join("grids"));
     crate::synth::write_carving_setup(motion, &setup_dir, views, (640, 480), &|_, _| {})?;
     let setup = open_setup(&setup_dir)?;

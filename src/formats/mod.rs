@@ -163,7 +163,7 @@ fn joint_names() -> Vec<String> {
 }
 
 /// Serialises to pretty JSON and saves atomically.
-fn save_json<T: serde::Serialize>(value: &T, path: &Path) -> Result<(), FormatError> {
+pub(crate) fn save_json<T: serde::Serialize>(value: &T, path: &Path) -> Result<(), FormatError> {
     let mut text = serde_json::to_string_pretty(value).map_err(|source| FormatError::Json {
         path: path.to_owned(),
         source,

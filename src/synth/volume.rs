@@ -12,7 +12,7 @@ use crate::volume::VolumeError;
 use crate::volume::carve::{CalibratedCamera, CamerasFile};
 use crate::volume::cloud::write_ply;
 use image::GrayImage;
-use nalgebra::{Matrix3, Point3, Vector3};
+use nalgebra::{Point3, Vector3};
 use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -90,10 +90,7 @@ pub fn write_volume_sequence(
     params: &VoxelParams,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<usize, VolumeError> {
-    std::fs::create_dir_all(dir).map_err(|e| VolumeError::Io {
-        path: dir.to_owned(),
-        source: e,
-    })?;
+    std::fs::create_dir_all(dir).map_err(VolumeError::io(dir))?;
     let stature = stature_of(motion);
     let mut rng = rand::rngs::StdRng::seed_from_u64(params.seed);
     let mut points_total = 0;
@@ -134,10 +131,8 @@ pub fn ring_cameras(
 /// centre drawn as a disc as wide as its voxel's projected half-diagonal.
 pub fn silhouette(points: &[Point3<f64>], voxel_m: f64, cam: &CalibratedCamera) -> GrayImage {
     let mut img = GrayImage::new(cam.width, cam.height);
-    let r = Matrix3::from_fn(|i, j| cam.rotation[i][j]);
-    let t = Vector3::from(cam.translation);
     for p in points {
-        let z = (r * p.coords + t).z;
+        let z = cam.to_camera(p).z;
         let Some((u, v)) = cam.project(p) else {
             continue;
         };
@@ -189,13 +184,9 @@ pub fn write_carving_setup(
         (f64::from(height.min(width)) / f64::from(width) * 30f64.to_radians().tan()).atan();
     let distance = radius / (0.9 * half_fov).sin();
     let cameras = ring_cameras(views, centre, distance, width, height);
-    let io = |path: &Path| {
-        let path = path.to_owned();
-        move |e: std::io::Error| VolumeError::Io { path, source: e }
-    };
     for c in &cameras {
         let d = dir.join("masks").join(&c.name);
-        std::fs::create_dir_all(&d).map_err(io(&d))?;
+        std::fs::create_dir_all(&d).map_err(VolumeError::io(&d))?;
     }
     CamerasFile::new(cameras.clone(), Some([lo.coords.into(), hi.coords.into()]))
         .save(&dir.join("cameras.json"))?;

@@ -54,11 +54,9 @@ struct Part {
     /// The colour model.
     template: Template,
     reliability: f32,
-    /// Longest plausible image length of the bone, pixels: `marked_max_len` times the head's
-    /// zoom since the marking (never below 1).
+    /// Longest plausible image length of the bone on the marked frame, pixels (proportions ×
+    /// marked stature); it grows with the head's zoom (`BodyTracker::zoom`).
     max_len: f64,
-    /// The same on the marked frame (proportions × marked stature).
-    marked_max_len: f64,
     /// How far along its bone the part is sampled.
     extent: Extent,
 }
@@ -139,6 +137,9 @@ pub struct BodyTracker {
     predictor: HeadPredictor,
     /// The head block's length on the marked frame, pixels.
     marked_head_m: f64,
+    /// The head's zoom since the marking (never below 1): every length limit is multiplied by
+    /// it.
+    zoom: f64,
     /// The head's displacement over the last frame, pixels.
     head_velocity: nalgebra::Vector2<f64>,
     prev_image: Arc<RgbImage>,
@@ -179,7 +180,6 @@ impl BodyTracker {
                 template: Template::sample(frame, &block, extent(kind), w),
                 reliability: 1.0,
                 max_len: (1.2 * fraction * stature).max(block.m * 1.05),
-                marked_max_len: (1.2 * fraction * stature).max(block.m * 1.05),
                 extent: extent(kind),
             }
         };
@@ -212,7 +212,6 @@ impl BodyTracker {
                 template: Template::sample(frame, &block, Extent::BLOCK, w),
                 reliability: 1.0,
                 max_len: block.m,
-                marked_max_len: block.m,
                 extent: Extent::BLOCK,
             }
         };
@@ -245,6 +244,7 @@ impl BodyTracker {
             trunk_points,
             predictor: HeadPredictor::default(),
             marked_head_m: pose_head_m,
+            zoom: 1.0,
             head_velocity: nalgebra::Vector2::zeros(),
             prev_image: image,
         }
@@ -349,10 +349,8 @@ impl BodyTracker {
         // block zooms with them (the spiral searches its length), so every bone's length limit
         // grows by the head's zoom since the marking; without this the trunk and limbs stop at
         // their marked-size limits and the hips and feet are left behind.
-        let zoom = (self.head.block.m / self.marked_head_m.max(1e-9)).max(1.0);
-        for part in std::iter::once(&mut self.trunk).chain(self.limbs.iter_mut().flatten()) {
-            part.max_len = part.marked_max_len * zoom;
-        }
+        self.zoom = (self.head.block.m / self.marked_head_m.max(1e-9)).max(1.0);
+        let zoom = self.zoom;
 
         // Trunk, anchored at the neck.
         let neck = self.head.block.end();
@@ -369,7 +367,7 @@ impl BodyTracker {
                 m_count: 5,
                 scale_width: false,
             },
-            &prior(&self.trunk, &trunk_pred, &p),
+            &prior(&self.trunk, &trunk_pred, &p, zoom),
         );
         accept(&mut self.trunk, found, frame, &p);
         if p.hip_patch {
@@ -382,7 +380,7 @@ impl BodyTracker {
         let roots = CHAINS.map(|c| pose_now[c[0]].pos);
         let [a, b, c, d] = &mut self.limbs;
         let track_chain = |parts: &mut [Part; 2], root: Point2<f64>| {
-            track_limb(parts, root, trunk_angles, frame, &p);
+            track_limb(parts, root, trunk_angles, frame, &p, zoom);
         };
         if p.parallel {
             rayon::join(
@@ -439,7 +437,10 @@ impl BodyTracker {
         );
         let centre = found.block.to_image(0.5, 0.0);
         let len = (centre - neck).norm();
-        if found.cost + p.hip_margin < c_trunk && len > 0.5 * t.m && len <= self.trunk.max_len {
+        if found.cost + p.hip_margin < c_trunk
+            && len > 0.5 * t.m
+            && len <= self.trunk.max_len * self.zoom
+        {
             let block = MorphBlock::along(neck, centre, t.n);
             let cost = self
                 .trunk
@@ -489,15 +490,16 @@ fn predict_anchored(
     }
 }
 
-/// The motion prior of an anchored part around its prediction.
-fn prior(part: &Part, pred: &MorphBlock, p: &TrackerParams) -> Prior {
+/// The motion prior of an anchored part around its prediction; its length limits are the
+/// marked ones times the head's `zoom`.
+fn prior(part: &Part, pred: &MorphBlock, p: &TrackerParams, zoom: f64) -> Prior {
     Prior {
         theta: pred.theta,
         m: pred.m,
         per_degree: p.angle_penalty,
         per_log_length: p.length_penalty,
-        m_min: 0.2 * part.max_len,
-        m_max: part.max_len,
+        m_min: 0.2 * part.max_len * zoom,
+        m_max: part.max_len * zoom,
     }
 }
 
@@ -530,6 +532,7 @@ fn track_limb(
     trunk_angles: [f64; 3],
     frame: FrameView,
     p: &TrackerParams,
+    zoom: f64,
 ) {
     let mut parent = trunk_angles;
     let mut anchor = root;
@@ -543,7 +546,7 @@ fn track_limb(
             m_count: 5,
             scale_width: false,
         };
-        let prior = prior(part, &pred, p);
+        let prior = prior(part, &pred, p, zoom);
         let predicted_off = off_image(pred.end(), frame);
         let narrow = if off_image(pred.to_image(part.extent.end, 0.0), frame) {
             // The far end of the sampled part is cut off by the image's edge, so its length

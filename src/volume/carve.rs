@@ -67,10 +67,14 @@ impl CalibratedCamera {
         }
     }
 
+    /// A world point in this camera's space (metres; X right, Y down, Z forward).
+    pub fn to_camera(&self, p: &Point3<f64>) -> Vector3<f64> {
+        Matrix3::from_fn(|i, j| self.rotation[i][j]) * p.coords + Vector3::from(self.translation)
+    }
+
     /// The pixel (x right, y down) a world point projects to, if in front of the camera.
     pub fn project(&self, p: &Point3<f64>) -> Option<(f64, f64)> {
-        let r = Matrix3::from_fn(|i, j| self.rotation[i][j]);
-        let c = r * p.coords + Vector3::from(self.translation);
+        let c = self.to_camera(p);
         (c.z > 1e-6).then(|| (self.fx * c.x / c.z + self.cx, self.fy * c.y / c.z + self.cy))
     }
 }
@@ -104,11 +108,7 @@ impl CamerasFile {
 
     /// Writes the file atomically.
     pub fn save(&self, path: &Path) -> Result<(), VolumeError> {
-        let text = serde_json::to_string_pretty(self).map_err(|e| VolumeError::Invalid {
-            path: path.to_owned(),
-            problem: e.to_string(),
-        })?;
-        Ok(crate::formats::write_atomically(path, text.as_bytes())?)
+        Ok(crate::formats::save_json(self, path)?)
     }
 }
 
@@ -185,10 +185,7 @@ pub fn open_setup(dir: &Path) -> Result<CarvingSetup, VolumeError> {
     let mut per_camera: Vec<Vec<PathBuf>> = Vec::new();
     for cam in &file.cameras {
         let d = dir.join("masks").join(&cam.name);
-        let entries = std::fs::read_dir(&d).map_err(|e| VolumeError::Io {
-            path: d.clone(),
-            source: e,
-        })?;
+        let entries = std::fs::read_dir(&d).map_err(VolumeError::io(&d))?;
         let mut files: Vec<PathBuf> = entries
             .filter_map(|e| e.ok().map(|e| e.path()))
             .filter(|p| p.is_file() && is_mask(p))
@@ -371,10 +368,7 @@ pub fn carve_sequence(
         });
     }
     let carver = Carver::new(setup.grid(voxel_m)?, &setup.cameras);
-    std::fs::create_dir_all(out_dir).map_err(|e| VolumeError::Io {
-        path: out_dir.to_owned(),
-        source: e,
-    })?;
+    std::fs::create_dir_all(out_dir).map_err(VolumeError::io(out_dir))?;
     let done = AtomicUsize::new(0);
     let total = setup.frames.len();
     (0..total)

@@ -43,10 +43,7 @@ impl CloudKind {
 
 /// The frame files of a sequence directory in natural order (`frame2` before `frame10`).
 pub fn list_frames(dir: &Path) -> Result<Vec<PathBuf>, VolumeError> {
-    let entries = std::fs::read_dir(dir).map_err(|e| VolumeError::Io {
-        path: dir.to_owned(),
-        source: e,
-    })?;
+    let entries = std::fs::read_dir(dir).map_err(VolumeError::io(dir))?;
     let mut files: Vec<PathBuf> = entries
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.is_file() && CloudKind::of(p).is_some())
@@ -73,7 +70,7 @@ pub fn read_cloud(path: &Path) -> Result<PointCloud, VolumeError> {
         path: path.to_owned(),
         problem: "unknown point cloud type (expected .ply, .xyz, .txt or .voxels.json)".into(),
     })?;
-    let bytes = std::fs::read(path).map_err(io_error(path))?;
+    let bytes = std::fs::read(path).map_err(VolumeError::io(path))?;
     parse_cloud(kind, &bytes, path)
 }
 
@@ -102,13 +99,6 @@ pub fn parse_cloud(kind: CloudKind, bytes: &[u8], path: &Path) -> Result<PointCl
         });
     }
     Ok(points)
-}
-
-fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> VolumeError + '_ {
-    move |e| VolumeError::Io {
-        path: path.to_owned(),
-        source: e,
-    }
 }
 
 fn parse_ply(bytes: &[u8], path: &Path) -> Result<PointCloud, VolumeError> {
@@ -212,7 +202,7 @@ pub fn write_ply(path: &Path, points: &[Point3<f64>]) -> Result<(), VolumeError>
     let mut bytes = Vec::new();
     ply_rs_bw::writer::Writer::new()
         .write_ply(&mut bytes, &mut ply)
-        .map_err(io_error(path))?;
+        .map_err(VolumeError::io(path))?;
     Ok(crate::formats::write_atomically(path, &bytes)?)
 }
 

@@ -47,6 +47,16 @@ pub enum VolumeError {
     Format(#[from] FormatError),
 }
 
+impl VolumeError {
+    /// Turns an I/O error on `path` into [`VolumeError::Io`] (for `map_err`).
+    pub(crate) fn io(path: &Path) -> impl FnOnce(std::io::Error) -> VolumeError + '_ {
+        move |source| VolumeError::Io {
+            path: path.to_owned(),
+            source,
+        }
+    }
+}
+
 /// Why one frame gave no pose (the sequence goes on: the frame is interpolated or skipped).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum FrameProblem {
