@@ -32,6 +32,16 @@ fn job(marks: &Marks, threads: usize) -> TrackJob {
     TrackJob::from_marks(marks, TrackerParams::default(), threads)
 }
 
+/// Asserts the clip's PCK@0.2 is at least `floor`, reporting the mean error if not.
+fn assert_pck(s: &ClipScore, floor: f64) {
+    assert!(
+        s.overall.pck02() >= floor,
+        "PCK@0.2 {:.3}, mean {:.1} px",
+        s.overall.pck02(),
+        s.overall.mean_px()
+    );
+}
+
 /// Tracks the clip rendered into `dir` (PNG frames) from its marks with `params`, two threads,
 /// and scores it against the clip's truth.
 fn track_rendered(dir: &Path, params: TrackerParams) -> ClipScore {
@@ -64,12 +74,7 @@ fn a_waving_person_is_tracked_within_a_fifth_of_the_torso() {
     assert_eq!(out.tracks.frames.len(), 30);
     assert!(seen >= 30, "progress reported {seen} times");
     let s = score_tracks(&gt, &out.tracks).unwrap();
-    assert!(
-        s.overall.pck02() >= 0.9,
-        "PCK@0.2 {:.3}, mean {:.1} px",
-        s.overall.pck02(),
-        s.overall.mean_px()
-    );
+    assert_pck(&s, 0.9);
     // The marked frame is returned exactly, with full confidence.
     for j in Joint::ALL {
         let p = out.tracks.frames[0].points[j];
@@ -230,12 +235,7 @@ fn a_tall_person_is_tracked_on_frames_the_decoder_shrinks() {
     // Tracks are in video pixels, at the accuracy of the full-size test above.
     assert_eq!(out.tracks.source.width, 320);
     let s = score_tracks(&gt, &out.tracks).unwrap();
-    assert!(
-        s.overall.pck02() >= 0.85,
-        "PCK@0.2 {:.3}, mean {:.1} px",
-        s.overall.pck02(),
-        s.overall.mean_px()
-    );
+    assert_pck(&s, 0.85);
 }
 
 /// Walking obliquely towards the camera the person grows by 1.85× over four seconds. The head
@@ -255,12 +255,7 @@ fn a_person_walking_towards_the_camera_is_followed_as_they_grow() {
     let growth = stature(119) / stature(0);
     let s = track_rendered(dir.path(), TrackerParams::default());
     assert!(growth > 1.4, "the person grows {growth:.2}×");
-    assert!(
-        s.overall.pck02() >= 0.85,
-        "PCK@0.2 {:.3}, mean {:.1} px",
-        s.overall.pck02(),
-        s.overall.mean_px()
-    );
+    assert_pck(&s, 0.85);
 }
 
 /// A bow seen from the side: the spine bends and the hips stay. The rigid trunk hung from the
