@@ -177,9 +177,11 @@ fn joints_leaving_the_frame_are_tracked_and_exported_consistently() {
             said_on * 10 >= on * 9,
             "{j}: on the frame in {on} frames, not off in {said_on}"
         );
-        // Picked up again after re-entry.
+        // Picked up again after re-entry (a wrist left behind is tens of pixels off). The pull
+        // of limbs towards their full length (`short_penalty`) lengthens the raised forearm by
+        // a pixel or two on this wide-angle clip: left wrist 4.4 → 6.0 px, right 1.7 both.
         assert!(
-            median < 5.0,
+            median < 7.0,
             "{j}: median error {median:.1} px after re-entries"
         );
     }

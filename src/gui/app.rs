@@ -1287,6 +1287,8 @@ impl App {
                     .on_hover_text(format!("Frames are shrunk so the person is about this tall while tracking (faster, smoother); default {} px", d.working_stature_px));
                 ui.add(egui::Slider::new(&mut t.limb_range_deg, 5.0..=90.0).text("limb search (°)"))
                     .on_hover_text(format!("How far a limb may turn between frames in the search; default {}°", d.limb_range_deg));
+                ui.add(egui::Slider::new(&mut t.short_penalty, 0.0..=20.0).text("keep limbs long"))
+                    .on_hover_text(format!("How strongly a limb is pulled back to its full length when it looks shorter (legs crossing); lower it for limbs pointing at the camera, such as a seated person's thighs seen from the front; default {}", d.short_penalty));
                 ui.checkbox(&mut t.hip_patch, "hold the hips when the back bends")
                     .on_hover_text(format!("A patch around the hips holds the pelvis when the spine bends (a bow, a reach), and the trunk is re-hung from the neck to it; default {}", if d.hip_patch { "on" } else { "off" }));
                 if ui.button("Defaults").clicked() {

@@ -61,6 +61,10 @@ struct Part {
     extent: Extent,
 }
 
+/// A limb's longest plausible image length over its full length from the proportions (people
+/// differ from the table, and marks are not exact).
+const LENGTH_SLACK: f64 = 1.2;
+
 /// The sampled extent of each part along its bone (see [`Extent`]): the head block reaches a
 /// little above the calvaria, limb blocks past their far joint (into the forearm, the hand,
 /// the shank, the foot).
@@ -179,7 +183,7 @@ impl BodyTracker {
                 prev_theta: block.theta,
                 template: Template::sample(frame, &block, extent(kind), w),
                 reliability: 1.0,
-                max_len: (1.2 * fraction * stature).max(block.m * 1.05),
+                max_len: (LENGTH_SLACK * fraction * stature).max(block.m * 1.05),
                 extent: extent(kind),
             }
         };
@@ -367,7 +371,7 @@ impl BodyTracker {
                 m_count: 5,
                 scale_width: false,
             },
-            &prior(&self.trunk, &trunk_pred, &p, zoom),
+            &prior(&self.trunk, &trunk_pred, &p, zoom, 0.0),
         );
         accept(&mut self.trunk, found, frame, &p);
         if p.hip_patch {
@@ -491,13 +495,16 @@ fn predict_anchored(
 }
 
 /// The motion prior of an anchored part around its prediction; its length limits are the
-/// marked ones times the head's `zoom`.
-fn prior(part: &Part, pred: &MorphBlock, p: &TrackerParams, zoom: f64) -> Prior {
+/// marked ones times the head's `zoom`, and a block shorter than the part's full length pays
+/// `short` per unit of log ratio (limbs; the trunk passes 0).
+fn prior(part: &Part, pred: &MorphBlock, p: &TrackerParams, zoom: f64, short: f32) -> Prior {
     Prior {
         theta: pred.theta,
         m: pred.m,
         per_degree: p.angle_penalty,
         per_log_length: p.length_penalty,
+        per_log_short: short,
+        m_full: part.max_len * zoom / LENGTH_SLACK,
         m_min: 0.2 * part.max_len * zoom,
         m_max: part.max_len * zoom,
     }
@@ -546,7 +553,7 @@ fn track_limb(
             m_count: 5,
             scale_width: false,
         };
-        let prior = prior(part, &pred, p, zoom);
+        let prior = prior(part, &pred, p, zoom, p.short_penalty);
         let predicted_off = off_image(pred.end(), frame);
         let narrow = if off_image(pred.to_image(part.extent.end, 0.0), frame) {
             // The far end of the sampled part is cut off by the image's edge, so its length

@@ -73,6 +73,13 @@ pub struct TrackerParams {
     /// image (degrees) is folded back onto it, which elbows and knees cannot do: the match is
     /// refused and the joint held. Default 165 (180 turns the check off).
     pub fold_limit_deg: f64,
+    /// Cost (8-bit levels) per unit of ln(full length / length) that a limb block shorter than
+    /// its full image length pays (beyond the paper). The length search is centred on the last
+    /// length, so a limb that matched the other leg at half its length where the legs cross
+    /// stayed short; this pull lets it grow back. Full length: proportions × marked stature ×
+    /// the head's zoom. Default 8 (0 turns it off); it also resists true foreshortening, which
+    /// costs a frontal seated knee.
+    pub short_penalty: f32,
 }
 
 impl Default for TrackerParams {
@@ -103,6 +110,7 @@ impl Default for TrackerParams {
             hip_patch: true,
             hip_margin: 3.0,
             fold_limit_deg: 165.0,
+            short_penalty: 8.0,
         }
     }
 }

@@ -30,6 +30,10 @@ pub struct Prior {
     pub per_degree: f32,
     /// Penalty per unit of |ln(m / predicted m)|.
     pub per_log_length: f32,
+    /// Penalty per unit of ln(m_full / m) when the block is shorter than `m_full`.
+    pub per_log_short: f32,
+    /// The part's full (not foreshortened) image length, pixels.
+    pub m_full: f64,
     /// Shortest allowed length, pixels.
     pub m_min: f64,
     /// Longest allowed length, pixels.
@@ -43,6 +47,8 @@ impl Prior {
         m: 1.0,
         per_degree: 0.0,
         per_log_length: 0.0,
+        per_log_short: 0.0,
+        m_full: 0.0,
         m_min: 0.0,
         m_max: f64::INFINITY,
     };
@@ -58,6 +64,9 @@ impl Prior {
         }
         if self.per_log_length > 0.0 && self.m > 0.0 {
             p += self.per_log_length * (b.m / self.m).ln().abs() as f32;
+        }
+        if self.per_log_short > 0.0 && b.m < self.m_full {
+            p += self.per_log_short * (self.m_full / b.m).ln() as f32;
         }
         p
     }
