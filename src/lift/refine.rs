@@ -9,7 +9,10 @@
 //! - every joint's acceleration, `σ = a · Δt²` with `a` from the tracks' noise (adaptive, the
 //!   default) or `acceleration_sigma_mps2`;
 //! - each length near its starting value (`σ = length_prior` of it) and their sum at its
-//!   starting value (a monocular camera cannot see scale: the subject's height sets it).
+//!   starting value (a monocular camera cannot see scale: the subject's height sets it);
+//! - every joint near where the per-frame solve put it, `σ = anchor_sigma_m` (a trust region:
+//!   one camera sees depth poorly, and without it a few 2D points the skeleton cannot reach
+//!   re-posed whole bodies to reach them).
 //!
 //! Solved by Levenberg–Marquardt; the normal equations are sparse (banded over frames plus
 //! the length columns) and factored with `nalgebra-sparse`'s Cholesky.
@@ -42,6 +45,13 @@ pub struct RefineParams {
     pub length_prior: f64,
     /// Levenberg–Marquardt iterations at most (default 20).
     pub max_iterations: usize,
+    /// How far (metres, standard deviation per axis) a joint may move from the per-frame solve
+    /// (default 0.03; 0 turns the anchor off). Without it, on the synthetic suite with the
+    /// tracker's 2D and true lengths, a forearm the tracker made too long pulled whole trunks
+    /// 5 cm off (jumping jacks: shoulders 7 → 57 mm) and the refinement raised the error,
+    /// 111.2 → 117.0 mm; with it 111.2 → 110.8 mm, and exact tracks stay at 20.4 mm (21.6
+    /// without). 2 px noise: 63.5 → 62.2 mm (61.5 without).
+    pub anchor_sigma_m: f64,
     /// Set the acceleration deviation from the tracks' own noise (default true): it is
     /// [`ACCELERATION_TIMES_NOISE`] over the median white-noise deviation of the joints' tracks
     /// ([`super::smoothing::median_noise_px`]), so noisy tracks are smoothed firmly and exact ones
@@ -57,6 +67,7 @@ impl Default for RefineParams {
             acceleration_sigma_mps2: 100.0,
             length_prior: 0.01,
             max_iterations: 20,
+            anchor_sigma_m: 0.03,
             adaptive: true,
         }
     }
@@ -64,7 +75,8 @@ impl Default for RefineParams {
 
 /// The adaptive refinement's acceleration deviation (m/s²) is this over the tracks' noise
 /// (pixels): jitter needs a firm hand, exact tracks almost none. On the synthetic suite with true
-/// lengths it gave 63.5 → 61.5 mm MPJPE with 2 px noise and 20.4 → 21.6 mm with exact tracks
+/// lengths and before the anchor ([`RefineParams::anchor_sigma_m`]) it gave 63.5 → 61.5 mm
+/// MPJPE with 2 px noise and 20.4 → 21.6 mm with exact tracks
 /// (without the floor below, 30 gave 66.3 and 23.5 and 100 gave 63.1 and 20.9; the fixed
 /// 100 m/s² gives 64.2 and 24.4).
 pub const ACCELERATION_TIMES_NOISE: f64 = 60.0;
@@ -134,6 +146,8 @@ struct Problem<'a> {
     cam: &'a PinholeCamera,
     images: &'a [PerJoint<Point2<f64>>],
     weights: &'a [PerJoint<f64>],
+    /// The per-frame solve, where the anchor rows hold the joints.
+    start: &'a [PerJoint<Point3<f64>>],
     start_lengths: [f64; LENGTHS],
     params: RefineParams,
     /// Acceleration deviation, metres per frame² ([`acceleration_sigma_m`]).
@@ -227,6 +241,16 @@ impl Problem<'_> {
                         .with(c + 1, s * f / z)
                         .with(c + 2, -s * f * q.y / (z * z)),
                 );
+            }
+            if p.anchor_sigma_m > 0.0 {
+                let s = 1.0 / p.anchor_sigma_m;
+                for j in Joint::ALL {
+                    let c = Self::col(t, j);
+                    let q = Self::point(x, t, j) - self.start[t][j];
+                    for axis in 0..3 {
+                        emit(Row::new(s * q[axis]).with(c + axis, s));
+                    }
+                }
             }
             let s = 1.0 / p.length_sigma_m;
             for (k, &(a, b)) in pairs.iter().enumerate() {
@@ -354,6 +378,7 @@ pub fn refine(
         cam,
         images,
         weights,
+        start,
         start_lengths,
         params: *params,
         accel_sigma_m: acceleration_sigma_m(track_noise_px, params, dt),
@@ -490,6 +515,7 @@ mod tests {
             cam: &cam,
             images: &images,
             weights: &weights,
+            start: &start,
             start_lengths,
             params: RefineParams::default(),
             accel_sigma_m: 20.0 / 900.0,

@@ -23,9 +23,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 #[serde(default, deny_unknown_fields)]
 pub struct LiftParams {
     /// Run the global refinement after the per-frame solve (default false: on the synthetic
-    /// suite with true lengths it lowers the error only with 2 px white noise, 63.5 → 61.5 mm,
-    /// and raises it with exact tracks, 20.4 → 21.6 mm, and with the tracker's output,
-    /// 149.6 → 153.6 mm; `bench lift` reports both).
+    /// suite with true lengths it lowers the error by little, 63.5 → 62.2 mm with 2 px white
+    /// noise and 111.2 → 110.8 mm with the tracker's output and leaves exact tracks at
+    /// 20.4 mm, but raises it on the real sample with the reference 2D, 69.2 → 72.8 mm;
+    /// `bench lift` reports both).
     pub refine: bool,
     /// A key-triangle calibration fits when its residual is below this RMS, pixels (default 1).
     pub calibration_tolerance_px: f64,
