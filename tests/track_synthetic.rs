@@ -28,6 +28,16 @@ fn render(dir: &Path, motion: ProceduralMotion, frames: usize, view: View) {
     render_clip(&params, dir, &mut |_, _| {}, &AtomicBool::new(false)).unwrap();
 }
 
+/// A motion-capture file of `tests/data`, from its start.
+fn bundled_bvh(file: &str) -> MotionSource {
+    MotionSource::Bvh {
+        path: Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data")
+            .join(file),
+        start_s: 0.0,
+    }
+}
+
 fn job(marks: &Marks, threads: usize) -> TrackJob {
     TrackJob::from_marks(marks, TrackerParams::default(), threads)
 }
@@ -291,10 +301,7 @@ fn a_bow_from_the_side_keeps_the_pelvis_where_the_hips_are() {
 fn a_running_shank_never_folds_back_onto_its_thigh() {
     let dir = tempfile::tempdir().unwrap();
     let params = SynthParams {
-        motion: MotionSource::Bvh {
-            path: Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/cmu_02_03_run.bvh"),
-            start_s: 0.0,
-        },
+        motion: bundled_bvh("cmu_02_03_run.bvh"),
         frames: 45,
         view: View::Side,
         width: 320,
@@ -336,10 +343,7 @@ fn a_running_shank_never_folds_back_onto_its_thigh() {
 fn a_leg_shortened_where_the_legs_cross_grows_back() {
     let dir = tempfile::tempdir().unwrap();
     let mut params = SynthParams {
-        motion: MotionSource::Bvh {
-            path: Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/cmu_02_01_walk.bvh"),
-            start_s: 0.0,
-        },
+        motion: bundled_bvh("cmu_02_01_walk.bvh"),
         frames: 86,
         view: View::Side,
         person_px: 300.0,
