@@ -2098,6 +2098,34 @@ mod tests {
     /// The tracker's hip patch can be turned off from the Parameters panel, and that is an
     /// undoable project setting.
     #[test]
+    fn the_short_limb_pull_is_set_in_the_tracker_settings() {
+        let dir = tempfile::tempdir().unwrap();
+        let dialogs = PreparedDialogs::default();
+        let mut h = harness(None, &dialogs, &dir.path().join("state"));
+        h.state_mut().project = Some(Project::new(dir.path().join("v.mp4")));
+        h.run();
+        let default = TrackerParams::default().short_penalty;
+        assert_eq!(
+            h.state().project().unwrap().settings.tracker.short_penalty,
+            default
+        );
+        h.get_by_label("Tracker").click();
+        h.run();
+        h.get_by_role_and_label(egui::accesskit::Role::Slider, "keep limbs long")
+            .set_value_accesskit(2.0);
+        h.run();
+        assert_eq!(
+            h.state().project().unwrap().settings.tracker.short_penalty,
+            2.0
+        );
+        h.state_mut().undo();
+        assert_eq!(
+            h.state().project().unwrap().settings.tracker.short_penalty,
+            default
+        );
+    }
+
+    #[test]
     fn the_hip_patch_is_switched_in_the_tracker_settings() {
         let dir = tempfile::tempdir().unwrap();
         let dialogs = PreparedDialogs::default();
