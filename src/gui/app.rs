@@ -2095,43 +2095,40 @@ mod tests {
         wait(&mut h, "the other folder", |a| a.frame_count() == 1);
     }
 
-    /// The tracker's hip patch can be turned off from the Parameters panel, and that is an
-    /// undoable project setting.
+    /// The app on a fresh project (no video) in `dir`, one frame drawn.
+    fn with_project(dir: &Path) -> Harness<'static, App> {
+        let mut h = harness(None, &PreparedDialogs::default(), &dir.join("state"));
+        h.state_mut().project = Some(Project::new(dir.join("v.mp4")));
+        h.run();
+        h
+    }
+
+    /// The pull of short limbs back to full length is set from the Parameters panel, and that
+    /// is an undoable project setting.
     #[test]
     fn the_short_limb_pull_is_set_in_the_tracker_settings() {
         let dir = tempfile::tempdir().unwrap();
-        let dialogs = PreparedDialogs::default();
-        let mut h = harness(None, &dialogs, &dir.path().join("state"));
-        h.state_mut().project = Some(Project::new(dir.path().join("v.mp4")));
-        h.run();
+        let mut h = with_project(dir.path());
+        let pull =
+            |h: &Harness<'static, App>| h.state().project().unwrap().settings.tracker.short_penalty;
         let default = TrackerParams::default().short_penalty;
-        assert_eq!(
-            h.state().project().unwrap().settings.tracker.short_penalty,
-            default
-        );
+        assert_eq!(pull(&h), default);
         h.get_by_label("Tracker").click();
         h.run();
         h.get_by_role_and_label(egui::accesskit::Role::Slider, "keep limbs long")
             .set_value_accesskit(2.0);
         h.run();
-        assert_eq!(
-            h.state().project().unwrap().settings.tracker.short_penalty,
-            2.0
-        );
+        assert_eq!(pull(&h), 2.0);
         h.state_mut().undo();
-        assert_eq!(
-            h.state().project().unwrap().settings.tracker.short_penalty,
-            default
-        );
+        assert_eq!(pull(&h), default);
     }
 
+    /// The tracker's hip patch can be turned off from the Parameters panel, and that is an
+    /// undoable project setting.
     #[test]
     fn the_hip_patch_is_switched_in_the_tracker_settings() {
         let dir = tempfile::tempdir().unwrap();
-        let dialogs = PreparedDialogs::default();
-        let mut h = harness(None, &dialogs, &dir.path().join("state"));
-        h.state_mut().project = Some(Project::new(dir.path().join("v.mp4")));
-        h.run();
+        let mut h = with_project(dir.path());
         assert!(h.state().project().unwrap().settings.tracker.hip_patch);
         h.get_by_label("Tracker").click();
         h.run();
