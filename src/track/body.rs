@@ -17,6 +17,7 @@ use crate::camera::point_in_frame;
 use crate::skeleton::{BodyPart, Joint, PerJoint, Proportions};
 use image::RgbImage;
 use nalgebra::Point2;
+use rayon::prelude::*;
 use std::sync::Arc;
 
 /// The four limb chains: root joint, middle joint, end joint.
@@ -326,24 +327,40 @@ impl BodyTracker {
             self.head_velocity * p.velocity_damping,
             nalgebra::Vector2::zeros(),
         ];
-        let mut found: Option<Found> = None;
-        for (k, d) in starts.iter().enumerate() {
-            if k > 0 && starts[..k].iter().any(|e| (e - d).norm() < p.head_step_px) {
-                continue;
-            }
-            let predicted = MorphBlock {
+        // The starts, less any within a step of an earlier one; the hip patch's spiral (it
+        // starts where the patch was, not from the head) runs beside them.
+        let starts: Vec<MorphBlock> = starts
+            .iter()
+            .enumerate()
+            .filter(|&(k, d)| !starts[..k].iter().any(|e| (e - d).norm() < p.head_step_px))
+            .map(|(_, d)| MorphBlock {
                 origin: self.head.block.origin + d,
                 ..self.head.block
-            };
-            let f = spiral(&self.head.template, frame, &predicted, &spiral_params);
-            if found.is_none_or(|b| f.cost < b.cost) {
-                found = Some(f);
+            })
+            .collect();
+        let head_template = &self.head.template;
+        let search_head = || -> Vec<Found> {
+            let one = |b: &MorphBlock| spiral(head_template, frame, b, &spiral_params);
+            if p.parallel {
+                starts.par_iter().map(one).collect()
+            } else {
+                starts.iter().map(one).collect()
             }
-        }
-        let found = found.unwrap_or(Found {
-            block: self.head.block,
-            cost: f32::INFINITY,
-        });
+        };
+        let search_hips = || p.hip_patch.then(|| self.hips_spiral(frame, &p));
+        let (ends, hips_found) = if p.parallel {
+            rayon::join(search_head, search_hips)
+        } else {
+            (search_head(), search_hips())
+        };
+        // The best end wins; on a tie the earlier start.
+        let found = ends
+            .into_iter()
+            .reduce(|best, f| if f.cost < best.cost { f } else { best })
+            .unwrap_or(Found {
+                block: self.head.block,
+                cost: f32::INFINITY,
+            });
         let moved = found.block.origin - self.head.block.origin;
         self.predictor.adapt(motion.displacement, moved);
         self.head_velocity = moved;
@@ -374,8 +391,8 @@ impl BodyTracker {
             &prior(&self.trunk, &trunk_pred, &p, zoom, 0.0),
         );
         accept(&mut self.trunk, found, frame, &p);
-        if p.hip_patch {
-            self.hips_hold(frame, neck, &p);
+        if let Some(hips_found) = hips_found {
+            self.hips_hold(frame, neck, hips_found, &p);
         }
         let pose_now = self.pose();
 
@@ -416,19 +433,9 @@ fn hip_patch(pelvis: Point2<f64>, theta: f64, trunk_m: f64, trunk_n: f64) -> Mor
 }
 
 impl BodyTracker {
-    /// Beyond the paper: the trunk is one rigid block hung from the neck, so when the spine
-    /// bends (a bow, a reach) the block keeps its angle and the pelvis swings away with the
-    /// neck, while the hips in fact stay. The hip patch, sampled on the key frame, is searched
-    /// by the head's spiral from where it was; when it matches clearly better there than where
-    /// the trunk put the pelvis, the trunk is re-hung from the neck to the patch's centre.
-    fn hips_hold(&mut self, frame: FrameView, neck: Point2<f64>, p: &TrackerParams) {
-        let t = self.trunk.block;
-        let at_trunk = hip_patch(t.end(), t.theta, t.m, t.n);
-        let c_trunk = self
-            .hips
-            .template
-            .cost(frame, &at_trunk, false, f32::INFINITY);
-        let found = spiral(
+    /// The hip patch searched by the head's spiral from where it was (for [`Self::hips_hold`]).
+    fn hips_spiral(&self, frame: FrameView, p: &TrackerParams) -> Found {
+        spiral(
             &self.hips.template,
             frame,
             &self.hips.block,
@@ -438,7 +445,22 @@ impl BodyTracker {
                 d_m: 0.0,
                 max_rings: p.head_max_rings,
             },
-        );
+        )
+    }
+
+    /// Beyond the paper: the trunk is one rigid block hung from the neck, so when the spine
+    /// bends (a bow, a reach) the block keeps its angle and the pelvis swings away with the
+    /// neck, while the hips in fact stay. The hip patch, sampled on the key frame, is searched
+    /// by the head's spiral from where it was (`found`, from [`Self::hips_spiral`]); when it
+    /// matches clearly better there than where the trunk put the pelvis, the trunk is re-hung
+    /// from the neck to the patch's centre.
+    fn hips_hold(&mut self, frame: FrameView, neck: Point2<f64>, found: Found, p: &TrackerParams) {
+        let t = self.trunk.block;
+        let at_trunk = hip_patch(t.end(), t.theta, t.m, t.n);
+        let c_trunk = self
+            .hips
+            .template
+            .cost(frame, &at_trunk, false, f32::INFINITY);
         let centre = found.block.to_image(0.5, 0.0);
         let len = (centre - neck).norm();
         if found.cost + p.hip_margin < c_trunk
