@@ -5,6 +5,7 @@
 use super::block::{MorphBlock, wrap_angle};
 use super::similarity::{FrameView, Template};
 use nalgebra::Vector2;
+use rayon::prelude::*;
 
 /// The best block found and its cost.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -154,23 +155,30 @@ pub fn spiral(
     try_point(predicted.origin, predicted, &mut best);
     for ring in 1..=p.max_rings {
         let r = ring as i64;
-        let mut improved = false;
         // The square ring at Chebyshev distance r, walked clockwise from its top-left corner.
-        for k in 0..(8 * r) {
-            let side = k / (2 * r);
-            let t = k % (2 * r);
-            let (dx, dy) = match side {
-                0 => (-r + t, -r),
-                1 => (r, -r + t),
-                2 => (r - t, r),
-                _ => (-r, r - t),
-            };
-            let o = predicted.origin + Vector2::new(dx as f64, dy as f64) * p.step_px;
-            improved |= try_point(o, predicted, &mut best);
-        }
-        if !improved {
+        // Its points are tried in parallel, each against the best before the ring; the ring's
+        // winner is the first of the lowest, exactly as when walked one by one.
+        let ring_best = (0..(8 * r))
+            .into_par_iter()
+            .map(|k| {
+                let side = k / (2 * r);
+                let t = k % (2 * r);
+                let (dx, dy) = match side {
+                    0 => (-r + t, -r),
+                    1 => (r, -r + t),
+                    2 => (r - t, r),
+                    _ => (-r, r - t),
+                };
+                let o = predicted.origin + Vector2::new(dx as f64, dy as f64) * p.step_px;
+                let mut local = best;
+                try_point(o, predicted, &mut local);
+                local
+            })
+            .reduce(|| best, |a, b| if b.cost < a.cost { b } else { a });
+        if ring_best.cost >= best.cost {
             break;
         }
+        best = ring_best;
     }
     refine(
         template,
