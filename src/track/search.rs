@@ -465,4 +465,101 @@ mod tests {
         let err = (found.block.origin - Point2::new(66.0, 46.0)).norm();
         assert!(err < 1.0, "origin off by {err} px");
     }
+
+    /// The spiral walked one point at a time, as Fig. 6 draws it (no early exit, no threads).
+    fn spiral_in_order(
+        t: &Template,
+        frame: FrameView,
+        predicted: &MorphBlock,
+        p: &SpiralParams,
+    ) -> Found {
+        let mut best = Found {
+            block: *predicted,
+            cost: f32::INFINITY,
+        };
+        let try_point = |o: Point2<f64>, best: &mut Found| {
+            let mut improved = false;
+            for v in variants(
+                &MorphBlock {
+                    origin: o,
+                    ..*predicted
+                },
+                p,
+            ) {
+                let c = t.cost(frame, &v, false, f32::INFINITY);
+                if c < best.cost {
+                    *best = Found { block: v, cost: c };
+                    improved = true;
+                }
+            }
+            improved
+        };
+        try_point(predicted.origin, &mut best);
+        for r in 1..=p.max_rings as i64 {
+            let mut improved = false;
+            for k in 0..(8 * r) {
+                let (side, s) = (k / (2 * r), k % (2 * r));
+                let (dx, dy) = match side {
+                    0 => (-r + s, -r),
+                    1 => (r, -r + s),
+                    2 => (r - s, r),
+                    _ => (-r, r - s),
+                };
+                let o = predicted.origin + Vector2::new(dx as f64, dy as f64) * p.step_px;
+                improved |= try_point(o, &mut best);
+            }
+            if !improved {
+                break;
+            }
+        }
+        refine(
+            t,
+            frame,
+            best,
+            &Steps {
+                position: p.step_px / 2.0,
+                theta: p.d_theta / 2.0,
+                scale: p.d_m / 2.0,
+                scale_width: true,
+                move_origin: true,
+                levels: 3,
+            },
+            &Prior::NONE,
+        )
+    }
+
+    #[test]
+    fn the_parallel_spiral_finds_what_walking_in_order_finds() {
+        let block = MorphBlock::along(Point2::new(60.0, 50.0), Point2::new(70.0, 100.0), 20.0);
+        let a = bar(block.origin, block.end(), 20.0);
+        let t = Template::sample(
+            FrameView::new(&a),
+            &block,
+            Extent::BLOCK,
+            SimilarityWeights::default(),
+        );
+        let p = SpiralParams {
+            step_px: 2.0,
+            d_theta: 0.05,
+            d_m: 0.05,
+            max_rings: 10,
+        };
+        for (k, shift) in [(3.0, -2.0), (9.0, 7.0), (-13.0, 4.0), (0.5, 0.5)]
+            .into_iter()
+            .enumerate()
+        {
+            let d = Vector2::new(shift.0, shift.1);
+            let b = bar(block.origin + d, block.end() + d, 20.0);
+            let expected = spiral_in_order(&t, FrameView::new(&b), &block, &p);
+            for threads in [1, 3] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .expect("a thread pool");
+                let found = pool.install(|| spiral(&t, FrameView::new(&b), &block, &p));
+                assert_eq!(found.block, expected.block, "shift {k}, {threads} threads");
+                assert_eq!(found.cost, expected.cost, "shift {k}, {threads} threads");
+            }
+        }
+    }
 }
