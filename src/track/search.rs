@@ -140,19 +140,22 @@ pub fn spiral(
         block: *predicted,
         cost: f32::INFINITY,
     };
-    let try_point = |origin: nalgebra::Point2<f64>, base: &MorphBlock, best: &mut Found| {
-        let at = MorphBlock { origin, ..*base };
-        let mut improved = false;
-        for v in variants(&at, p) {
+    // The morph variants at one point, each kept if it beats `best`.
+    let try_point = |origin: nalgebra::Point2<f64>, best: &mut Found| {
+        for v in variants(
+            &MorphBlock {
+                origin,
+                ..*predicted
+            },
+            p,
+        ) {
             let c = template.cost(frame, &v, false, best.cost);
             if c < best.cost {
                 *best = Found { block: v, cost: c };
-                improved = true;
             }
         }
-        improved
     };
-    try_point(predicted.origin, predicted, &mut best);
+    try_point(predicted.origin, &mut best);
     for ring in 1..=p.max_rings {
         let r = ring as i64;
         // The square ring at Chebyshev distance r, walked clockwise from its top-left corner.
@@ -171,7 +174,7 @@ pub fn spiral(
                 };
                 let o = predicted.origin + Vector2::new(dx as f64, dy as f64) * p.step_px;
                 let mut local = best;
-                try_point(o, predicted, &mut local);
+                try_point(o, &mut local);
                 local
             })
             .reduce(|| best, |a, b| if b.cost < a.cost { b } else { a });
@@ -180,6 +183,12 @@ pub fn spiral(
         }
         best = ring_best;
     }
+    spiral_refine(template, frame, best, p)
+}
+
+/// The spiral's last step: a local refinement of position, angle and size from the best ring
+/// point, its steps half the spiral's, halved three times.
+fn spiral_refine(template: &Template, frame: FrameView, best: Found, p: &SpiralParams) -> Found {
     refine(
         template,
         frame,
@@ -466,7 +475,8 @@ mod tests {
         assert!(err < 1.0, "origin off by {err} px");
     }
 
-    /// The spiral walked one point at a time, as Fig. 6 draws it (no early exit, no threads).
+    /// The spiral's rings walked one point at a time, as Fig. 6 draws them (no early exit, no
+    /// threads), then the same final refinement.
     fn spiral_in_order(
         t: &Template,
         frame: FrameView,
@@ -512,20 +522,7 @@ mod tests {
                 break;
             }
         }
-        refine(
-            t,
-            frame,
-            best,
-            &Steps {
-                position: p.step_px / 2.0,
-                theta: p.d_theta / 2.0,
-                scale: p.d_m / 2.0,
-                scale_width: true,
-                move_origin: true,
-                levels: 3,
-            },
-            &Prior::NONE,
-        )
+        spiral_refine(t, frame, best, p)
     }
 
     #[test]
