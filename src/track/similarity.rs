@@ -120,7 +120,8 @@ impl<'a> FrameView<'a> {
     }
 
     /// The colour at a point known to lie inside `[0, width − 1) × [0, height − 2)`, as four
-    /// lanes (R, G, B, 0) so the compiler keeps a pixel in one vector register: no clamping,
+    /// lanes (R, G, B and a fourth that callers weight by zero) so the compiler keeps a pixel in
+    /// one vector register: no clamping,
     /// and each pair of neighbouring pixels is one 8-byte load (hence one row of headroom).
     /// `None` when the point is not inside after all.
     #[inline]
@@ -350,8 +351,8 @@ impl Template {
                         r * (w_key[k] * (c[k] - key[k]).abs() + w_ada[k] * (c[k] - ada[k]).abs());
                 }
             }
-            // The fourth lane is zero (zero weight), but summing it keeps all four lanes one
-            // vector operation.
+            // The fourth lane has zero weight, but summing it keeps all four lanes one vector
+            // operation.
             sum += row.iter().sum::<f32>();
             if sum > limit {
                 return f32::INFINITY;
@@ -425,7 +426,7 @@ impl Template {
             f32::INFINITY
         };
         let g = GridGeometry::new(block, self.extent, self.rows, self.cols);
-        // eq. 3's channel weights times the two models' mix, per lane (the fourth lane is 0).
+        // eq. 3's channel weights times the two models' mix, per lane (the fourth weighs 0).
         let [wr, wg, wb] = self.weights.rgb;
         let wk = self.weights.key;
         let wa = 1.0 - wk;
