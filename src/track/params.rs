@@ -61,7 +61,9 @@ pub struct TrackerParams {
     /// Limb and head blocks are this many times the body part's breadth from the proportions,
     /// so their margins (eq. 5's b2) hold the part's outline against the background. Default 1.0.
     pub block_width_scale: f64,
-    /// Track the four limb chains in parallel.
+    /// Search the head's starts beside the hip patch, and the four limb chains, in parallel
+    /// (results are the same either way; a spiral's rings always share the worker threads,
+    /// whose number the job's thread count sets).
     pub parallel: bool,
     /// Track a patch around the hips and re-hang the trunk from the neck to it when it matches
     /// clearly better than where the rigid trunk put the pelvis (a bending spine). Default true.

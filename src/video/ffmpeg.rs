@@ -419,7 +419,7 @@ impl FfmpegSource {
 }
 
 /// What a converter converts: source pixel format and size, output size.
-type ScalerKey = (ff::format::Pixel, u32, u32, u32, u32);
+type ConverterKey = (ff::format::Pixel, u32, u32, u32, u32);
 
 /// Decoded frames to RGB24 at the output size. A smaller output is shrunk in the decoder's own
 /// pixel format first and then converted at its size: FFmpeg's planar scaling and its unscaled
@@ -429,7 +429,7 @@ type ScalerKey = (ff::format::Pixel, u32, u32, u32, u32);
 /// interpolating it; shrinking to 4:4:4 first would interpolate, but is no faster than one step.
 struct Converter {
     /// Source format, source size, output size.
-    key: ScalerKey,
+    key: ConverterKey,
     /// The shrinking stage and its output frame (reused), when the output is smaller.
     shrink: Option<(ff::software::scaling::Context, ff::frame::Video)>,
     /// To RGB24 at the output size.
@@ -437,7 +437,7 @@ struct Converter {
 }
 
 impl Converter {
-    fn new(key: ScalerKey) -> Result<Converter, ff::Error> {
+    fn new(key: ConverterKey) -> Result<Converter, ff::Error> {
         use ff::software::scaling::{Context, Flags};
         let (fmt, sw, sh, w, h) = key;
         let shrink = if (w, h) != (sw, sh) {
