@@ -18,8 +18,9 @@ use videomocap::eval::pose3d::{
 };
 use videomocap::formats::{Marks, Tracks2d};
 use videomocap::lift::focal::estimate_focal;
+use videomocap::lift::key_shape::subject_from_height;
 use videomocap::lift::{LiftJob, LiftParams, lift, lift_per_frame};
-use videomocap::skeleton::{Proportions, SubjectModel};
+use videomocap::skeleton::SubjectModel;
 use videomocap::synth::GroundTruth;
 use videomocap::track::TrackerParams;
 use videomocap::video::{OpenOptions, Video};
@@ -86,12 +87,13 @@ fn run_clip(
         tracks_from_truth(&gt, 2.0, 7),
         tracked,
     ];
-    let subjects = [
-        subject_from_truth(&gt),
-        SubjectModel::from_height(stature_from_truth(&gt), Proportions::default())
-            .map_err(ExitError::failed)?,
-    ];
     for (i, tracks) in inputs.iter().enumerate() {
+        let subjects = [
+            subject_from_truth(&gt),
+            subject_from_height(stature_from_truth(&gt), tracks)
+                .map_err(ExitError::failed)?
+                .0,
+        ];
         for (l, subject) in subjects.iter().enumerate() {
             lift_case(&gt, tracks, subject.clone(), params, &mut cases[i][l])?;
         }
@@ -173,8 +175,8 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             }
         }
         let tracks = tracks_from_truth(&gt, 0.0, 1);
-        let subject = SubjectModel::from_height(stature_from_truth(&gt), Proportions::default())
-            .map_err(ExitError::failed)?;
+        let (subject, _) =
+            subject_from_height(stature_from_truth(&gt), &tracks).map_err(ExitError::failed)?;
         let job = LiftJob {
             tracks: &tracks,
             camera: gt.camera(),

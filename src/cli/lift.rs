@@ -8,8 +8,9 @@ use std::sync::atomic::AtomicBool;
 use videomocap::camera::PinholeCamera;
 use videomocap::formats::Tracks2d;
 use videomocap::lift::focal::{DEFAULT_FOV_LONG_SIDE_DEG, default_focal, estimate_focal};
+use videomocap::lift::key_shape::subject_from_height;
 use videomocap::lift::{FrameFlag, LiftError, LiftJob, LiftOutput, LiftParams, lift};
-use videomocap::skeleton::{DEFAULT_HEIGHT_M, Proportions, SubjectModel};
+use videomocap::skeleton::DEFAULT_HEIGHT_M;
 
 /// Checks the camera and subject options before any work.
 pub fn check_options(o: &LiftOptions) -> Result<(), ExitError> {
@@ -69,11 +70,17 @@ pub fn lift_with_progress(
         Some(p) => load_settings(p)?,
         None => LiftParams::default(),
     };
-    let subject = SubjectModel::from_height(
-        o.height_m.unwrap_or(DEFAULT_HEIGHT_M),
-        Proportions::default(),
-    )
-    .map_err(ExitError::bad_input)?;
+    let (subject, drop) = subject_from_height(o.height_m.unwrap_or(DEFAULT_HEIGHT_M), tracks)
+        .map_err(ExitError::bad_input)?;
+    if let Some(d) = drop {
+        say(
+            global,
+            &format!(
+                "key triangle: the chest {:.3} of the trunk below the shoulders, read from {} frames (the proportions table has {:.3})",
+                d.measured, d.frames, d.model
+            ),
+        );
+    }
     let (w, h) = (tracks.source.width, tracks.source.height);
     let mut job = LiftJob {
         tracks,

@@ -8,8 +8,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, channel};
 use std::time::Instant;
 use videomocap::formats::{FrameTracks, Tracks2d};
+use videomocap::lift::key_shape::subject_from_height;
 use videomocap::lift::{DepthOverrides, LiftJob, LiftOutput, LiftParams, lift};
-use videomocap::skeleton::{Proportions, SubjectModel};
 use videomocap::track::{TrackJob, TrackOutput, track_video};
 use videomocap::video::{OpenOptions, Video};
 use videomocap::volume::{Processed, VolumeParams, process_directory};
@@ -87,9 +87,9 @@ impl Job {
         let cancel = Arc::new(AtomicBool::new(false));
         let flag = cancel.clone();
         std::thread::spawn(move || {
-            let result = SubjectModel::from_height(height_m, Proportions::default())
+            let result = subject_from_height(height_m, &tracks)
                 .map_err(|e| e.to_string())
-                .and_then(|subject| {
+                .and_then(|(subject, _)| {
                     let camera = videomocap::camera::PinholeCamera::centred(
                         focal_px,
                         tracks.source.width,
