@@ -18,9 +18,9 @@ use videomocap::eval::pose3d::{
 };
 use videomocap::formats::{Marks, Tracks2d};
 use videomocap::lift::focal::estimate_focal;
-use videomocap::lift::key_shape::subject_from_height;
+use videomocap::lift::subject_fit::subject_from_height;
 use videomocap::lift::{LiftJob, LiftParams, lift, lift_per_frame};
-use videomocap::skeleton::SubjectModel;
+use videomocap::skeleton::{Proportions, SubjectModel};
 use videomocap::synth::GroundTruth;
 use videomocap::track::TrackerParams;
 use videomocap::video::{OpenOptions, Video};
@@ -175,8 +175,9 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             }
         }
         let tracks = tracks_from_truth(&gt, 0.0, 1);
-        let (subject, _) =
-            subject_from_height(stature_from_truth(&gt), &tracks).map_err(ExitError::failed)?;
+        // The table's lengths, as `lift --estimate-focal` uses them.
+        let subject = SubjectModel::from_height(stature_from_truth(&gt), Proportions::default())
+            .map_err(ExitError::failed)?;
         let job = LiftJob {
             tracks: &tracks,
             camera: gt.camera(),

@@ -8,9 +8,9 @@ use std::sync::atomic::AtomicBool;
 use videomocap::camera::PinholeCamera;
 use videomocap::formats::Tracks2d;
 use videomocap::lift::focal::{DEFAULT_FOV_LONG_SIDE_DEG, default_focal, estimate_focal};
-use videomocap::lift::key_shape::subject_from_height;
+use videomocap::lift::subject_fit::{SubjectFit, fit_to_tracks};
 use videomocap::lift::{FrameFlag, LiftError, LiftJob, LiftOutput, LiftParams, lift};
-use videomocap::skeleton::DEFAULT_HEIGHT_M;
+use videomocap::skeleton::{DEFAULT_HEIGHT_M, Proportions, SubjectModel};
 
 /// Checks the camera and subject options before any work.
 pub fn check_options(o: &LiftOptions) -> Result<(), ExitError> {
@@ -58,6 +58,34 @@ fn lift_error(source: &Path, e: LiftError) -> ExitError {
     }
 }
 
+/// One line on what the subject model took from the tracks.
+fn fit_summary(fit: &SubjectFit) -> String {
+    let mut parts = Vec::new();
+    if let Some(d) = fit.chest_drop {
+        parts.push(format!(
+            "the chest {:.3} of the trunk below the shoulders ({} frames; the table has {:.3})",
+            d.measured, d.frames, d.model
+        ));
+    }
+    if !fit.limbs.is_empty() {
+        let limbs: Vec<String> = fit
+            .limbs
+            .iter()
+            .map(|(name, f)| format!("{name} ×{f:.2}"))
+            .collect();
+        parts.push(format!("against the table {}", limbs.join(", ")));
+    }
+    if parts.is_empty() {
+        return "subject: the proportions table (the tracks showed too little to read more)"
+            .to_owned();
+    }
+    format!(
+        "subject read from the tracks: {}; then every length ×{:.3} to keep the height",
+        parts.join("; "),
+        fit.stature_scale
+    )
+}
+
 /// Lifts tracks with the options' camera and subject, with progress; shared by `lift` and `run`.
 /// `source` names the tracks (or the video they came from) in errors.
 pub fn lift_with_progress(
@@ -70,17 +98,13 @@ pub fn lift_with_progress(
         Some(p) => load_settings(p)?,
         None => LiftParams::default(),
     };
-    let (subject, drop) = subject_from_height(o.height_m.unwrap_or(DEFAULT_HEIGHT_M), tracks)
-        .map_err(ExitError::bad_input)?;
-    if let Some(d) = drop {
-        say(
-            global,
-            &format!(
-                "key triangle: the chest {:.3} of the trunk below the shoulders, read from {} frames (the proportions table has {:.3})",
-                d.measured, d.frames, d.model
-            ),
-        );
-    }
+    let table = SubjectModel::from_height(
+        o.height_m.unwrap_or(DEFAULT_HEIGHT_M),
+        Proportions::default(),
+    )
+    .map_err(ExitError::bad_input)?;
+    let (subject, fit) = fit_to_tracks(&table, tracks);
+    say(global, &fit_summary(&fit));
     let (w, h) = (tracks.source.width, tracks.source.height);
     let mut job = LiftJob {
         tracks,
@@ -95,7 +119,12 @@ pub fn lift_with_progress(
         job.camera.focal_px = PinholeCamera::focal_from_horizontal_fov(fov, w);
     } else if o.estimate_focal {
         say(global, "estimating the focal length …");
-        let est = estimate_focal(&job).map_err(|e| lift_error(source, e))?;
+        // On the table's lengths: see `estimate_focal`.
+        let table_job = LiftJob {
+            subject: table,
+            ..job.clone()
+        };
+        let est = estimate_focal(&table_job).map_err(|e| lift_error(source, e))?;
         job.camera.focal_px = est.focal_px;
         let fov = 2.0 * (f64::from(w) / 2.0 / est.focal_px).atan().to_degrees();
         say(

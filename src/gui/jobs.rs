@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, channel};
 use std::time::Instant;
 use videomocap::formats::{FrameTracks, Tracks2d};
-use videomocap::lift::key_shape::subject_from_height;
+use videomocap::lift::subject_fit::subject_from_height;
 use videomocap::lift::{DepthOverrides, LiftJob, LiftOutput, LiftParams, lift};
 use videomocap::track::{TrackJob, TrackOutput, track_video};
 use videomocap::video::{OpenOptions, Video};

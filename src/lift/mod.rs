@@ -8,8 +8,8 @@
 //! length from its parent ([`backproject`]); the two roots of each bone are chosen over the
 //! whole sequence ([`ambiguity`]); a global least-squares pass ([`refine`]) then adjusts all
 //! frames and the bone lengths together. [`focal`] estimates an unknown focal length;
-//! [`key_shape`] reads the key triangle's height from the tracks when only the subject's height
-//! is known.
+//! [`subject_fit`] fits the key triangle and the limbs to the tracks when only the subject's
+//! height is known.
 //! Its input is [`crate::formats::Tracks2d`], its output [`crate::formats::Skeleton3d`].
 
 pub mod ambiguity;
@@ -17,12 +17,12 @@ pub mod backproject;
 pub mod calibrate;
 mod error;
 pub mod focal;
-pub mod key_shape;
 mod newton;
 pub mod propagate;
 pub mod refine;
 pub mod smoothing;
 mod solve;
+pub mod subject_fit;
 
 pub use ambiguity::{AmbiguityWeights, DepthOverrides};
 pub use backproject::Root;
