@@ -8,7 +8,7 @@ use std::sync::atomic::AtomicBool;
 use videomocap::camera::PinholeCamera;
 use videomocap::formats::Tracks2d;
 use videomocap::lift::focal::{DEFAULT_FOV_LONG_SIDE_DEG, default_focal, estimate_focal};
-use videomocap::lift::subject_fit::{SubjectFit, fit_to_tracks};
+use videomocap::lift::subject_fit::fit_to_tracks;
 use videomocap::lift::{FrameFlag, LiftError, LiftJob, LiftOutput, LiftParams, lift};
 use videomocap::skeleton::{DEFAULT_HEIGHT_M, Proportions, SubjectModel};
 
@@ -58,34 +58,6 @@ fn lift_error(source: &Path, e: LiftError) -> ExitError {
     }
 }
 
-/// One line on what the subject model took from the tracks.
-fn fit_summary(fit: &SubjectFit) -> String {
-    let mut parts = Vec::new();
-    if let Some(d) = fit.chest_drop {
-        parts.push(format!(
-            "the chest {:.3} of the trunk below the shoulders ({} frames; the table has {:.3})",
-            d.measured, d.frames, d.model
-        ));
-    }
-    if !fit.limbs.is_empty() {
-        let limbs: Vec<String> = fit
-            .limbs
-            .iter()
-            .map(|(name, f)| format!("{name} ×{f:.2}"))
-            .collect();
-        parts.push(format!("against the table {}", limbs.join(", ")));
-    }
-    if parts.is_empty() {
-        return "subject: the proportions table (the tracks showed too little to read more)"
-            .to_owned();
-    }
-    format!(
-        "subject read from the tracks: {}; then every length ×{:.3} to keep the height",
-        parts.join("; "),
-        fit.stature_scale
-    )
-}
-
 /// Lifts tracks with the options' camera and subject, with progress; shared by `lift` and `run`.
 /// `source` names the tracks (or the video they came from) in errors.
 pub fn lift_with_progress(
@@ -104,7 +76,7 @@ pub fn lift_with_progress(
     )
     .map_err(ExitError::bad_input)?;
     let (subject, fit) = fit_to_tracks(&table, tracks);
-    say(global, &fit_summary(&fit));
+    say(global, &fit.to_string());
     let (w, h) = (tracks.source.width, tracks.source.height);
     let mut job = LiftJob {
         tracks,

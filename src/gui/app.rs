@@ -127,6 +127,8 @@ pub struct App {
     /// Depth-root choices of recent lifts, keyed by the skeleton they produced (so that undo
     /// and redo, which bring back an earlier skeleton, find its choices).
     choices: Vec<(Arc<Skeleton3d>, Vec<[Root; BONE_COUNT]>)>,
+    /// What the last lift read of the subject from the tracks (shown under the height).
+    subject_fit: Option<String>,
     world: Option<WorldSkeleton>,
     playing: bool,
     play_time: f64,
@@ -187,6 +189,7 @@ impl App {
             show_help: false,
             recent: Vec::new(),
             status: "Open a video with File > Open video (or drop one here)".to_owned(),
+            subject_fit: None,
             volume: None,
             dirty: false,
             pending_open: None,
@@ -970,10 +973,19 @@ impl App {
         }
     }
 
-    fn lifted(&mut self, result: Result<videomocap::lift::LiftOutput, String>) {
+    fn lifted(
+        &mut self,
+        result: Result<
+            (
+                videomocap::lift::LiftOutput,
+                videomocap::lift::subject_fit::SubjectFit,
+            ),
+            String,
+        >,
+    ) {
         let Some(r) = self.running.take() else { return };
         match result {
-            Ok(out) => {
+            Ok((out, fit)) => {
                 let same = self
                     .project
                     .as_ref()
@@ -982,6 +994,7 @@ impl App {
                     self.status = "Lift finished for an older edit; result dropped".to_owned();
                     return;
                 }
+                self.subject_fit = Some(fit.to_string());
                 let skeleton = Arc::new(out.skeleton);
                 self.choices.push((skeleton.clone(), out.choices));
                 if self.choices.len() > 16 {
@@ -1275,7 +1288,10 @@ impl App {
             .on_hover_text(format!("Focal length in pixels; default {default_f:.0} px"));
             settings.focal_px = given.then_some(f);
             ui.add(egui::Slider::new(&mut settings.height_m, 1.0..=2.3).text("subject height (m)"))
-                .on_hover_text("The subject's stature: scales every bone length (default 1.70 m). The 3D skeleton's size and depth follow it.");
+                .on_hover_text("The subject's stature: scales every bone length (default 1.70 m). The 3D skeleton's size and depth follow it. The chest's place below the shoulders and the limbs' lengths are then read from the tracks.");
+            if let Some(fit) = &self.subject_fit {
+                ui.label(egui::RichText::new(fit).small().weak());
+            }
             ui.collapsing("Tracker", |ui| {
                 let t = &mut settings.tracker;
                 let d = TrackerParams::default();
@@ -1974,6 +1990,13 @@ mod tests {
                 .frames
                 .len(),
             60
+        );
+        // The Parameters panel says what the lift read of the subject from the tracks.
+        h.step();
+        assert!(
+            h.query_by_label_contains("subject read from the tracks: the chest")
+                .is_some(),
+            "no subject line under the height"
         );
 
         // Scrub.

@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, channel};
 use std::time::Instant;
 use videomocap::formats::{FrameTracks, Tracks2d};
-use videomocap::lift::subject_fit::subject_from_height;
+use videomocap::lift::subject_fit::{SubjectFit, subject_from_height};
 use videomocap::lift::{DepthOverrides, LiftJob, LiftOutput, LiftParams, lift};
 use videomocap::track::{TrackJob, TrackOutput, track_video};
 use videomocap::video::{OpenOptions, Video};
@@ -26,7 +26,7 @@ pub enum JobEvent {
     /// Tracking finished.
     Tracked(Result<TrackOutput, String>),
     /// Lifting finished.
-    Lifted(Result<LiftOutput, String>),
+    Lifted(Result<(LiftOutput, SubjectFit), String>),
     /// A point-volume sequence was processed.
     Volume(Result<Processed, String>),
 }
@@ -89,7 +89,7 @@ impl Job {
         std::thread::spawn(move || {
             let result = subject_from_height(height_m, &tracks)
                 .map_err(|e| e.to_string())
-                .and_then(|(subject, _)| {
+                .and_then(|(subject, fit)| {
                     let camera = videomocap::camera::PinholeCamera::centred(
                         focal_px,
                         tracks.source.width,
@@ -113,7 +113,9 @@ impl Job {
                         });
                         repaint.request_repaint();
                     };
-                    lift(&job, &mut progress, &flag).map_err(|e| e.to_string())
+                    lift(&job, &mut progress, &flag)
+                        .map(|out| (out, fit))
+                        .map_err(|e| e.to_string())
                 });
             let _ = tx.send(JobEvent::Lifted(result));
             ctx.request_repaint();

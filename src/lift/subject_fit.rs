@@ -31,6 +31,7 @@ use super::smoothing::{adaptive_sigmas, smoothed_images};
 use crate::formats::{PointSource, Tracks2d};
 use crate::skeleton::{Bone, Joint, PerJoint, Proportions, ProportionsError, SubjectModel};
 use nalgebra::Point2;
+use std::fmt;
 
 /// A trunk shorter than this in the image (pixels) is not measured.
 const MIN_TRUNK_PX: f64 = 10.0;
@@ -102,6 +103,38 @@ pub struct SubjectFit {
     pub limbs: Vec<(&'static str, f64)>,
     /// The factor applied to every length to keep the stature.
     pub stature_scale: f64,
+}
+
+impl fmt::Display for SubjectFit {
+    /// One line for the user: what was read, against the table.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mut parts = Vec::new();
+        if let Some(d) = self.chest_drop {
+            parts.push(format!(
+                "the chest {:.3} of the trunk below the shoulders ({} frames; the table has {:.3})",
+                d.measured, d.frames, d.model
+            ));
+        }
+        if !self.limbs.is_empty() {
+            let limbs: Vec<String> = self
+                .limbs
+                .iter()
+                .map(|(name, factor)| format!("{name} ×{factor:.2}"))
+                .collect();
+            parts.push(format!("against the table {}", limbs.join(", ")));
+        }
+        if parts.is_empty() {
+            return f.write_str(
+                "subject: the proportions table (the tracks showed too little to read more)",
+            );
+        }
+        write!(
+            f,
+            "subject read from the tracks: {}; then every length ×{:.3} to keep the height",
+            parts.join("; "),
+            self.stature_scale
+        )
+    }
 }
 
 /// The chest's perpendicular distance from the shoulder line in the subject model, metres, and
