@@ -428,10 +428,12 @@ impl App {
         self.preview = false;
         self.texture = None;
         self.marking = None;
+        self.subject_fit = None;
     }
 
     fn set_project(&mut self, p: Project) {
         self.project = Some(p);
+        self.subject_fit = None;
         self.history.clear();
         self.results_changed();
     }
