@@ -435,3 +435,47 @@ fn a_subject_fitted_to_the_tracks_beats_the_table_for_a_different_build() {
         "table {with_table:.1} mm, read from the tracks {with_fit:.1} mm, true lengths {exact:.1} mm"
     );
 }
+
+#[test]
+fn smoothing_the_key_depths_steadies_the_key_triangle_on_noisy_tracks() {
+    // 2 px noise: eqs. 10–11 turn the noise the 2D smoothing leaves into depth jitter of the
+    // shoulders and chest; smoothing their depths again (×2 the tracks' width, the default)
+    // cuts it.
+    let (gt, subject) = truth();
+    let tracks = tracks_from_truth(&gt, 2.0, 3);
+    // The key joints' jitter: their second differences over the frames against the truth's.
+    let key_jitter = |factor: f64| {
+        let job = LiftJob {
+            tracks: &tracks,
+            camera: camera(),
+            subject: subject.clone(),
+            params: LiftParams {
+                key_depth_smoothing: factor,
+                ..LiftParams::default()
+            },
+            overrides: DepthOverrides::new(),
+        };
+        let per = lift_per_frame(&job).unwrap();
+        let p = &per.resolved.points;
+        let truth: Vec<_> = gt.frames.iter().map(|g| g.points3d()).collect();
+        let mut sum = 0.0;
+        for t in 1..FRAMES - 1 {
+            for j in [Joint::LeftShoulder, Joint::RightShoulder, Joint::Chest] {
+                let d2 = |q: &dyn Fn(usize) -> Point3<f64>| {
+                    q(t + 1).coords - q(t).coords * 2.0 + q(t - 1).coords
+                };
+                sum += (d2(&|u| p[u][j]) - d2(&|u| truth[u][j])).norm();
+            }
+        }
+        1000.0 * sum / (3 * (FRAMES - 2)) as f64
+    };
+    let (off, on) = (
+        key_jitter(0.0),
+        key_jitter(LiftParams::default().key_depth_smoothing),
+    );
+    // Measured: 9.5 → 1.6 mm per frame.
+    assert!(
+        on < 0.5 * off,
+        "key joints' jitter {off:.1} mm unsmoothed, {on:.1} mm smoothed"
+    );
+}

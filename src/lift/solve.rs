@@ -7,9 +7,9 @@ use super::calibrate::{
     KEY_JOINTS, KeyTriangle, Residuals, calibrate_all, calibrate_from, shape, starting_poses,
 };
 use super::error::LiftError;
-use super::propagate::key_depths;
+use super::propagate::{depth_ray, key_depths};
 use super::refine::{RefineParams, RefineSummary, refine};
-use super::smoothing::{adaptive_sigmas, smoothed_images};
+use super::smoothing::{adaptive_sigmas, gaussian_mean, smoothed_images};
 use crate::camera::PinholeCamera;
 use crate::formats::{Frame3d, PointSource, Skeleton3d, Tracks2d};
 use crate::skeleton::{BONE_COUNT, Bone, Joint, PerJoint, SubjectModel};
@@ -23,9 +23,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 #[serde(default, deny_unknown_fields)]
 pub struct LiftParams {
     /// Run the global refinement after the per-frame solve (default false: on the synthetic
-    /// suite with true lengths it lowers the error by little, 63.5 → 62.2 mm with 2 px white
-    /// noise and 111.2 → 110.8 mm with the tracker's output and leaves exact tracks at
-    /// 20.4 mm, but raises it on the real sample with the reference 2D, 69.2 → 72.8 mm;
+    /// suite with true lengths it lowers the error by little, 55.7 → 54.6 mm with 2 px white
+    /// noise and 111.9 → 111.5 mm with the tracker's output and leaves exact tracks at
+    /// 20.0 mm, but raises it on the real sample with the reference 2D, 69.0 → 72.6 mm;
     /// `bench lift` reports both).
     pub refine: bool,
     /// A key-triangle calibration fits when its residual is below this RMS, pixels (default 1).
@@ -44,6 +44,15 @@ pub struct LiftParams {
     /// white noise 162 → 77.5 mm, exact tracks 31.1 → 31.1 mm, the tracker's output
     /// 151.5 → 157.7 mm (its errors are drift and jumps more than white noise).
     pub adaptive_smoothing: bool,
+    /// After the key triangle's path is chosen, each key joint's depth is smoothed over time
+    /// by a Gaussian this many times its 2D track's width (default 2; 0 = off), and the joint
+    /// put back on its viewing ray at that depth. Eqs. 10–11 amplify what 2D noise the
+    /// smoothing left (a near-frontal triangle's tilt goes as the square root of its side
+    /// errors), so depth wants a wider window than the image. On the synthetic suite with true
+    /// lengths, per-frame MPJPE with 2 px noise / exact tracks / the real sample's reference
+    /// 2D: off 63.5 / 20.4 / 69.2 mm; ×0.5 61.5 / 20.3 / 69.2; ×1 60.7 / 20.5 / 69.2;
+    /// ×2 55.7 / 20.0 / 69.0; ×3 55.5 / 19.9 / 68.9; ×4 55.5 / 20.1 / 70.9 mm.
+    pub key_depth_smoothing: f64,
     /// Weights of the depth-ambiguity priors.
     pub ambiguity: AmbiguityWeights,
     /// Weights of the global refinement.
@@ -58,6 +67,7 @@ impl Default for LiftParams {
             propagation_tolerance_m: 0.005,
             smoothing_s: 0.0,
             adaptive_smoothing: true,
+            key_depth_smoothing: 2.0,
             ambiguity: AmbiguityWeights::default(),
             refinement: RefineParams::default(),
         }
@@ -264,7 +274,13 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
         let mut candidates: Vec<Vec<[Point3<f64>; 3]>> =
             per_frame.iter().map(|(k, _)| k.clone()).collect();
         candidates[calibration_frame] = vec![key_of(&c.pose)];
-        let key = smoothest_key_path(&candidates);
+        let mut key = smoothest_key_path(&candidates);
+        smooth_key_depths(
+            &mut key,
+            &images,
+            cam,
+            &sigma.map(|_, s| s * job.params.key_depth_smoothing),
+        );
         let mut reports: Vec<FrameReport> = tracks
             .frames
             .iter()
@@ -369,6 +385,29 @@ fn key_candidates(
         }
     }
     (out, converged)
+}
+
+/// Smooths each key joint's depth over the frames by a Gaussian of `sigma[joint]` frames and
+/// puts the joint back on its viewing ray (through `images`) at the smoothed depth.
+fn smooth_key_depths(
+    key: &mut [[Point3<f64>; 3]],
+    images: &[PerJoint<Point2<f64>>],
+    cam: &PinholeCamera,
+    sigma: &PerJoint<f64>,
+) {
+    let n = key.len();
+    for (i, &joint) in KEY_JOINTS.iter().enumerate() {
+        let s = sigma[joint];
+        // As in `smoothed_images`: below a third of a frame, untouched.
+        if s < 0.3 {
+            continue;
+        }
+        let depth: Vec<f64> = key.iter().map(|k| k[i].z).collect();
+        for (t, k) in key.iter_mut().enumerate() {
+            let z = gaussian_mean(t, n, s, 0.0, |u| (depth[u], 1.0));
+            k[i] = Point3::from(depth_ray(cam, &images[t][joint]) * z);
+        }
+    }
 }
 
 /// Squared acceleration of the key joints over three frames.
