@@ -5,6 +5,7 @@ use nalgebra::{Point3, Rotation3, Vector3};
 use std::sync::atomic::AtomicBool;
 use videomocap::camera::PinholeCamera;
 use videomocap::eval::pose3d::{score_skeleton, tracks_from_truth};
+use videomocap::formats::Tracks2d;
 use videomocap::lift::ambiguity::lift_order;
 use videomocap::lift::backproject::bone_roots;
 use videomocap::lift::calibrate::KeyTriangle;
@@ -20,6 +21,17 @@ const FRAMES: usize = 60;
 
 fn camera() -> PinholeCamera {
     PinholeCamera::centred(700.0, 640, 480)
+}
+
+/// A lift of `tracks` through [`camera`], with no forced roots.
+fn job_for<'a>(tracks: &'a Tracks2d, subject: &SubjectModel, params: LiftParams) -> LiftJob<'a> {
+    LiftJob {
+        tracks,
+        camera: camera(),
+        subject: subject.clone(),
+        params,
+        overrides: DepthOverrides::new(),
+    }
 }
 
 /// A walking-like sequence of the default subject, turning slowly in front of the camera.
@@ -130,19 +142,14 @@ fn truth_of(s: SubjectModel) -> (GroundTruth, SubjectModel) {
 
 fn run(gt: &GroundTruth, subject: &SubjectModel, noise: f64, refine: bool) -> LiftOutput {
     let tracks = tracks_from_truth(gt, noise, 3);
-    let job = LiftJob {
-        tracks: &tracks,
-        camera: camera(),
-        subject: subject.clone(),
-        params: LiftParams {
-            refine,
-            // Exact tracks: no temporal smoothing, so the geometry must be exact; noisy ones
-            // get the adaptive smoothing of the default settings.
-            adaptive_smoothing: noise > 0.0,
-            ..LiftParams::default()
-        },
-        overrides: DepthOverrides::new(),
+    let params = LiftParams {
+        refine,
+        // Exact tracks: no temporal smoothing, so the geometry must be exact; noisy ones get
+        // the adaptive smoothing of the default settings.
+        adaptive_smoothing: noise > 0.0,
+        ..LiftParams::default()
     };
+    let job = job_for(&tracks, subject, params);
     lift(&job, &mut |_| {}, &AtomicBool::new(false)).unwrap()
 }
 
@@ -412,16 +419,11 @@ fn a_subject_fitted_to_the_tracks_beats_the_table_for_a_different_build() {
     let drop = fit.chest_drop.unwrap();
     assert!((drop.measured - 0.335).abs() < 0.01, "{drop:?}");
     let error = |subject: &SubjectModel| {
-        let job = LiftJob {
-            tracks: &tracks,
-            camera: camera(),
-            subject: subject.clone(),
-            params: LiftParams {
-                adaptive_smoothing: false,
-                ..LiftParams::default()
-            },
-            overrides: DepthOverrides::new(),
+        let params = LiftParams {
+            adaptive_smoothing: false,
+            ..LiftParams::default()
         };
+        let job = job_for(&tracks, subject, params);
         let out = lift(&job, &mut |_| {}, &AtomicBool::new(false)).unwrap();
         score_skeleton(&gt, &out.skeleton).unwrap().mpjpe_mm()
     };
@@ -445,16 +447,11 @@ fn smoothing_the_key_depths_steadies_the_key_triangle_on_noisy_tracks() {
     let tracks = tracks_from_truth(&gt, 2.0, 3);
     // The key joints' jitter: their second differences over the frames against the truth's.
     let key_jitter = |factor: f64| {
-        let job = LiftJob {
-            tracks: &tracks,
-            camera: camera(),
-            subject: subject.clone(),
-            params: LiftParams {
-                key_depth_smoothing: factor,
-                ..LiftParams::default()
-            },
-            overrides: DepthOverrides::new(),
+        let params = LiftParams {
+            key_depth_smoothing: factor,
+            ..LiftParams::default()
         };
+        let job = job_for(&tracks, &subject, params);
         let per = lift_per_frame(&job).unwrap();
         let p = &per.resolved.points;
         let truth: Vec<_> = gt.frames.iter().map(|g| g.points3d()).collect();

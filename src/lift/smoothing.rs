@@ -54,9 +54,13 @@ pub fn adaptive_sigma(noise_px: f64, motion_px: f64) -> f64 {
     (WIDTH_FACTOR * s5.powf(0.2)).min(MAX_ADAPTIVE_SIGMA)
 }
 
+/// A Gaussian narrower than this (frames) leaves a series as it is: its neighbours would weigh
+/// less than 1e-4.
+pub const UNTOUCHED_BELOW: f64 = 0.3;
+
 /// The Gaussian mean of `n` samples around sample `t`, `s` wide (in samples): `sample(u)` gives
 /// sample `u`'s value and its own weight (which multiplies the Gaussian's).
-pub fn gaussian_mean<V>(
+pub(crate) fn gaussian_mean<V>(
     t: usize,
     n: usize,
     s: f64,
@@ -92,8 +96,7 @@ pub fn smoothed_images(tracks: &Tracks2d, sigma: &PerJoint<f64>) -> Vec<PerJoint
         .map(|t| {
             PerJoint::from_fn(|j| {
                 let s = sigma[j];
-                // Below a third of a frame the neighbours weigh less than 1e-4: untouched.
-                if s < 0.3 {
+                if s < UNTOUCHED_BELOW {
                     return raw[t][j];
                 }
                 Point2::from(gaussian_mean(t, n, s, Vector2::zeros(), |u| {

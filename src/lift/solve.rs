@@ -9,7 +9,7 @@ use super::calibrate::{
 use super::error::LiftError;
 use super::propagate::{depth_ray, key_depths};
 use super::refine::{RefineParams, RefineSummary, refine};
-use super::smoothing::{adaptive_sigmas, gaussian_mean, smoothed_images};
+use super::smoothing::{UNTOUCHED_BELOW, adaptive_sigmas, gaussian_mean, smoothed_images};
 use crate::camera::PinholeCamera;
 use crate::formats::{Frame3d, PointSource, Skeleton3d, Tracks2d};
 use crate::skeleton::{BONE_COUNT, Bone, Joint, PerJoint, SubjectModel};
@@ -398,8 +398,7 @@ fn smooth_key_depths(
     let n = key.len();
     for (i, &joint) in KEY_JOINTS.iter().enumerate() {
         let s = sigma[joint];
-        // As in `smoothed_images`: below a third of a frame, untouched.
-        if s < 0.3 {
+        if s < UNTOUCHED_BELOW {
             continue;
         }
         let depth: Vec<f64> = key.iter().map(|k| k[i].z).collect();
