@@ -441,8 +441,8 @@ fn a_subject_fitted_to_the_tracks_beats_the_table_for_a_different_build() {
 #[test]
 fn smoothing_the_key_depths_steadies_the_key_triangle_on_noisy_tracks() {
     // 2 px noise: eqs. 10–11 turn the noise the 2D smoothing leaves into depth jitter of the
-    // shoulders and chest; smoothing their depths again (×2 the tracks' width, the default)
-    // cuts it.
+    // shoulders and chest; smoothing their depths again (×2 the tracks' width) cuts it, and
+    // the key triangle keeps its sides.
     let (gt, subject) = truth();
     let tracks = tracks_from_truth(&gt, 2.0, 3);
     // The key joints' jitter: their second differences over the frames against the truth's.
@@ -454,6 +454,12 @@ fn smoothing_the_key_depths_steadies_the_key_triangle_on_noisy_tracks() {
         let job = job_for(&tracks, &subject, params);
         let per = lift_per_frame(&job).unwrap();
         let p = &per.resolved.points;
+        // The key triangle keeps its sides in every frame.
+        for q in p {
+            let side = (q[Joint::LeftShoulder] - q[Joint::Chest]).norm();
+            let want = subject.bone_length(Bone::new(Joint::Chest, Joint::LeftShoulder));
+            assert!((side - want).abs() < 1e-6, "{side} {want}");
+        }
         let truth: Vec<_> = gt.frames.iter().map(|g| g.points3d()).collect();
         let mut sum = 0.0;
         for t in 1..FRAMES - 1 {
@@ -466,10 +472,7 @@ fn smoothing_the_key_depths_steadies_the_key_triangle_on_noisy_tracks() {
         }
         1000.0 * sum / (3 * (FRAMES - 2)) as f64
     };
-    let (off, on) = (
-        key_jitter(0.0),
-        key_jitter(LiftParams::default().key_depth_smoothing),
-    );
+    let (off, on) = (key_jitter(0.0), key_jitter(2.0));
     // Measured: 9.5 → 1.6 mm per frame.
     assert!(
         on < 0.5 * off,

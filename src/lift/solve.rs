@@ -13,7 +13,7 @@ use super::smoothing::{UNTOUCHED_BELOW, adaptive_sigmas, gaussian_mean, smoothed
 use crate::camera::PinholeCamera;
 use crate::formats::{Frame3d, PointSource, Skeleton3d, Tracks2d};
 use crate::skeleton::{BONE_COUNT, Bone, Joint, PerJoint, SubjectModel};
-use nalgebra::{Point2, Point3};
+use nalgebra::{Point2, Point3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -23,9 +23,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 #[serde(default, deny_unknown_fields)]
 pub struct LiftParams {
     /// Run the global refinement after the per-frame solve (default false: on the synthetic
-    /// suite with true lengths it lowers the error by little, 55.7 → 54.6 mm with 2 px white
-    /// noise and 111.9 → 111.5 mm with the tracker's output and leaves exact tracks at
-    /// 20.0 mm, but raises it on the real sample with the reference 2D, 69.0 → 72.6 mm;
+    /// suite with true lengths it lowers the error by little, 71.0 → 70.2 mm with 2 px white
+    /// noise (four draws) and 111.3 → 110.8 mm with the tracker's output and leaves exact
+    /// tracks at 20.4 mm, but raises it on the real sample with the reference 2D,
+    /// 69.2 → 72.8 mm;
     /// `bench lift` reports both).
     pub refine: bool,
     /// A key-triangle calibration fits when its residual is below this RMS, pixels (default 1).
@@ -44,14 +45,13 @@ pub struct LiftParams {
     /// white noise 162 → 77.5 mm, exact tracks 31.1 → 31.1 mm, the tracker's output
     /// 151.5 → 157.7 mm (its errors are drift and jumps more than white noise).
     pub adaptive_smoothing: bool,
-    /// After the key triangle's path is chosen, each key joint's depth is smoothed over time
-    /// by a Gaussian this many times its 2D track's width (default 2; 0 = off), and the joint
-    /// put back on its viewing ray at that depth. Eqs. 10–11 amplify what 2D noise the
-    /// smoothing left (a near-frontal triangle's tilt goes as the square root of its side
-    /// errors), so depth wants a wider window than the image. On the synthetic suite with true
-    /// lengths, per-frame MPJPE with 2 px noise / exact tracks / the real sample's reference
-    /// 2D: off 63.5 / 20.4 / 69.2 mm; ×0.5 61.5 / 20.3 / 69.2; ×1 60.7 / 20.5 / 69.2;
-    /// ×2 55.7 / 20.0 / 69.0; ×3 55.5 / 19.9 / 68.9; ×4 55.5 / 20.1 / 70.9 mm.
+    /// When above 0, after the key triangle's path is chosen each key joint's depth is smoothed
+    /// over time by a Gaussian this many times its 2D track's width, on its viewing ray, and the
+    /// key triangle refitted rigidly to the result (default 0, off). Eqs. 10–11 amplify what
+    /// 2D noise the smoothing left, so depth would want a wider window than the image; but on
+    /// the synthetic suite with true lengths, ×2 took 2 px noise (four draws) 71.0 → 66.7 mm
+    /// and exact tracks 20.4 → 20.1 mm while the tracker's output with height-based lengths went
+    /// 124.8 → 142.2 mm and the real sample with noise 73.1 → 83.4 mm, so it is off.
     pub key_depth_smoothing: f64,
     /// Weights of the depth-ambiguity priors.
     pub ambiguity: AmbiguityWeights,
@@ -67,7 +67,7 @@ impl Default for LiftParams {
             propagation_tolerance_m: 0.005,
             smoothing_s: 0.0,
             adaptive_smoothing: true,
-            key_depth_smoothing: 2.0,
+            key_depth_smoothing: 0.0,
             ambiguity: AmbiguityWeights::default(),
             refinement: RefineParams::default(),
         }
@@ -253,12 +253,26 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
             score(a).total_cmp(&score(b))
         })
         .ok_or(LiftError::DegenerateKeyTriangle)?;
-    let calibrations = calibrate_all(
+    let mut calibrations = calibrate_all(
         cam,
         &triangle,
         &key_image(&images, calibration_frame),
         job.params.calibration_tolerance_px,
     );
+    // Poses too deep for the trunk's image length are dropped, unless every pose is.
+    let max_depth = deepest_trunk(cam, &job.subject, &images[calibration_frame]);
+    let plausible = |c: &super::calibrate::Calibration| {
+        triangle
+            .points
+            .iter()
+            .map(|p| c.pose.apply(p).z)
+            .sum::<f64>()
+            / 3.0
+            <= max_depth
+    };
+    if calibrations.iter().any(plausible) {
+        calibrations.retain(plausible);
+    }
     // Several poses fit three points. Each is carried through the whole sequence and the
     // whole body is built on it; the one kept explains the tracks best (bones too long for
     // their image give a wrong pose away) with the least prior and acceleration cost of the
@@ -268,7 +282,10 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
     let mut best: Option<(f64, Vec<FrameReport>, Resolved)> = None;
     // Every frame's candidate poses, computed once.
     let per_frame: Vec<(Vec<[Point3<f64>; 3]>, bool)> = (0..n)
-        .map(|t| key_candidates(job, &triangle, &sides, &key_image(&images, t)))
+        .map(|t| {
+            let max_depth = deepest_trunk(cam, &job.subject, &images[t]);
+            key_candidates(job, &triangle, &sides, &key_image(&images, t), max_depth)
+        })
         .collect();
     for c in &calibrations {
         let mut candidates: Vec<Vec<[Point3<f64>; 3]>> =
@@ -280,6 +297,7 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
             &images,
             cam,
             &sigma.map(|_, s| s * job.params.key_depth_smoothing),
+            &triangle.points,
         );
         let mut reports: Vec<FrameReport> = tracks
             .frames
@@ -346,28 +364,55 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
     })
 }
 
+/// How deep the trunk can be and still look as long as it does in the image: a segment of
+/// length `L` at depth `Z` spans at most about `f·L/Z` pixels, so `Z ≤ f·L/l` for the trunk
+/// (neck to pelvis, `l` pixels), with half as much again for perspective and tracking error;
+/// unbounded when the trunk's image is under a pixel.
+fn deepest_trunk(
+    cam: &PinholeCamera,
+    subject: &SubjectModel,
+    image: &PerJoint<Point2<f64>>,
+) -> f64 {
+    let trunk_m = subject.bone_length(Bone::new(Joint::Chest, Joint::Neck))
+        + subject.bone_length(Bone::new(Joint::Pelvis, Joint::Chest));
+    let trunk_px = (image[Joint::Neck] - image[Joint::Pelvis]).norm();
+    if trunk_px < 1.0 {
+        f64::INFINITY
+    } else {
+        1.5 * cam.focal_px * trunk_m / trunk_px
+    }
+}
+
 /// Every pose of the key triangle that fits one frame (a three-point pose has up to four), each
 /// made exact by eqs. 10–11; when none fits within tolerance, the closest fit, and `false`.
+/// Poses whose centroid lies deeper than `max_depth` are dropped: a thin image triangle (a side
+/// view) is also fitted by a tiny far-away triangle whose key lines pass near the marked points,
+/// and on the synthetic suite with 2 px noise such fits, chained over frames, carried the trunk
+/// thousands of kilometres away. When every pose is dropped, the closest point fit, brought
+/// along its rays to `max_depth` at most (and `false`).
 fn key_candidates(
     job: &LiftJob<'_>,
     triangle: &KeyTriangle,
     sides: &[f64; 3],
     image: &[Point2<f64>; 3],
+    max_depth: f64,
 ) -> (Vec<[Point3<f64>; 3]>, bool) {
     let cam = &job.camera;
     let fits = calibrate_all(cam, triangle, image, job.params.calibration_tolerance_px);
-    let converged = !fits.is_empty();
-    let poses: Vec<_> = if converged {
-        fits.iter().map(|c| c.pose).collect()
-    } else {
+    let closest_point_fit = || {
         starting_poses(cam, triangle, image)
             .into_iter()
             .map(|start| calibrate_from(cam, triangle, image, start, Residuals::Points))
             .min_by(|a, b| a.rms_px.total_cmp(&b.rms_px))
             .map(|c| c.pose)
-            .into_iter()
-            .collect()
     };
+    let converged = !fits.is_empty();
+    let poses: Vec<_> = if converged {
+        fits.iter().map(|c| c.pose).collect()
+    } else {
+        closest_point_fit().into_iter().collect()
+    };
+    let depth = |k: &[Point3<f64>; 3]| (k[0].z + k[1].z + k[2].z) / 3.0;
     let mut out: Vec<[Point3<f64>; 3]> = Vec::new();
     for pose in poses {
         let k = triangle.points.map(|p| pose.apply(&p));
@@ -377,36 +422,85 @@ fn key_candidates(
         } else {
             k
         };
-        if !out
-            .iter()
-            .any(|o| (0..3).all(|i| (o[i] - k[i]).norm() < 1e-3))
+        if depth(&k) <= max_depth
+            && !out
+                .iter()
+                .any(|o| (0..3).all(|i| (o[i] - k[i]).norm() < 1e-3))
         {
             out.push(k);
         }
     }
+    if out.is_empty() {
+        if let Some(pose) = closest_point_fit() {
+            let k = triangle.points.map(|p| pose.apply(&p));
+            let scale = (max_depth / depth(&k)).min(1.0);
+            out.push(k.map(|p| Point3::from(p.coords * scale)));
+        }
+        return (out, false);
+    }
     (out, converged)
 }
 
-/// Smooths each key joint's depth over the frames by a Gaussian of `sigma[joint]` frames and
-/// puts the joint back on its viewing ray (through `images`) at the smoothed depth.
+/// Smooths each key joint's depth over the frames by a Gaussian of `sigma[joint]` frames, on its
+/// viewing ray (through `images`), then puts the key triangle `model` rigidly where it best fits
+/// the smoothed points (Kabsch), so that its sides keep their lengths: the bones stay rigid and
+/// the BVH export stays exact.
 fn smooth_key_depths(
     key: &mut [[Point3<f64>; 3]],
     images: &[PerJoint<Point2<f64>>],
     cam: &PinholeCamera,
     sigma: &PerJoint<f64>,
+    model: &[Point3<f64>; 3],
 ) {
     let n = key.len();
+    let mut moved = false;
     for (i, &joint) in KEY_JOINTS.iter().enumerate() {
         let s = sigma[joint];
         if s < UNTOUCHED_BELOW {
             continue;
         }
+        moved = true;
         let depth: Vec<f64> = key.iter().map(|k| k[i].z).collect();
         for (t, k) in key.iter_mut().enumerate() {
             let z = gaussian_mean(t, n, s, 0.0, |u| (depth[u], 1.0));
             k[i] = Point3::from(depth_ray(cam, &images[t][joint]) * z);
         }
     }
+    if moved {
+        let cm = centroid(model);
+        for k in key.iter_mut() {
+            let r = rigid_rotation(model, k);
+            let c = centroid(k);
+            *k = model.map(|m| Point3::from(r * (m.coords - cm) + c));
+        }
+    }
+}
+
+fn centroid(p: &[Point3<f64>; 3]) -> Vector3<f64> {
+    (p[0].coords + p[1].coords + p[2].coords) / 3.0
+}
+
+/// The rotation taking `model` onto `target` about their centroids, in the least-squares sense
+/// (Kabsch 1976).
+fn rigid_rotation(
+    model: &[Point3<f64>; 3],
+    target: &[Point3<f64>; 3],
+) -> nalgebra::UnitQuaternion<f64> {
+    let (cm, ct) = (centroid(model), centroid(target));
+    let mut h = nalgebra::Matrix3::zeros();
+    for (m, t) in model.iter().zip(target) {
+        h += (m.coords - cm) * (t.coords - ct).transpose();
+    }
+    let svd = h.svd(true, true);
+    let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
+        return nalgebra::UnitQuaternion::identity();
+    };
+    let mut d = nalgebra::Matrix3::identity();
+    if (v_t.transpose() * u.transpose()).determinant() < 0.0 {
+        d[(2, 2)] = -1.0;
+    }
+    let r = v_t.transpose() * d * u.transpose();
+    nalgebra::UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(r))
 }
 
 /// Squared acceleration of the key joints over three frames.
@@ -574,4 +668,58 @@ pub fn lift(
         calibration_frame: per.calibration_frame,
         refinement,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_rigid_rotation_finds_a_turned_triangle() {
+        let model = [
+            Point3::new(0.18, 0.0, 0.0),
+            Point3::new(-0.18, 0.0, 0.0),
+            Point3::new(0.0, 0.15, 0.0),
+        ];
+        let r = nalgebra::UnitQuaternion::from_euler_angles(0.3, -0.8, 0.2);
+        let moved = model.map(|p| r * p + Vector3::new(0.2, -0.1, 3.0));
+        assert!(rigid_rotation(&model, &moved).angle_to(&r) < 1e-9);
+    }
+
+    #[test]
+    fn key_poses_deeper_than_the_trunk_allows_are_dropped() {
+        let subject = SubjectModel::default();
+        let triangle = KeyTriangle::from_subject(&subject).unwrap();
+        let sides = crate::lift::calibrate::KEY_LINES.map(|(i, j)| triangle.side(i, j));
+        let cam = PinholeCamera::centred(800.0, 640, 480);
+        let pose =
+            nalgebra::Isometry3::new(Vector3::new(0.1, 0.0, 3.0), Vector3::new(0.0, 0.4, 0.0));
+        let image = triangle.points.map(|p| cam.project(&(pose * p)).unwrap());
+        let tracks = Tracks2d {
+            source: crate::formats::SourceInfo {
+                path: "test".into(),
+                width: 640,
+                height: 480,
+                fps: 30.0,
+                frame_count: 1,
+            },
+            frames: Vec::new(),
+        };
+        let job = LiftJob {
+            tracks: &tracks,
+            camera: cam,
+            subject,
+            params: LiftParams::default(),
+            overrides: DepthOverrides::new(),
+        };
+        let depth = |k: &[Point3<f64>; 3]| (k[0].z + k[1].z + k[2].z) / 3.0;
+        // Unbounded: the true pose (3 m away) is among the candidates.
+        let (all, converged) = key_candidates(&job, &triangle, &sides, &image, f64::INFINITY);
+        assert!(converged && all.iter().any(|k| (depth(k) - 3.0).abs() < 0.05));
+        // Bounded at 2.9 m: nothing fits, so the closest fit comes back no deeper, flagged.
+        let (bounded, converged) = key_candidates(&job, &triangle, &sides, &image, 2.9);
+        assert!(!converged);
+        assert_eq!(bounded.len(), 1);
+        assert!(depth(&bounded[0]) <= 2.9 + 1e-9, "{}", depth(&bounded[0]));
+    }
 }
