@@ -262,13 +262,7 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
     // Poses too deep for the trunk's image length are dropped, unless every pose is.
     let max_depth = deepest_trunk(cam, &job.subject, &images[calibration_frame]);
     let plausible = |c: &super::calibrate::Calibration| {
-        triangle
-            .points
-            .iter()
-            .map(|p| c.pose.apply(p).z)
-            .sum::<f64>()
-            / 3.0
-            <= max_depth
+        centroid(&triangle.points.map(|p| c.pose.apply(&p))).z <= max_depth
     };
     if calibrations.iter().any(plausible) {
         calibrations.retain(plausible);
@@ -373,8 +367,7 @@ fn deepest_trunk(
     subject: &SubjectModel,
     image: &PerJoint<Point2<f64>>,
 ) -> f64 {
-    let trunk_m = subject.bone_length(Bone::new(Joint::Chest, Joint::Neck))
-        + subject.bone_length(Bone::new(Joint::Pelvis, Joint::Chest));
+    let trunk_m = subject.trunk_m();
     let trunk_px = (image[Joint::Neck] - image[Joint::Pelvis]).norm();
     if trunk_px < 1.0 {
         f64::INFINITY
@@ -412,7 +405,7 @@ fn key_candidates(
     } else {
         closest_point_fit().into_iter().collect()
     };
-    let depth = |k: &[Point3<f64>; 3]| (k[0].z + k[1].z + k[2].z) / 3.0;
+    let depth = |k: &[Point3<f64>; 3]| centroid(k).z;
     let mut out: Vec<[Point3<f64>; 3]> = Vec::new();
     for pose in poses {
         let k = triangle.points.map(|p| pose.apply(&p));
@@ -476,6 +469,7 @@ fn smooth_key_depths(
     }
 }
 
+/// The centroid of three points (the key triangle's).
 fn centroid(p: &[Point3<f64>; 3]) -> Vector3<f64> {
     (p[0].coords + p[1].coords + p[2].coords) / 3.0
 }
@@ -712,7 +706,7 @@ mod tests {
             params: LiftParams::default(),
             overrides: DepthOverrides::new(),
         };
-        let depth = |k: &[Point3<f64>; 3]| (k[0].z + k[1].z + k[2].z) / 3.0;
+        let depth = |k: &[Point3<f64>; 3]| centroid(k).z;
         // Unbounded: the true pose (3 m away) is among the candidates.
         let (all, converged) = key_candidates(&job, &triangle, &sides, &image, f64::INFINITY);
         assert!(converged && all.iter().any(|k| (depth(k) - 3.0).abs() < 0.05));

@@ -53,7 +53,8 @@ pub const LIMB_RANGE: (f64, f64) = (0.8, 1.2);
 /// Fewest measured frames for a limb's length: a quantile of a handful of poses says little.
 const MIN_LIMB_FRAMES: usize = 10;
 
-/// The bones measured together (left and right pooled), each named for the report.
+/// The bones measured together (left and right pooled, parent first), each named for the
+/// report.
 const LIMBS: [(&str, &[(Joint, Joint)]); 5] = {
     use Joint::*;
     [
@@ -71,7 +72,7 @@ const LIMBS: [(&str, &[(Joint, Joint)]); 5] = {
     ]
 };
 
-/// The bones stacked in the stature (ankle to head top, one leg).
+/// The bones stacked in the stature (ankle to head top, one leg), parent first.
 const STATURE_STACK: [(Joint, Joint); 5] = {
     use Joint::*;
     [
@@ -153,26 +154,10 @@ fn model_triangle(subject: &SubjectModel) -> Option<(f64, f64)> {
     (h2 > 0.0).then(|| (h2.sqrt(), x))
 }
 
-/// The trunk's length in the subject model: chest–neck plus pelvis–chest (the chest lies on the
-/// line between neck and pelvis by its definition).
-fn model_trunk(subject: &SubjectModel) -> f64 {
-    subject.bone_length(Bone::new(Joint::Chest, Joint::Neck))
-        + subject.bone_length(Bone::new(Joint::Pelvis, Joint::Chest))
-}
-
-/// The length of a bone given by its two ends, whichever way the model's tree runs.
-fn bone_between(a: Joint, b: Joint) -> Bone {
-    if Bone::ALL.contains(&Bone::new(a, b)) {
-        Bone::new(a, b)
-    } else {
-        Bone::new(b, a)
-    }
-}
-
 fn stature_stack(subject: &SubjectModel) -> f64 {
     STATURE_STACK
         .iter()
-        .map(|&(a, b)| subject.bone_length(bone_between(a, b)))
+        .map(|&(a, b)| subject.bone_length(Bone::new(a, b)))
         .sum()
 }
 
@@ -267,7 +252,7 @@ fn measure_limb(views: &[FrameView<'_>], bones: &[(Joint, Joint)]) -> Option<f64
 pub fn fit_to_tracks(subject: &SubjectModel, tracks: &Tracks2d) -> (SubjectModel, SubjectFit) {
     let images = smoothed_images(tracks, &adaptive_sigmas(tracks));
     let views = views(tracks, &images);
-    let trunk = model_trunk(subject);
+    let trunk = subject.trunk_m();
     let mut out = subject.clone();
     let mut fit = SubjectFit {
         chest_drop: None,
@@ -299,7 +284,7 @@ pub fn fit_to_tracks(subject: &SubjectModel, tracks: &Tracks2d) -> (SubjectModel
         let measured = ratio * trunk;
         let mut factor = 1.0;
         for &(a, b) in bones {
-            let k = bone_between(a, b).index();
+            let k = Bone::new(a, b).index();
             let table = subject.bone_length_m[k];
             let length = measured.clamp(LIMB_RANGE.0 * table, LIMB_RANGE.1 * table);
             factor = length / table;
@@ -339,7 +324,7 @@ mod tests {
     /// upper arms `arms` times the table's.
     fn build(drop: f64, arms: f64) -> SubjectModel {
         let mut s = SubjectModel::default();
-        let h = drop * model_trunk(&s);
+        let h = drop * s.trunk_m();
         let a = (h * h + (s.shoulder_width_m / 2.0).powi(2)).sqrt();
         for (a_end, b_end, len) in [
             (Joint::Chest, Joint::LeftShoulder, a),
@@ -411,7 +396,7 @@ mod tests {
     fn the_drop_is_read_in_front_oblique_and_side_views() {
         let truth = build(0.33, 1.0);
         let table = SubjectModel::default();
-        let model = model_triangle(&table).unwrap().0 / model_trunk(&table);
+        let model = model_triangle(&table).unwrap().0 / table.trunk_m();
         assert!(
             (model - 0.33).abs() > 0.05,
             "the test needs a different build"

@@ -238,6 +238,12 @@ impl SubjectModel {
         self.bone_length_m[bone.index()]
     }
 
+    /// The trunk's length, neck to pelvis, in metres: chest–neck plus pelvis–chest (the chest
+    /// lies on the line between neck and pelvis by its definition).
+    pub fn trunk_m(&self) -> f64 {
+        self.length_to(Joint::Neck) + self.length_to(Joint::Chest)
+    }
+
     /// Length of the bone ending at `child` in metres (0 for the pelvis).
     pub fn length_to(&self, child: Joint) -> f64 {
         Bone::to(child).map_or(0.0, |b| self.bone_length(b))
