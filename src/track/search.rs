@@ -4,7 +4,7 @@
 
 use super::block::{MorphBlock, wrap_angle};
 use super::similarity::{FrameView, Template};
-use nalgebra::Vector2;
+use nalgebra::{Point2, Vector2};
 use rayon::prelude::*;
 
 /// The best block found and its cost.
@@ -140,41 +140,17 @@ pub fn spiral(
         block: *predicted,
         cost: f32::INFINITY,
     };
-    // The morph variants at one point, each kept if it beats `best`.
-    let try_point = |origin: nalgebra::Point2<f64>, best: &mut Found| {
-        for v in variants(
-            &MorphBlock {
-                origin,
-                ..*predicted
-            },
-            p,
-        ) {
-            let c = template.cost(frame, &v, false, best.cost);
-            if c < best.cost {
-                *best = Found { block: v, cost: c };
-            }
-        }
-    };
-    try_point(predicted.origin, &mut best);
+    try_point(template, frame, predicted, predicted.origin, p, &mut best);
     for ring in 1..=p.max_rings {
         let r = ring as i64;
-        // The square ring at Chebyshev distance r, walked clockwise from its top-left corner.
-        // Its points are tried in parallel, each against the best before the ring; the ring's
+        // The ring's points are tried in parallel, each against the best before the ring; the ring's
         // winner is the first of the lowest, exactly as when walked one by one.
         let ring_best = (0..(8 * r))
             .into_par_iter()
             .map(|k| {
-                let side = k / (2 * r);
-                let t = k % (2 * r);
-                let (dx, dy) = match side {
-                    0 => (-r + t, -r),
-                    1 => (r, -r + t),
-                    2 => (r - t, r),
-                    _ => (-r, r - t),
-                };
-                let o = predicted.origin + Vector2::new(dx as f64, dy as f64) * p.step_px;
+                let o = ring_point(predicted.origin, r, k, p.step_px);
                 let mut local = best;
-                try_point(o, &mut local);
+                try_point(template, frame, predicted, o, p, &mut local);
                 local
             })
             .reduce(|| best, |a, b| if b.cost < a.cost { b } else { a });
@@ -184,6 +160,46 @@ pub fn spiral(
         best = ring_best;
     }
     spiral_refine(template, frame, best, p)
+}
+
+/// Point `k` (0 ≤ k < 8r) of the square ring at Chebyshev distance `r` (in steps of `step`
+/// pixels) around `centre`, walked clockwise from its top-left corner.
+fn ring_point(centre: Point2<f64>, r: i64, k: i64, step: f64) -> Point2<f64> {
+    let (side, t) = (k / (2 * r), k % (2 * r));
+    let (dx, dy) = match side {
+        0 => (-r + t, -r),
+        1 => (r, -r + t),
+        2 => (r - t, r),
+        _ => (-r, r - t),
+    };
+    centre + Vector2::new(dx as f64, dy as f64) * step
+}
+
+/// The morph variants of `predicted` moved to `origin`, each kept in `best` if it beats it;
+/// whether one did.
+fn try_point(
+    template: &Template,
+    frame: FrameView,
+    predicted: &MorphBlock,
+    origin: Point2<f64>,
+    p: &SpiralParams,
+    best: &mut Found,
+) -> bool {
+    let mut improved = false;
+    for v in variants(
+        &MorphBlock {
+            origin,
+            ..*predicted
+        },
+        p,
+    ) {
+        let c = template.cost(frame, &v, false, best.cost);
+        if c < best.cost {
+            *best = Found { block: v, cost: c };
+            improved = true;
+        }
+    }
+    improved
 }
 
 /// The spiral's last step: a local refinement of position, angle and size from the best ring
@@ -382,7 +398,6 @@ mod tests {
     use super::*;
     use crate::track::similarity::{Extent, SimilarityWeights};
     use image::{Rgb, RgbImage};
-    use nalgebra::Point2;
 
     /// A textured bar from `a` to `b` over a differently textured background.
     fn bar(a: Point2<f64>, b: Point2<f64>, width: f64) -> RgbImage {
@@ -475,8 +490,8 @@ mod tests {
         assert!(err < 1.0, "origin off by {err} px");
     }
 
-    /// The spiral's rings walked one point at a time, as Fig. 6 draws them (no early exit, no
-    /// threads), then the same final refinement.
+    /// The spiral's rings walked one point at a time, as Fig. 6 draws them (no threads), then
+    /// the same final refinement.
     fn spiral_in_order(
         t: &Template,
         frame: FrameView,
@@ -487,36 +502,12 @@ mod tests {
             block: *predicted,
             cost: f32::INFINITY,
         };
-        let try_point = |o: Point2<f64>, best: &mut Found| {
-            let mut improved = false;
-            for v in variants(
-                &MorphBlock {
-                    origin: o,
-                    ..*predicted
-                },
-                p,
-            ) {
-                let c = t.cost(frame, &v, false, f32::INFINITY);
-                if c < best.cost {
-                    *best = Found { block: v, cost: c };
-                    improved = true;
-                }
-            }
-            improved
-        };
-        try_point(predicted.origin, &mut best);
+        try_point(t, frame, predicted, predicted.origin, p, &mut best);
         for r in 1..=p.max_rings as i64 {
             let mut improved = false;
             for k in 0..(8 * r) {
-                let (side, s) = (k / (2 * r), k % (2 * r));
-                let (dx, dy) = match side {
-                    0 => (-r + s, -r),
-                    1 => (r, -r + s),
-                    2 => (r - s, r),
-                    _ => (-r, r - s),
-                };
-                let o = predicted.origin + Vector2::new(dx as f64, dy as f64) * p.step_px;
-                improved |= try_point(o, &mut best);
+                let o = ring_point(predicted.origin, r, k, p.step_px);
+                improved |= try_point(t, frame, predicted, o, p, &mut best);
             }
             if !improved {
                 break;
