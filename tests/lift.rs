@@ -4,7 +4,9 @@
 use nalgebra::{Point3, Rotation3, Vector3};
 use std::sync::atomic::AtomicBool;
 use videomocap::camera::PinholeCamera;
-use videomocap::eval::pose3d::{score_skeleton, tracks_from_truth};
+use videomocap::eval::pose3d::{
+    key_triangle_flex_m, lift_on_reference_key, score_skeleton, tracks_from_truth,
+};
 use videomocap::formats::Tracks2d;
 use videomocap::lift::ambiguity::lift_order;
 use videomocap::lift::backproject::bone_roots;
@@ -478,4 +480,37 @@ fn smoothing_the_key_depths_steadies_the_key_triangle_on_noisy_tracks() {
         on < 0.5 * off,
         "key joints' jitter {off:.1} mm unsmoothed, {on:.1} mm smoothed"
     );
+}
+
+#[test]
+fn on_a_rigid_key_triangle_the_reference_key_lift_is_the_lift_and_a_sliding_chest_flexes_it() {
+    let (mut gt, subject) = truth();
+    // The model's key triangle is rigid, and the lift finds it exactly from exact tracks, so
+    // putting the reference's triangle in place changes nothing: the difference left is the
+    // root choices' alone.
+    assert!(key_triangle_flex_m(&gt) < 1e-9);
+    let out = run(&gt, &subject, 0.0, false);
+    let on_key = lift_on_reference_key(&gt, &subject, &LiftParams::default().ambiguity);
+    assert_eq!(on_key.frames.len(), out.per_frame.frames.len());
+    for (a, b) in on_key.frames.iter().zip(&out.per_frame.frames) {
+        for (j, p) in a.points.iter() {
+            assert!((p - b.points[j]).norm() < 1e-6, "frame {} {j}", a.index);
+        }
+    }
+    // A chest sliding ±1 cm along the trunk, as a motion-capture chest on the line from neck
+    // to pelvis does when the spine bends: each chest–shoulder side (about 0.2 m, the chest
+    // about 0.1 m below the shoulder line) changes by about half the slide, so the mean
+    // standard deviation of the three sides (the width stays) is about
+    // 2/3 · 0.5 · 1 cm / √2 ≈ 2.4 mm.
+    for (t, f) in gt.frames.iter_mut().enumerate() {
+        let p = f.points3d();
+        let up = (nalgebra::center(&p[Joint::LeftShoulder], &p[Joint::RightShoulder])
+            - p[Joint::Chest])
+            .normalize();
+        let slide = 0.01 * (t as f64 / 7.0).sin();
+        let c = p[Joint::Chest] + up * slide;
+        f.points3d[Joint::Chest.index()] = [c.x, c.y, c.z];
+    }
+    let flex = key_triangle_flex_m(&gt);
+    assert!((0.0015..0.0035).contains(&flex), "flex {flex} m");
 }

@@ -4,8 +4,10 @@
 //! inputs of the lift benchmark from ground truth (true or noisy 2D, the true subject).
 
 use super::EvalError;
-use crate::formats::{FrameTracks, PointSource, Skeleton3d, SourceInfo, TrackedPoint, Tracks2d};
-use crate::lift::ambiguity::lift_order;
+use crate::formats::{
+    Frame3d, FrameTracks, PointSource, Skeleton3d, SourceInfo, TrackedPoint, Tracks2d,
+};
+use crate::lift::ambiguity::{AmbiguityWeights, lift_order, resolve};
 use crate::skeleton::{Bone, Joint, PerJoint, Proportions, SubjectModel};
 use crate::synth::GroundTruth;
 use nalgebra::{Matrix3, Point2, Point3, Vector3};
@@ -228,6 +230,80 @@ pub fn tracks_from_truth(gt: &GroundTruth, noise_px: f64, seed: u64) -> Tracks2d
                         source: PointSource::Tracked,
                     }),
                 }
+            })
+            .collect(),
+    }
+}
+
+/// How much the reference's key triangle flexes: the standard deviation across frames of each
+/// of its three sides (shoulder to shoulder, chest to each shoulder), averaged, metres. The lift
+/// holds the triangle rigid (eqs. 9–11); a motion-capture chest, on the line from neck to
+/// pelvis, rides the bending spine, so even exact 2D with the mean lengths misplaces it.
+pub fn key_triangle_flex_m(gt: &GroundTruth) -> f64 {
+    let sides = [
+        (Joint::LeftShoulder, Joint::RightShoulder),
+        (Joint::Chest, Joint::LeftShoulder),
+        (Joint::Chest, Joint::RightShoulder),
+    ];
+    let n = gt.frames.len().max(1) as f64;
+    sides
+        .iter()
+        .map(|&(a, b)| {
+            let lengths: Vec<f64> = gt
+                .frames
+                .iter()
+                .map(|f| {
+                    let p = f.points3d();
+                    (p[a] - p[b]).norm()
+                })
+                .collect();
+            let mean = lengths.iter().sum::<f64>() / n;
+            (lengths.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / n).sqrt()
+        })
+        .sum::<f64>()
+        / sides.len() as f64
+}
+
+/// The lift's root choices on their own: every frame's key triangle (both shoulders and the
+/// chest) put where the reference has it, every other joint solved from the true 2D points with
+/// `subject`'s lengths and its root chosen by [`resolve`]. What stays wrong is the depth
+/// ambiguity's alone, the key triangle's share of the error removed.
+pub fn lift_on_reference_key(
+    gt: &GroundTruth,
+    subject: &SubjectModel,
+    weights: &AmbiguityWeights,
+) -> Skeleton3d {
+    let camera = gt.camera();
+    let key: Vec<[Point3<f64>; 3]> = gt
+        .frames
+        .iter()
+        .map(|f| {
+            let p = f.points3d();
+            [
+                p[Joint::LeftShoulder],
+                p[Joint::RightShoulder],
+                p[Joint::Chest],
+            ]
+        })
+        .collect();
+    let rays: Vec<PerJoint<Vector3<f64>>> = gt
+        .frames
+        .iter()
+        .map(|f| f.points2d().map(|_, p| camera.ray(p)))
+        .collect();
+    let index: Vec<usize> = gt.frames.iter().map(|f| f.index).collect();
+    let resolved = resolve(&key, &rays, &index, subject, weights, &Default::default());
+    Skeleton3d {
+        camera,
+        fps: Some(gt.fps),
+        bone_lengths_m: Default::default(),
+        frames: index
+            .iter()
+            .zip(resolved.points)
+            .map(|(&index, points)| Frame3d {
+                index,
+                points,
+                flags: Vec::new(),
             })
             .collect(),
     }
