@@ -17,6 +17,8 @@ pub mod backproject;
 pub mod calibrate;
 mod error;
 pub mod focal;
+pub mod key_path;
+pub(crate) mod least_squares;
 mod newton;
 pub mod propagate;
 pub mod refine;

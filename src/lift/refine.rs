@@ -18,12 +18,11 @@
 //! the length columns) and factored with `nalgebra-sparse`'s Cholesky.
 
 use super::error::LiftError;
+use super::least_squares::{Residuals, Row, minimise};
 use crate::camera::PinholeCamera;
 use crate::formats::{PointSource, TrackedPoint};
 use crate::skeleton::{BONE_COUNT, Bone, JOINT_COUNT, Joint, PerJoint, SubjectModel};
-use nalgebra::{DMatrix, DVector, Point2, Point3};
-use nalgebra_sparse::factorization::CscCholesky;
-use nalgebra_sparse::{CooMatrix, CscMatrix};
+use nalgebra::{DVector, Point2, Point3};
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -154,29 +153,6 @@ struct Problem<'a> {
     accel_sigma_m: f64,
 }
 
-/// One residual row: value and its nonzero partial derivatives (at most one per length, the
-/// widest row being the scale row).
-struct Row {
-    value: f64,
-    entries: [(usize, f64); LENGTHS],
-    len: usize,
-}
-
-impl Row {
-    fn new(value: f64) -> Row {
-        Row {
-            value,
-            entries: [(0, 0.0); LENGTHS],
-            len: 0,
-        }
-    }
-    fn with(mut self, col: usize, d: f64) -> Row {
-        self.entries[self.len] = (col, d);
-        self.len += 1;
-        self
-    }
-}
-
 /// The subject's lengths in refinement order: the 15 bones, then the shoulder width.
 fn subject_lengths(subject: &SubjectModel) -> [f64; LENGTHS] {
     let mut lengths = [subject.shoulder_width_m; LENGTHS];
@@ -185,10 +161,6 @@ fn subject_lengths(subject: &SubjectModel) -> [f64; LENGTHS] {
 }
 
 impl Problem<'_> {
-    fn unknowns(&self) -> usize {
-        self.images.len() * PER_FRAME + LENGTHS
-    }
-
     /// The unknowns as one vector: every frame's joints, then the lengths.
     fn pack(points: &[PerJoint<Point3<f64>>], lengths: &[f64; LENGTHS]) -> DVector<f64> {
         let n = points.len();
@@ -217,7 +189,7 @@ impl Problem<'_> {
     }
 
     /// Calls `emit` for every residual row at `x`.
-    fn rows(&self, x: &DVector<f64>, mut emit: impl FnMut(Row)) {
+    fn emit_rows(&self, x: &DVector<f64>, emit: &mut dyn FnMut(Row)) {
         let n = self.images.len();
         let lcol = n * PER_FRAME;
         let p = &self.params;
@@ -319,12 +291,6 @@ impl Problem<'_> {
         emit(row);
     }
 
-    fn cost(&self, x: &DVector<f64>) -> f64 {
-        let mut c = 0.0;
-        self.rows(x, |r| c += r.value * r.value);
-        c
-    }
-
     fn reprojection_rms(&self, x: &DVector<f64>) -> f64 {
         let mut sum = 0.0;
         let mut count = 0.0f64;
@@ -337,6 +303,12 @@ impl Problem<'_> {
             }
         }
         (sum / count.max(1.0)).sqrt()
+    }
+}
+
+impl Residuals for Problem<'_> {
+    fn rows(&self, x: &DVector<f64>, emit: &mut dyn FnMut(Row)) {
+        self.emit_rows(x, emit);
     }
 }
 
@@ -383,65 +355,14 @@ pub fn refine(
         params: *params,
         accel_sigma_m: acceleration_sigma_m(track_noise_px, params, dt),
     };
-    let m = problem.unknowns();
-    let mut x = Problem::pack(start, &start_lengths);
-    let cost_before = problem.cost(&x);
+    let x = Problem::pack(start, &start_lengths);
     let reprojection_px_before = problem.reprojection_rms(&x);
-    let mut cost = cost_before;
-    let mut lambda = 1e-3;
-    let mut iterations = 0;
-    while iterations < params.max_iterations {
-        if cancel.load(Ordering::Relaxed) {
-            return Err(LiftError::Cancelled);
-        }
-        progress(iterations, params.max_iterations);
-        iterations += 1;
-        // Normal equations JᵀJ and Jᵀr, accumulated row by row.
-        let mut jtj = CooMatrix::new(m, m);
-        let mut jtr = DVector::<f64>::zeros(m);
-        problem.rows(&x, |row| {
-            let e = &row.entries[..row.len];
-            for &(i, di) in e {
-                jtr[i] += di * row.value;
-                for &(k, dk) in e {
-                    jtj.push(i, k, di * dk);
-                }
-            }
-        });
-        let jtj = CscMatrix::from(&jtj);
-        let diagonal: Vec<f64> = (0..m)
-            .map(|i| jtj.get_entry(i, i).map_or(0.0, |e| e.into_value()))
-            .collect();
-        let mut improved = false;
-        while lambda < 1e8 {
-            let mut damped = CooMatrix::new(m, m);
-            for (i, k, v) in jtj.triplet_iter() {
-                damped.push(i, k, *v);
-            }
-            for (i, d) in diagonal.iter().enumerate() {
-                damped.push(i, i, lambda * d.max(1e-9) + 1e-12);
-            }
-            let Ok(chol) = CscCholesky::factor(&CscMatrix::from(&damped)) else {
-                lambda *= 10.0;
-                continue;
-            };
-            let step: DMatrix<f64> = chol.solve(&jtr);
-            let candidate = &x - step.column(0);
-            let c = problem.cost(&candidate);
-            if c.is_finite() && c < cost {
-                let gain = (cost - c) / cost.max(1e-300);
-                x = candidate;
-                cost = c;
-                lambda = (lambda / 4.0).max(1e-9);
-                improved = gain > 1e-6;
-                break;
-            }
-            lambda *= 4.0;
-        }
-        if !improved {
-            break;
-        }
-    }
+    let minimum = minimise(&problem, x, params.max_iterations, &mut |i| {
+        progress(i, params.max_iterations);
+        !cancel.load(Ordering::Relaxed)
+    })
+    .ok_or(LiftError::Cancelled)?;
+    let x = minimum.x;
     progress(params.max_iterations, params.max_iterations);
     let points = (0..n)
         .map(|t| PerJoint::from_fn(|j| Problem::point(&x, t, j)))
@@ -453,9 +374,9 @@ pub fn refine(
         bone_lengths,
         shoulder_width: x[n * PER_FRAME + BONE_COUNT],
         summary: RefineSummary {
-            iterations,
-            cost_before,
-            cost_after: cost,
+            iterations: minimum.iterations,
+            cost_before: minimum.cost_before,
+            cost_after: minimum.cost_after,
             reprojection_px_before,
             reprojection_px_after: problem.reprojection_rms(&x),
         },
@@ -465,6 +386,7 @@ pub fn refine(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::DMatrix;
 
     #[test]
     fn the_adaptive_acceleration_term_is_firmer_for_noisier_tracks() {
@@ -520,11 +442,11 @@ mod tests {
             params: RefineParams::default(),
             accel_sigma_m: 20.0 / 900.0,
         };
-        let m = problem.unknowns();
         let x = Problem::pack(&start, &start_lengths.map(|l| l * 1.05));
+        let m = x.len();
         let collect = |x: &DVector<f64>| {
             let mut rows = Vec::new();
-            problem.rows(x, |r| rows.push(r));
+            problem.emit_rows(x, &mut |r| rows.push(r));
             rows
         };
         let base = collect(&x);

@@ -56,17 +56,11 @@ pub fn adaptive_sigma(noise_px: f64, motion_px: f64) -> f64 {
 
 /// A Gaussian narrower than this (frames) leaves a series as it is: its neighbours would weigh
 /// less than 1e-4.
-pub const UNTOUCHED_BELOW: f64 = 0.3;
+const UNTOUCHED_BELOW: f64 = 0.3;
 
 /// The Gaussian mean of `n` samples around sample `t`, `s` wide (in samples): `sample(u)` gives
 /// sample `u`'s value and its own weight (which multiplies the Gaussian's).
-pub(crate) fn gaussian_mean<V>(
-    t: usize,
-    n: usize,
-    s: f64,
-    zero: V,
-    sample: impl Fn(usize) -> (V, f64),
-) -> V
+fn gaussian_mean<V>(t: usize, n: usize, s: f64, zero: V, sample: impl Fn(usize) -> (V, f64)) -> V
 where
     V: Copy + std::ops::Add<Output = V> + std::ops::Mul<f64, Output = V>,
 {
@@ -122,10 +116,10 @@ pub fn adaptive_sigmas(tracks: &Tracks2d) -> PerJoint<f64> {
     out
 }
 
-/// The median over joints of the tracks' white-noise deviation, pixels (0 below five frames):
-/// how noisy the 2D input is as a whole.
-pub fn median_noise_px(tracks: &Tracks2d) -> f64 {
-    let mut noise: Vec<f64> = Joint::ALL
+/// The median over `joints` of their tracks' white-noise deviation, pixels (0 below five
+/// frames): how noisy the 2D input is (as a whole with [`Joint::ALL`]).
+pub fn median_noise_px(tracks: &Tracks2d, joints: &[Joint]) -> f64 {
+    let mut noise: Vec<f64> = joints
         .iter()
         .filter_map(|&j| {
             let track: Vec<Point2<f64>> = tracks.frames.iter().map(|f| f.points[j].pos).collect();

@@ -7,13 +7,14 @@ use super::calibrate::{
     KEY_JOINTS, KeyTriangle, Residuals, calibrate_all, calibrate_from, shape, starting_poses,
 };
 use super::error::LiftError;
-use super::propagate::{depth_ray, key_depths};
-use super::refine::{RefineParams, RefineSummary, refine};
-use super::smoothing::{UNTOUCHED_BELOW, adaptive_sigmas, gaussian_mean, smoothed_images};
+use super::key_path::{centroid, smooth_key_path};
+use super::propagate::key_depths;
+use super::refine::{RefineParams, RefineSummary, refine, track_weight};
+use super::smoothing::{adaptive_sigmas, median_noise_px, smoothed_images};
 use crate::camera::PinholeCamera;
 use crate::formats::{Frame3d, PointSource, Skeleton3d, Tracks2d};
 use crate::skeleton::{BONE_COUNT, Bone, Joint, PerJoint, SubjectModel};
-use nalgebra::{Point2, Point3, Vector3};
+use nalgebra::{Point2, Point3};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -23,10 +24,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 #[serde(default, deny_unknown_fields)]
 pub struct LiftParams {
     /// Run the global refinement after the per-frame solve (default false: on the synthetic
-    /// suite with true lengths it lowers the error by little, 71.0 → 70.2 mm with 2 px white
-    /// noise (four draws) and 111.3 → 110.8 mm with the tracker's output and leaves exact
-    /// tracks at 20.4 mm, but raises it on the real sample with the reference 2D,
-    /// 69.2 → 72.8 mm;
+    /// suite with true lengths it lowers the error by little, 61.9 → 61.4 mm with 2 px white
+    /// noise (four draws) and 111.8 → 111.4 mm with the tracker's output and leaves exact
+    /// tracks at 20.6 mm, but raises it on the real sample with the reference 2D,
+    /// 69.3 → 72.9 mm;
     /// `bench lift` reports both).
     pub refine: bool,
     /// A key-triangle calibration fits when its residual is below this RMS, pixels (default 1).
@@ -45,14 +46,13 @@ pub struct LiftParams {
     /// white noise 162 → 77.5 mm, exact tracks 31.1 → 31.1 mm, the tracker's output
     /// 151.5 → 157.7 mm (its errors are drift and jumps more than white noise).
     pub adaptive_smoothing: bool,
-    /// When above 0, after the key triangle's path is chosen each key joint's depth is smoothed
-    /// over time by a Gaussian this many times its 2D track's width, on its viewing ray, and the
-    /// key triangle refitted rigidly to the result (default 0, off). Eqs. 10–11 amplify what
-    /// 2D noise the smoothing left, so depth would want a wider window than the image; but on
-    /// the synthetic suite with true lengths, ×2 took 2 px noise (four draws) 71.0 → 66.7 mm
-    /// and exact tracks 20.4 → 20.1 mm while the tracker's output with height-based lengths went
-    /// 124.8 → 142.2 mm and the real sample with noise 73.1 → 83.4 mm, so it is off.
-    pub key_depth_smoothing: f64,
+    /// Refit the key triangle's path over the whole clip after it is chosen frame by frame
+    /// ([`super::key_path`]: reprojection, rigid sides and acceleration by least squares, as
+    /// firm as the tracks are noisy; default true). With the calibration frame chosen by size
+    /// as well, on the synthetic suite with true lengths: 2 px noise (four draws)
+    /// 71.0 → 61.9 mm, exact tracks 20.4 → 20.6 mm, the tracker's output 111.3 → 111.8 mm; the
+    /// real sample with noise 73.1 → 70.3 mm, with its reference 2D 69.2 → 69.3 mm.
+    pub key_path_smoothing: bool,
     /// Weights of the depth-ambiguity priors.
     pub ambiguity: AmbiguityWeights,
     /// Weights of the global refinement.
@@ -67,7 +67,7 @@ impl Default for LiftParams {
             propagation_tolerance_m: 0.005,
             smoothing_s: 0.0,
             adaptive_smoothing: true,
-            key_depth_smoothing: 0.0,
+            key_path_smoothing: true,
             ambiguity: AmbiguityWeights::default(),
             refinement: RefineParams::default(),
         }
@@ -238,7 +238,10 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
     let rays: Vec<_> = images.iter().map(|im| im.map(|_, p| cam.ray(p))).collect();
     let frame_index: Vec<usize> = tracks.frames.iter().map(|f| f.index).collect();
 
-    // The calibration frame: the best-shaped key triangle, weighted by the trust in its points.
+    // The calibration frame: the best-shaped key triangle, weighted by the trust in its points
+    // and by its size in the image (a pixel of noise turns a small triangle further: with one
+    // draw of 2 px noise the suite's far walk was calibrated 0.5 m too near on its first frame,
+    // 301 mm MPJPE; by size, 30 frames later, 53 mm).
     let calibration_frame = (0..n)
         .filter(|&t| !degenerate(&key_image(&images, t)))
         .max_by(|&a, &b| {
@@ -248,7 +251,15 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
                     .map(|&j| f64::from(tracks.frames[t].points[j].confidence))
                     .fold(1.0, f64::min)
                     .max(0.05);
-                shape(&key_image(&images, t)) * trust
+                let k = key_image(&images, t);
+                let longest = [
+                    (k[1] - k[0]).norm(),
+                    (k[2] - k[0]).norm(),
+                    (k[2] - k[1]).norm(),
+                ]
+                .into_iter()
+                .fold(0.0, f64::max);
+                shape(&k) * longest * trust
             };
             score(a).total_cmp(&score(b))
         })
@@ -273,6 +284,17 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
     // root choices (a wrong pose twists the shoulders against the hips and bends knees the
     // wrong way for the whole clip).
     let key_of = |pose: &super::calibrate::Pose| triangle.points.map(|p| pose.apply(&p));
+    // What the key path's refit needs: the key joints' smoothed image points, their trust, and
+    // their tracks' noise (the key joints' own: the tracker carries them with the trunk block,
+    // steadier than the limbs; on the suite from the tracker's output 113.1 → 111.8 mm against
+    // the median over all joints, other inputs within 0.5 mm).
+    let key_observed: Vec<[Point2<f64>; 3]> = (0..n).map(|t| key_image(&images, t)).collect();
+    let key_weights: Vec<[f64; 3]> = tracks
+        .frames
+        .iter()
+        .map(|f| KEY_JOINTS.map(|j| track_weight(&f.points[j])))
+        .collect();
+    let noise_px = median_noise_px(tracks, &KEY_JOINTS);
     let mut best: Option<(f64, Vec<FrameReport>, Resolved)> = None;
     // Every frame's candidate poses, computed once.
     let per_frame: Vec<(Vec<[Point3<f64>; 3]>, bool)> = (0..n)
@@ -286,13 +308,17 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
             per_frame.iter().map(|(k, _)| k.clone()).collect();
         candidates[calibration_frame] = vec![key_of(&c.pose)];
         let mut key = smoothest_key_path(&candidates);
-        smooth_key_depths(
-            &mut key,
-            &images,
-            cam,
-            &sigma.map(|_, s| s * job.params.key_depth_smoothing),
-            &triangle.points,
-        );
+        if job.params.key_path_smoothing {
+            key = smooth_key_path(
+                cam,
+                &key,
+                &key_observed,
+                &key_weights,
+                &triangle.points,
+                noise_px,
+                fps,
+            );
+        }
         let mut reports: Vec<FrameReport> = tracks
             .frames
             .iter()
@@ -434,69 +460,6 @@ fn key_candidates(
     (out, converged)
 }
 
-/// Smooths each key joint's depth over the frames by a Gaussian of `sigma[joint]` frames, on its
-/// viewing ray (through `images`), then puts the key triangle `model` rigidly where it best fits
-/// the smoothed points (Kabsch), so that its sides keep their lengths: the bones stay rigid and
-/// the BVH export stays exact.
-fn smooth_key_depths(
-    key: &mut [[Point3<f64>; 3]],
-    images: &[PerJoint<Point2<f64>>],
-    cam: &PinholeCamera,
-    sigma: &PerJoint<f64>,
-    model: &[Point3<f64>; 3],
-) {
-    let n = key.len();
-    let mut moved = false;
-    for (i, &joint) in KEY_JOINTS.iter().enumerate() {
-        let s = sigma[joint];
-        if s < UNTOUCHED_BELOW {
-            continue;
-        }
-        moved = true;
-        let depth: Vec<f64> = key.iter().map(|k| k[i].z).collect();
-        for (t, k) in key.iter_mut().enumerate() {
-            let z = gaussian_mean(t, n, s, 0.0, |u| (depth[u], 1.0));
-            k[i] = Point3::from(depth_ray(cam, &images[t][joint]) * z);
-        }
-    }
-    if moved {
-        let cm = centroid(model);
-        for k in key.iter_mut() {
-            let r = rigid_rotation(model, k);
-            let c = centroid(k);
-            *k = model.map(|m| Point3::from(r * (m.coords - cm) + c));
-        }
-    }
-}
-
-/// The centroid of three points (the key triangle's).
-fn centroid(p: &[Point3<f64>; 3]) -> Vector3<f64> {
-    (p[0].coords + p[1].coords + p[2].coords) / 3.0
-}
-
-/// The rotation taking `model` onto `target` about their centroids, in the least-squares sense
-/// (Kabsch 1976).
-fn rigid_rotation(
-    model: &[Point3<f64>; 3],
-    target: &[Point3<f64>; 3],
-) -> nalgebra::UnitQuaternion<f64> {
-    let (cm, ct) = (centroid(model), centroid(target));
-    let mut h = nalgebra::Matrix3::zeros();
-    for (m, t) in model.iter().zip(target) {
-        h += (m.coords - cm) * (t.coords - ct).transpose();
-    }
-    let svd = h.svd(true, true);
-    let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
-        return nalgebra::UnitQuaternion::identity();
-    };
-    let mut d = nalgebra::Matrix3::identity();
-    if (v_t.transpose() * u.transpose()).determinant() < 0.0 {
-        d[(2, 2)] = -1.0;
-    }
-    let r = v_t.transpose() * d * u.transpose();
-    nalgebra::UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(r))
-}
-
 /// Squared acceleration of the key joints over three frames.
 fn key_acceleration(a: &[Point3<f64>; 3], b: &[Point3<f64>; 3], c: &[Point3<f64>; 3]) -> f64 {
     (0..3)
@@ -625,7 +588,7 @@ pub fn lift(
             .tracks
             .frames
             .iter()
-            .map(|f| f.points.map(|_, p| super::refine::track_weight(p)))
+            .map(|f| f.points.map(|_, p| track_weight(p)))
             .collect();
         // The refinement sees the same smoothed points: fitted to the raw ones it brought the
         // noise back (2 px noise on the suite: 80 → 108 mm).
@@ -636,7 +599,7 @@ pub fn lift(
             &per.resolved.points,
             &job.subject,
             job.tracks.source.fps,
-            super::smoothing::median_noise_px(job.tracks),
+            median_noise_px(job.tracks, &Joint::ALL),
             &job.params.refinement,
             &mut |done, total| {
                 progress(&LiftProgress {
@@ -667,18 +630,7 @@ pub fn lift(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn the_rigid_rotation_finds_a_turned_triangle() {
-        let model = [
-            Point3::new(0.18, 0.0, 0.0),
-            Point3::new(-0.18, 0.0, 0.0),
-            Point3::new(0.0, 0.15, 0.0),
-        ];
-        let r = nalgebra::UnitQuaternion::from_euler_angles(0.3, -0.8, 0.2);
-        let moved = model.map(|p| r * p + Vector3::new(0.2, -0.1, 3.0));
-        assert!(rigid_rotation(&model, &moved).angle_to(&r) < 1e-9);
-    }
+    use nalgebra::Vector3;
 
     #[test]
     fn key_poses_deeper_than_the_trunk_allows_are_dropped() {
