@@ -4,7 +4,8 @@
 //! Each joint's 2D track is first smoothed by the width its own noise calls for ([`smoothing`]).
 //! The key triangle (both shoulders and the chest) calibrates the camera on the best frame
 //! ([`calibrate`], eqs. 6–9) and is carried to the other frames by its constant side lengths
-//! ([`propagate`], eqs. 10–11); every other joint is placed on its viewing ray at its bone's
+//! ([`propagate`], eqs. 10–11), and its path is refitted over the whole clip ([`key_path`]);
+//! every other joint is placed on its viewing ray at its bone's
 //! length from its parent ([`backproject`]); the two roots of each bone are chosen over the
 //! whole sequence ([`ambiguity`]); a global least-squares pass ([`refine`]) then adjusts all
 //! frames and the bone lengths together. [`focal`] estimates an unknown focal length;
