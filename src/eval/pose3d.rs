@@ -160,17 +160,20 @@ pub fn score_skeleton(gt: &GroundTruth, skeleton: &Skeleton3d) -> Result<Pose3dS
     Ok(s)
 }
 
-/// Mean distance between two joints over the reference's frames.
-fn mean_distance(gt: &GroundTruth, a: Joint, b: Joint) -> f64 {
-    let sum: f64 = gt
-        .frames
+/// The distance between two joints in each of the reference's frames.
+fn distances(gt: &GroundTruth, a: Joint, b: Joint) -> Vec<f64> {
+    gt.frames
         .iter()
         .map(|f| {
             let p = f.points3d();
             (p[a] - p[b]).norm()
         })
-        .sum();
-    sum / gt.frames.len().max(1) as f64
+        .collect()
+}
+
+/// Mean distance between two joints over the reference's frames.
+fn mean_distance(gt: &GroundTruth, a: Joint, b: Joint) -> f64 {
+    distances(gt, a, b).iter().sum::<f64>() / gt.frames.len().max(1) as f64
 }
 
 /// The subject's stature as a user would give it: the reference's leg, spine, neck and head
@@ -249,14 +252,7 @@ pub fn key_triangle_flex_m(gt: &GroundTruth) -> f64 {
     sides
         .iter()
         .map(|&(a, b)| {
-            let lengths: Vec<f64> = gt
-                .frames
-                .iter()
-                .map(|f| {
-                    let p = f.points3d();
-                    (p[a] - p[b]).norm()
-                })
-                .collect();
+            let lengths = distances(gt, a, b);
             let mean = lengths.iter().sum::<f64>() / n;
             (lengths.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / n).sqrt()
         })

@@ -15,7 +15,7 @@
 //! Each frame's triangle is then put rigidly where it best fits the result (Kabsch), so its
 //! sides keep their lengths exactly and the BVH export stays exact.
 
-use super::least_squares::{Residuals, Row, minimise};
+use super::least_squares::{Residuals, Row, frame_interval_s, minimise};
 use crate::camera::PinholeCamera;
 use nalgebra::{DVector, Matrix3, Point2, Point3, Rotation3, UnitQuaternion, Vector3};
 
@@ -134,11 +134,7 @@ pub fn smooth_key_path(
         // Tracks without measurable noise: the path from eqs. 10–11 is already exact.
         return key.to_vec();
     }
-    let dt = if fps.is_finite() && fps > 0.0 {
-        1.0 / fps
-    } else {
-        1.0 / 30.0
-    };
+    let dt = frame_interval_s(fps);
     let problem = KeyPath {
         cam,
         observed,
@@ -275,17 +271,10 @@ mod tests {
         let weights = vec![[1.0; 3]; truth.len()];
         // Without noise the path is returned as it is; at the least noise assumed it barely
         // moves.
-        let out = smooth_key_path(&cam, &truth, &observed, &weights, &model, 0.0, 30.0);
-        assert_eq!(out, truth);
-        let out = smooth_key_path(
-            &cam,
-            &truth,
-            &observed,
-            &weights,
-            &model,
-            MIN_NOISE_PX,
-            30.0,
-        );
+        let fit =
+            |noise: f64| smooth_key_path(&cam, &truth, &observed, &weights, &model, noise, 30.0);
+        assert_eq!(fit(0.0), truth);
+        let out = fit(MIN_NOISE_PX);
         assert!(
             mean_error(&out, &truth) < 1e-4,
             "{}",
@@ -306,20 +295,12 @@ mod tests {
         // tight, acceleration loose) from a start along the true path.
         let (cam, model, truth, observed) = walk(2.0);
         let weights = vec![[1.0; 3]; truth.len()];
-        let per_frame = smooth_key_path(
-            &cam,
-            &truth,
-            &observed,
-            &weights,
-            &model,
-            MIN_NOISE_PX,
-            30.0,
-        );
+        let fit = |start: &[[Point3<f64>; 3]], noise: f64| {
+            smooth_key_path(&cam, start, &observed, &weights, &model, noise, 30.0)
+        };
+        let per_frame = fit(&truth, MIN_NOISE_PX);
         let before = mean_error(&per_frame, &truth);
-        let after = mean_error(
-            &smooth_key_path(&cam, &per_frame, &observed, &weights, &model, 2.0, 30.0),
-            &truth,
-        );
+        let after = mean_error(&fit(&per_frame, 2.0), &truth);
         // Measured: 224 → 86 mm.
         assert!(before > 0.1, "before {before}");
         assert!(after < 0.5 * before, "{before} → {after}");

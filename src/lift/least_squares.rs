@@ -7,6 +7,16 @@ use nalgebra::{DMatrix, DVector};
 use nalgebra_sparse::factorization::CscCholesky;
 use nalgebra_sparse::{CooMatrix, CscMatrix};
 
+/// The time between frames at `fps`, seconds (1/30 s when the rate is unknown): both problems'
+/// acceleration terms are second differences over frames.
+pub(crate) fn frame_interval_s(fps: f64) -> f64 {
+    if fps.is_finite() && fps > 0.0 {
+        1.0 / fps
+    } else {
+        1.0 / 30.0
+    }
+}
+
 /// Most nonzero partial derivatives in one residual row (the refinement's scale row has one per
 /// length: 15 bones and the shoulder width).
 pub(crate) const MAX_ENTRIES: usize = 16;

@@ -18,7 +18,7 @@
 //! the length columns) and factored with `nalgebra-sparse`'s Cholesky.
 
 use super::error::LiftError;
-use super::least_squares::{Residuals, Row, minimise};
+use super::least_squares::{Residuals, Row, frame_interval_s, minimise};
 use crate::camera::PinholeCamera;
 use crate::formats::{PointSource, TrackedPoint};
 use crate::skeleton::{BONE_COUNT, Bone, JOINT_COUNT, Joint, PerJoint, SubjectModel};
@@ -341,11 +341,7 @@ pub fn refine(
 ) -> Result<Refined, LiftError> {
     let n = start.len();
     let start_lengths = subject_lengths(subject);
-    let dt = if fps.is_finite() && fps > 0.0 {
-        1.0 / fps
-    } else {
-        1.0 / 30.0
-    };
+    let dt = frame_interval_s(fps);
     let problem = Problem {
         cam,
         images,
