@@ -194,6 +194,7 @@ fn rigid_rotation(model: &[Point3<f64>; 3], target: &[Point3<f64>; 3]) -> UnitQu
 
 #[cfg(test)]
 mod tests {
+    use super::super::least_squares::assert_rows_match_finite_differences;
     use super::*;
     use rand::SeedableRng;
     use rand_distr::{Distribution, Normal};
@@ -263,6 +264,30 @@ mod tests {
             .map(|(p, q)| (0..3).map(|k| (p[k] - q[k]).norm()).sum::<f64>())
             .sum();
         sum / (3 * a.len()) as f64
+    }
+
+    /// Central finite differences of every residual against the analytic rows, off the
+    /// solution (noisy points, a start moved away from them).
+    #[test]
+    fn analytic_rows_match_finite_differences() {
+        let (cam, model, truth, observed) = walk(2.0);
+        let (truth, observed) = (&truth[..5], &observed[..5]);
+        let weights: Vec<[f64; 3]> = (0..5).map(|t| [1.0, 0.5, 0.2 + 0.1 * t as f64]).collect();
+        let problem = KeyPath {
+            cam: &cam,
+            observed,
+            weights: &weights,
+            sides: SIDES.map(|(a, b)| 1.02 * (model[b] - model[a]).norm()),
+            sigma_px: 0.7,
+            sigma_accel_m: 0.01,
+        };
+        let x = DVector::from_iterator(
+            45,
+            truth
+                .iter()
+                .flat_map(|k| k.iter().flat_map(|p| [p.x + 0.01, p.y - 0.02, p.z + 0.05])),
+        );
+        assert_rows_match_finite_differences(&problem, &x);
     }
 
     #[test]

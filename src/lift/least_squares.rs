@@ -144,6 +144,40 @@ pub(crate) fn minimise(
     })
 }
 
+/// Test support: asserts that every row's analytic partial derivatives at `x` match central
+/// finite differences.
+#[cfg(test)]
+pub(crate) fn assert_rows_match_finite_differences(problem: &dyn Residuals, x: &DVector<f64>) {
+    let collect = |x: &DVector<f64>| {
+        let mut rows = Vec::new();
+        problem.rows(x, &mut |r| rows.push(r));
+        rows
+    };
+    let base = collect(x);
+    let mut dense = DMatrix::<f64>::zeros(base.len(), x.len());
+    for (r, row) in base.iter().enumerate() {
+        for &(c, d) in &row.entries[..row.len] {
+            dense[(r, c)] += d;
+        }
+    }
+    for c in 0..x.len() {
+        let h = 1e-6;
+        let mut xp = x.clone();
+        xp[c] += h;
+        let mut xm = x.clone();
+        xm[c] -= h;
+        let (rp, rm) = (collect(&xp), collect(&xm));
+        for r in 0..base.len() {
+            let numeric = (rp[r].value - rm[r].value) / (2.0 * h);
+            let analytic = dense[(r, c)];
+            assert!(
+                (numeric - analytic).abs() <= 1e-4 * (1.0 + numeric.abs()),
+                "row {r} column {c}: analytic {analytic}, numeric {numeric}"
+            );
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

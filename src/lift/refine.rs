@@ -381,8 +381,8 @@ pub fn refine(
 
 #[cfg(test)]
 mod tests {
+    use super::super::least_squares::assert_rows_match_finite_differences;
     use super::*;
-    use nalgebra::DMatrix;
 
     #[test]
     fn the_adaptive_acceleration_term_is_firmer_for_noisier_tracks() {
@@ -439,34 +439,6 @@ mod tests {
             accel_sigma_m: 20.0 / 900.0,
         };
         let x = Problem::pack(&start, &start_lengths.map(|l| l * 1.05));
-        let m = x.len();
-        let collect = |x: &DVector<f64>| {
-            let mut rows = Vec::new();
-            problem.emit_rows(x, &mut |r| rows.push(r));
-            rows
-        };
-        let base = collect(&x);
-        let mut dense = DMatrix::<f64>::zeros(base.len(), m);
-        for (r, row) in base.iter().enumerate() {
-            for &(c, d) in &row.entries[..row.len] {
-                dense[(r, c)] += d;
-            }
-        }
-        for c in 0..m {
-            let h = 1e-6;
-            let mut xp = x.clone();
-            xp[c] += h;
-            let mut xm = x.clone();
-            xm[c] -= h;
-            let (rp, rm) = (collect(&xp), collect(&xm));
-            for r in 0..base.len() {
-                let numeric = (rp[r].value - rm[r].value) / (2.0 * h);
-                let analytic = dense[(r, c)];
-                assert!(
-                    (numeric - analytic).abs() <= 1e-4 * (1.0 + numeric.abs()),
-                    "row {r} column {c}: analytic {analytic}, numeric {numeric}"
-                );
-            }
-        }
+        assert_rows_match_finite_differences(&problem, &x);
     }
 }
