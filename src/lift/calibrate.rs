@@ -189,14 +189,23 @@ pub fn shape(image: &[Point2<f64>; 3]) -> f64 {
     let a = image[1] - image[0];
     let b = image[2] - image[0];
     let area2 = (a.x * b.y - a.y * b.x).abs();
-    let longest = [a.norm(), b.norm(), (image[2] - image[1]).norm()]
-        .into_iter()
-        .fold(0.0, f64::max);
+    let longest = longest_side(image);
     if longest <= 0.0 {
         0.0
     } else {
         area2 / (longest * longest)
     }
+}
+
+/// The longest side of an image triangle, pixels.
+pub fn longest_side(image: &[Point2<f64>; 3]) -> f64 {
+    [
+        (image[1] - image[0]).norm(),
+        (image[2] - image[0]).norm(),
+        (image[2] - image[1]).norm(),
+    ]
+    .into_iter()
+    .fold(0.0, f64::max)
 }
 
 /// Below this [`shape`], lines are not used (see [`Residuals::Points`]).

@@ -113,7 +113,7 @@ impl Residuals for KeyPath<'_> {
 }
 
 /// The key acceleration deviation for tracks of `noise_px` white noise, m/s².
-pub fn key_acceleration_mps2(noise_px: f64) -> f64 {
+fn key_acceleration_mps2(noise_px: f64) -> f64 {
     (KEY_ACCELERATION_TIMES_NOISE / noise_px.max(MIN_NOISE_PX)).max(MIN_KEY_ACCELERATION_MPS2)
 }
 

@@ -129,6 +129,8 @@ pub fn track_weight(p: &TrackedPoint) -> f64 {
 
 /// Lengths held: the 15 bones then the shoulder width.
 const LENGTHS: usize = BONE_COUNT + 1;
+// The scale row has one entry per length.
+const _: () = assert!(LENGTHS <= super::least_squares::MAX_ENTRIES);
 const PER_FRAME: usize = 3 * JOINT_COUNT;
 
 /// The pairs of joints held at a length, in [`Bone::ALL`] order then the shoulders.
@@ -188,8 +190,23 @@ impl Problem<'_> {
         Point3::new(x[c], x[c + 1], x[c + 2])
     }
 
-    /// Calls `emit` for every residual row at `x`.
-    fn emit_rows(&self, x: &DVector<f64>, emit: &mut dyn FnMut(Row)) {
+    fn reprojection_rms(&self, x: &DVector<f64>) -> f64 {
+        let mut sum = 0.0;
+        let mut count = 0.0f64;
+        for (t, image) in self.images.iter().enumerate() {
+            for j in Joint::ALL {
+                if let Some(p) = self.cam.project(&Self::point(x, t, j)) {
+                    sum += (p - image[j]).norm_squared();
+                    count += 1.0;
+                }
+            }
+        }
+        (sum / count.max(1.0)).sqrt()
+    }
+}
+
+impl Residuals for Problem<'_> {
+    fn rows(&self, x: &DVector<f64>, emit: &mut dyn FnMut(Row)) {
         let n = self.images.len();
         let lcol = n * PER_FRAME;
         let p = &self.params;
@@ -289,26 +306,6 @@ impl Problem<'_> {
             row = row.with(lcol + k, s);
         }
         emit(row);
-    }
-
-    fn reprojection_rms(&self, x: &DVector<f64>) -> f64 {
-        let mut sum = 0.0;
-        let mut count = 0.0f64;
-        for (t, image) in self.images.iter().enumerate() {
-            for j in Joint::ALL {
-                if let Some(p) = self.cam.project(&Self::point(x, t, j)) {
-                    sum += (p - image[j]).norm_squared();
-                    count += 1.0;
-                }
-            }
-        }
-        (sum / count.max(1.0)).sqrt()
-    }
-}
-
-impl Residuals for Problem<'_> {
-    fn rows(&self, x: &DVector<f64>, emit: &mut dyn FnMut(Row)) {
-        self.emit_rows(x, emit);
     }
 }
 

@@ -58,25 +58,6 @@ pub fn adaptive_sigma(noise_px: f64, motion_px: f64) -> f64 {
 /// less than 1e-4.
 const UNTOUCHED_BELOW: f64 = 0.3;
 
-/// The Gaussian mean of `n` samples around sample `t`, `s` wide (in samples): `sample(u)` gives
-/// sample `u`'s value and its own weight (which multiplies the Gaussian's).
-fn gaussian_mean<V>(t: usize, n: usize, s: f64, zero: V, sample: impl Fn(usize) -> (V, f64)) -> V
-where
-    V: Copy + std::ops::Add<Output = V> + std::ops::Mul<f64, Output = V>,
-{
-    let reach = (3.0 * s).ceil() as usize;
-    let mut sum = zero;
-    let mut total = 0.0;
-    for u in t.saturating_sub(reach)..(t + reach + 1).min(n) {
-        let d = u as f64 - t as f64;
-        let (value, weight) = sample(u);
-        let w = (-0.5 * d * d / (s * s)).exp() * weight;
-        sum = sum + value * w;
-        total += w;
-    }
-    sum * (1.0 / total)
-}
-
 /// The tracks smoothed over time, joint `j` by a Gaussian of `sigma[j]` frames (0 = untouched),
 /// each point weighted by its trust ([`super::refine::track_weight`]).
 pub fn smoothed_images(tracks: &Tracks2d, sigma: &PerJoint<f64>) -> Vec<PerJoint<Point2<f64>>> {
@@ -93,12 +74,19 @@ pub fn smoothed_images(tracks: &Tracks2d, sigma: &PerJoint<f64>) -> Vec<PerJoint
                 if s < UNTOUCHED_BELOW {
                     return raw[t][j];
                 }
-                Point2::from(gaussian_mean(t, n, s, Vector2::zeros(), |u| {
-                    (
-                        raw[u][j].coords,
-                        super::refine::track_weight(&tracks.frames[u].points[j]),
-                    )
-                }))
+                let reach = (3.0 * s).ceil() as usize;
+                let mut sum = Vector2::zeros();
+                let mut total = 0.0;
+                let first = t.saturating_sub(reach);
+                let window = raw.iter().zip(&tracks.frames).enumerate();
+                for (u, (point, frame)) in window.skip(first).take(t + reach + 1 - first) {
+                    let d = u as f64 - t as f64;
+                    let w = (-0.5 * d * d / (s * s)).exp()
+                        * super::refine::track_weight(&frame.points[j]);
+                    sum += point[j].coords * w;
+                    total += w;
+                }
+                Point2::from(sum * (1.0 / total))
             })
         })
         .collect()

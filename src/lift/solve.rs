@@ -4,7 +4,8 @@
 use super::ambiguity::{AmbiguityWeights, DepthOverrides, Resolved, resolve};
 use super::backproject::Root;
 use super::calibrate::{
-    KEY_JOINTS, KeyTriangle, Residuals, calibrate_all, calibrate_from, shape, starting_poses,
+    KEY_JOINTS, KeyTriangle, Residuals, calibrate_all, calibrate_from, longest_side, shape,
+    starting_poses,
 };
 use super::error::LiftError;
 use super::key_path::{centroid, smooth_key_path};
@@ -252,14 +253,7 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
                     .fold(1.0, f64::min)
                     .max(0.05);
                 let k = key_image(&images, t);
-                let longest = [
-                    (k[1] - k[0]).norm(),
-                    (k[2] - k[0]).norm(),
-                    (k[2] - k[1]).norm(),
-                ]
-                .into_iter()
-                .fold(0.0, f64::max);
-                shape(&k) * longest * trust
+                shape(&k) * longest_side(&k) * trust
             };
             score(a).total_cmp(&score(b))
         })
