@@ -25,8 +25,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 #[serde(default, deny_unknown_fields)]
 pub struct LiftParams {
     /// Run the global refinement after the per-frame solve (default false: on the synthetic
-    /// suite with true lengths it lowers the error by little, 61.9 → 61.4 mm with 2 px white
-    /// noise (four draws) and 111.8 → 111.4 mm with the tracker's output and leaves exact
+    /// suite with true lengths it lowers the error by little, 56.8 → 56.5 mm with 2 px white
+    /// noise (four draws) and 112.0 → 111.6 mm with the tracker's output and leaves exact
     /// tracks at 20.6 mm, but raises it on the real sample with the reference 2D,
     /// 69.3 → 72.9 mm;
     /// `bench lift` reports both).
@@ -48,11 +48,12 @@ pub struct LiftParams {
     /// 151.5 → 157.7 mm (its errors are drift and jumps more than white noise).
     pub adaptive_smoothing: bool,
     /// Refit the key triangle's path over the whole clip after it is chosen frame by frame
-    /// ([`super::key_path`]: reprojection, rigid sides and acceleration by least squares, as
-    /// firm as the tracks are noisy; default true). With the calibration frame chosen by size
-    /// as well, on the synthetic suite with true lengths: 2 px noise (four draws)
-    /// 71.0 → 61.9 mm, exact tracks 20.4 → 20.6 mm, the tracker's output 111.3 → 111.8 mm; the
-    /// real sample with noise 73.1 → 70.3 mm, with its reference 2D 69.2 → 69.3 mm.
+    /// ([`super::key_path`]: reprojection, rigid sides, acceleration and the trunk's pitch
+    /// towards the camera by least squares, as firm as the tracks are noisy; default true).
+    /// With the calibration frame chosen by size as well, on the synthetic suite with true
+    /// lengths: 2 px noise (four draws) 71.0 → 56.8 mm, exact tracks 20.4 → 20.6 mm, the
+    /// tracker's output 111.3 → 112.0 mm; the real sample with noise 73.1 → 70.5 mm, with its
+    /// reference 2D 69.2 → 69.3 mm.
     pub key_path_smoothing: bool,
     /// Weights of the depth-ambiguity priors.
     pub ambiguity: AmbiguityWeights,
