@@ -138,6 +138,17 @@ impl Residuals for KeyPath<'_> {
     }
 }
 
+/// The weight of a squared pitch deviation (metres², [`tilt_m`] from the clip's) against a
+/// squared acceleration of the key joints (metres² per frame², unweighted) when the key poses are
+/// first chained frame by frame: the ratio of their variances in the refit, so both steps weigh
+/// the two alike (0.14 at 30 frames/s whatever the noise: both deviations scale with it).
+pub(crate) fn pitch_weight(noise_px: f64, fps: f64) -> f64 {
+    let dt = frame_interval_s(fps);
+    let sigma_accel_m = key_acceleration_mps2(noise_px) * dt * dt;
+    let sigma_tilt_m = KEY_TILT_TIMES_NOISE / noise_px.max(MIN_NOISE_PX);
+    (sigma_accel_m / sigma_tilt_m).powi(2)
+}
+
 /// The key acceleration deviation for tracks of `noise_px` white noise, m/s².
 fn key_acceleration_mps2(noise_px: f64) -> f64 {
     (KEY_ACCELERATION_TIMES_NOISE / noise_px.max(MIN_NOISE_PX)).max(MIN_KEY_ACCELERATION_MPS2)
@@ -203,7 +214,7 @@ pub fn smooth_key_path(
 
 /// How far the chest lies behind the shoulders' midpoint along the camera's axis, metres: the
 /// trunk's pitch towards (negative) or away from the camera.
-fn tilt_m(key: &[Point3<f64>; 3]) -> f64 {
+pub(crate) fn tilt_m(key: &[Point3<f64>; 3]) -> f64 {
     key[2].z - 0.5 * (key[0].z + key[1].z)
 }
 
