@@ -138,13 +138,23 @@ impl Residuals for KeyPath<'_> {
     }
 }
 
-/// The weight of a squared pitch deviation (metres², [`tilt_m`] from the clip's) against a
-/// squared acceleration of the key joints (metres² per frame², unweighted) when the key poses are
-/// first chained frame by frame: the ratio of their variances in the refit, so both steps weigh
-/// the two alike (0.14 at 30 frames/s whatever the noise: both deviations scale with it).
-pub(crate) fn pitch_weight(noise_px: f64, fps: f64) -> f64 {
+/// The pitch prior for chaining the key poses frame by frame, `(weight, reference pitch)`:
+/// a squared pitch deviation (metres², [`tilt_m`] from `reference`'s) weighs against a squared
+/// acceleration of the key joints (metres² per frame², unweighted) by the ratio of their
+/// variances in the refit, so both steps weigh the two alike (0.14 at 30 frames/s whatever the
+/// noise: both deviations scale with it). `None` where the refit leaves the path alone (below
+/// [`MIN_NOISE_PX`]).
+pub(crate) fn chain_pitch_prior(
+    noise_px: f64,
+    fps: f64,
+    reference: &[Point3<f64>; 3],
+) -> Option<(f64, f64)> {
+    if noise_px < MIN_NOISE_PX {
+        return None;
+    }
     let dt = frame_interval_s(fps);
-    (key_acceleration_mps2(noise_px) * dt * dt / key_tilt_sigma_m(noise_px)).powi(2)
+    let weight = (key_acceleration_mps2(noise_px) * dt * dt / key_tilt_sigma_m(noise_px)).powi(2);
+    Some((weight, tilt_m(reference)))
 }
 
 /// The deviation of a frame's pitch from the clip's for tracks of `noise_px` white noise, m.

@@ -8,7 +8,7 @@ use super::calibrate::{
     starting_poses,
 };
 use super::error::LiftError;
-use super::key_path::{MIN_NOISE_PX, centroid, pitch_weight, smooth_key_path, tilt_m};
+use super::key_path::{centroid, chain_pitch_prior, smooth_key_path, tilt_m};
 use super::propagate::key_depths;
 use super::refine::{RefineParams, RefineSummary, refine, track_weight};
 use super::smoothing::{adaptive_sigmas, median_noise_px, smoothed_images};
@@ -307,8 +307,11 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
         // choice then seldom tips a facing triangle the wrong way (2 px noise, four draws on
         // the suite: 56.8 → 53.3 mm, wrong roots 16.6 → 14.3 %; fixed weights from 0.05 to 0.4
         // gave 53.0–53.9; the real sample with noise and the tracker's output unchanged).
-        let pitch = (job.params.key_path_smoothing && noise_px >= MIN_NOISE_PX)
-            .then(|| (pitch_weight(noise_px, fps), tilt_m(&key_of(&c.pose))));
+        let pitch = job
+            .params
+            .key_path_smoothing
+            .then(|| chain_pitch_prior(noise_px, fps, &key_of(&c.pose)))
+            .flatten();
         let mut key = smoothest_key_path(&candidates, pitch);
         if job.params.key_path_smoothing {
             key = smooth_key_path(
@@ -510,9 +513,10 @@ fn smoothest_key_path(
         let mut from = vec![vec![0usize; kc]; kb];
         for b in 0..kb {
             for c in 0..kc {
+                let pitch_c = pitch_cost(&candidates[t][c]);
                 for (a, row) in cost.iter().enumerate() {
                     let total = row[b]
-                        + pitch_cost(&candidates[t][c])
+                        + pitch_c
                         + key_acceleration(
                             &candidates[t - 2][a],
                             &candidates[t - 1][b],
