@@ -8,7 +8,8 @@
 //! model update). Metrics from [`videomocap::eval`].
 //!
 //! Speed: frames per second of the tracker at 640×480 and 1080×1920, with frames already in
-//! memory (decoding excluded) and with decoding, on one thread and on all.
+//! memory (decoding excluded) and with decoding, on one thread and on all; and how much longer
+//! tracking with decoding takes than decoding alone, timed back to back in paired rounds.
 
 use super::args::{BenchArgs, GlobalArgs};
 use super::{ExitError, say};
@@ -380,7 +381,6 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         ("640×480", speed_clip.as_path()),
         ("1080×1920", real.as_path()),
     ] {
-        let mut with = f64::NAN;
         for decoding in [false, true] {
             for t in [1, threads] {
                 let n = speed(dir, t, decoding, params)?;
@@ -395,9 +395,6 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
                     format!("track {label}, {t} {plural}, {what}"),
                     n
                 ));
-                if decoding && t == threads {
-                    with = n;
-                }
             }
         }
         let d = decode_speed(dir)?;
@@ -406,10 +403,16 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             format!("decode only {label}"),
             d
         ));
+        let (median, low, high) = paired_ratio(dir, threads, params)?;
         lines.push(format!(
             "{:<48} {:>12.2}",
             format!("time ratio track+decode / decode {label}"),
-            d / with
+            median
+        ));
+        lines.push(format!(
+            "{:<48} {:>12}",
+            format!("  (median of {RATIO_ROUNDS} paired rounds; range)"),
+            format!("{low:.2}–{high:.2}")
         ));
     }
     if global.json {
@@ -434,8 +437,68 @@ fn merge(total: &mut ClipScore, s: &ClipScore) {
     }
 }
 
-/// Frames per second of `track_video` on a clip; `decoding` false pre-loads every frame into
-/// the cache first.
+/// A prepared speed measurement of tracking one clip: the job and, when decoding is excluded,
+/// the video with every frame already in its cache.
+struct TrackTimer {
+    dir: PathBuf,
+    job: TrackJob,
+    decoding: bool,
+    preloaded: Option<Video>,
+}
+
+impl TrackTimer {
+    fn new(
+        dir: &Path,
+        threads: usize,
+        decoding: bool,
+        params: TrackerParams,
+    ) -> Result<Self, ExitError> {
+        let marks = Marks::load(&dir.join("marks.json")).map_err(ExitError::failed)?;
+        // Frames in memory are full size: the tracker shrinks them itself (FFmpeg's scaling
+        // while decoding would empty the cache).
+        let params = TrackerParams {
+            decoder_scaling: decoding,
+            ..params
+        };
+        Ok(TrackTimer {
+            dir: dir.to_owned(),
+            job: TrackJob::from_marks(&marks, params, threads),
+            decoding,
+            preloaded: None,
+        })
+    }
+
+    /// Tracks the clip once: (frames, seconds). With decoding every run opens the video
+    /// afresh (its cache would hold the frames); without, the frames are loaded before the
+    /// clock starts and kept for the next run.
+    fn run_once(&mut self) -> Result<(usize, f64), ExitError> {
+        let mut video = match self.preloaded.take() {
+            Some(v) => v,
+            None => {
+                let options = OpenOptions {
+                    cache_bytes: 2 << 30,
+                    ..OpenOptions::default()
+                };
+                Video::open(&self.dir.join("video.mp4"), &options).map_err(ExitError::failed)?
+            }
+        };
+        let n = video.info().frame_count;
+        if !self.decoding {
+            for i in 0..n {
+                let _: Arc<_> = video.frame(i).map_err(ExitError::failed)?.image;
+            }
+        }
+        let t0 = Instant::now();
+        track_video(&mut video, &self.job, &mut |_| {}, &AtomicBool::new(false))
+            .map_err(ExitError::failed)?;
+        let s = t0.elapsed().as_secs_f64();
+        if !self.decoding {
+            self.preloaded = Some(video);
+        }
+        Ok((n, s))
+    }
+}
+
 /// Frames per second of tracking `dir`'s clip: the fastest of [`SPEED_RUNS`] runs (the machine
 /// is shared, and a slow run measures the neighbours, not the tracker).
 fn speed(
@@ -444,60 +507,71 @@ fn speed(
     decoding: bool,
     params: TrackerParams,
 ) -> Result<f64, ExitError> {
-    let marks = Marks::load(&dir.join("marks.json")).map_err(ExitError::failed)?;
-    let options = OpenOptions {
-        cache_bytes: 2 << 30,
-        ..OpenOptions::default()
-    };
-    // Frames in memory are full size: the tracker shrinks them itself (FFmpeg's scaling while
-    // decoding would empty the cache).
-    let params = TrackerParams {
-        decoder_scaling: decoding,
-        ..params
-    };
-    let job = TrackJob::from_marks(&marks, params, threads);
-    let mut preloaded: Option<Video> = None;
+    let mut timer = TrackTimer::new(dir, threads, decoding, params)?;
     let mut best = f64::INFINITY;
     let mut n = 0;
     for _ in 0..SPEED_RUNS {
-        // With decoding every run opens the video afresh (its cache would hold the frames).
-        let mut video = match preloaded.take() {
-            Some(v) => v,
-            None => Video::open(&dir.join("video.mp4"), &options).map_err(ExitError::failed)?,
-        };
-        n = video.info().frame_count;
-        if !decoding {
-            for i in 0..n {
-                let _: Arc<_> = video.frame(i).map_err(ExitError::failed)?.image;
-            }
-        }
-        let t0 = Instant::now();
-        track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false))
-            .map_err(ExitError::failed)?;
-        best = best.min(t0.elapsed().as_secs_f64());
-        if !decoding {
-            preloaded = Some(video);
-        }
+        let (frames, s) = timer.run_once()?;
+        n = frames;
+        best = best.min(s);
     }
     Ok(n as f64 / best)
 }
 
-/// Frames per second of decoding `dir`'s clip, the fastest of [`SPEED_RUNS`] runs.
-fn decode_speed(dir: &Path) -> Result<f64, ExitError> {
-    let mut s = f64::INFINITY;
-    let mut n = 0;
-    for _ in 0..SPEED_RUNS {
-        let mut video = Video::open(&dir.join("video.mp4"), &OpenOptions::default())
-            .map_err(ExitError::failed)?;
-        n = video.info().frame_count;
-        let t0 = Instant::now();
-        for i in 0..n {
-            video.frame(i).map_err(ExitError::failed)?;
-        }
-        s = s.min(t0.elapsed().as_secs_f64());
+/// Decodes `dir`'s clip once: (frames, seconds).
+fn decode_once(dir: &Path) -> Result<(usize, f64), ExitError> {
+    let mut video =
+        Video::open(&dir.join("video.mp4"), &OpenOptions::default()).map_err(ExitError::failed)?;
+    let n = video.info().frame_count;
+    let t0 = Instant::now();
+    for i in 0..n {
+        video.frame(i).map_err(ExitError::failed)?;
     }
+    let s = t0.elapsed().as_secs_f64();
     if s <= 0.0 {
         return Err(ExitError::failed(anyhow!("decoding took no time")));
     }
-    Ok(n as f64 / s)
+    Ok((n, s))
+}
+
+/// Frames per second of decoding `dir`'s clip, the fastest of [`SPEED_RUNS`] runs.
+fn decode_speed(dir: &Path) -> Result<f64, ExitError> {
+    let mut best = f64::INFINITY;
+    let mut n = 0;
+    for _ in 0..SPEED_RUNS {
+        let (frames, s) = decode_once(dir)?;
+        n = frames;
+        best = best.min(s);
+    }
+    Ok(n as f64 / best)
+}
+
+/// Rounds of the paired ratio measurement.
+const RATIO_ROUNDS: usize = 5;
+
+/// The time of tracking with decoding over the time of decoding alone, measured in
+/// [`RATIO_ROUNDS`] rounds that each time both back to back, so both halves of a ratio see the
+/// same neighbours on the shared machine: (median, lowest, highest) of the rounds' ratios.
+/// Fastest-of-n figures taken minutes apart put this ratio anywhere between 1.6 and 2.7.
+fn paired_ratio(
+    dir: &Path,
+    threads: usize,
+    params: TrackerParams,
+) -> Result<(f64, f64, f64), ExitError> {
+    let mut timer = TrackTimer::new(dir, threads, true, params)?;
+    // A first round warms the file cache and the thread pool; it is not counted.
+    decode_once(dir)?;
+    timer.run_once()?;
+    let mut ratios = Vec::with_capacity(RATIO_ROUNDS);
+    for _ in 0..RATIO_ROUNDS {
+        let (_, decode) = decode_once(dir)?;
+        let (_, track) = timer.run_once()?;
+        ratios.push(track / decode);
+    }
+    ratios.sort_by(f64::total_cmp);
+    Ok((
+        ratios[RATIO_ROUNDS / 2],
+        ratios[0],
+        ratios[RATIO_ROUNDS - 1],
+    ))
 }
