@@ -480,11 +480,20 @@ fn smoothest_key_path(
     candidates: &[Vec<[Point3<f64>; 3]>],
     pitch: Option<(f64, f64)>,
 ) -> Vec<[Point3<f64>; 3]> {
-    let pitch_cost = |k: &[Point3<f64>; 3]| {
-        pitch.map_or(0.0, |(weight, reference)| {
-            weight * (tilt_m(k) - reference).powi(2)
+    // Each candidate's pitch cost, once.
+    let pitch_cost: Vec<Vec<f64>> = candidates
+        .iter()
+        .map(|frame| {
+            frame
+                .iter()
+                .map(|k| {
+                    pitch.map_or(0.0, |(weight, reference)| {
+                        weight * (tilt_m(k) - reference).powi(2)
+                    })
+                })
+                .collect()
         })
-    };
+        .collect();
     let n = candidates.len();
     if n == 0 {
         return Vec::new();
@@ -495,13 +504,13 @@ fn smoothest_key_path(
     // cost[(a, b)]: best with frame t−1 at a and frame t at b.
     let mut cost: Vec<Vec<f64>> = candidates[0]
         .iter()
-        .map(|a| {
+        .zip(&pitch_cost[0])
+        .map(|(a, pitch_a)| {
             candidates[1]
                 .iter()
-                .map(|b| {
-                    pitch_cost(a)
-                        + pitch_cost(b)
-                        + (0..3).map(|i| (b[i] - a[i]).norm_squared()).sum::<f64>()
+                .zip(&pitch_cost[1])
+                .map(|(b, pitch_b)| {
+                    pitch_a + pitch_b + (0..3).map(|i| (b[i] - a[i]).norm_squared()).sum::<f64>()
                 })
                 .collect()
         })
@@ -513,7 +522,7 @@ fn smoothest_key_path(
         let mut from = vec![vec![0usize; kc]; kb];
         for b in 0..kb {
             for c in 0..kc {
-                let pitch_c = pitch_cost(&candidates[t][c]);
+                let pitch_c = pitch_cost[t][c];
                 for (a, row) in cost.iter().enumerate() {
                     let total = row[b]
                         + pitch_c
