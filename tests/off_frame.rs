@@ -206,8 +206,9 @@ fn joints_leaving_the_frame_are_tracked_and_exported_consistently() {
             }
         }
     }
-    // The report lists the off-frame runs and no interpolated run contains one; lost points
-    // lie in the runs left weak.
+    // The report lists the off-frame runs and no interpolated run contains one; a run left
+    // weak holds lost points, or was kept as tracked (it moved like its joint) and holds only
+    // tracked points under the weak threshold.
     let summary: serde_json::Value = serde_json::from_str(&summary).unwrap();
     let spans = summary["spans"].as_array().unwrap();
     for span in spans {
@@ -221,7 +222,12 @@ fn joints_leaving_the_frame_are_tracked_and_exported_consistently() {
         };
         assert_eq!(span["kind"] == "off_frame", has(&off_set), "{span}");
         if span["kind"] == "weak" {
-            assert!(has(&lost_set), "{span}");
+            let j = Joint::from_name(joint).unwrap();
+            let kept = tracks.frames[a..=b].iter().all(|f| {
+                f.points[j].source == PointSource::Tracked
+                    && f.points[j].confidence < TrackerParams::default().weak_reliability
+            });
+            assert!(has(&lost_set) || kept, "{span}");
         }
     }
 
