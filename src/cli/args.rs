@@ -220,7 +220,7 @@ pub struct CarveArgs {
 /// `synth`.
 #[derive(Debug, Args)]
 pub struct SynthArgs {
-    /// Motion: walk, wave, jumping-jacks, sit-down, bend, march, or a BVH file.
+    /// Motion: walk, treadmill, wave, jumping-jacks, sit-down, bend, march, or a BVH file.
     #[arg(long, default_value = "walk")]
     pub motion: String,
     /// Start time in the BVH, seconds.

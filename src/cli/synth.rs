@@ -23,7 +23,7 @@ pub fn params_from_args(a: &SynthArgs) -> Result<SynthParams, ExitError> {
             let path = PathBuf::from(&a.motion);
             if !path.is_file() {
                 return Err(ExitError::bad_input(anyhow!(
-                    "--motion {}: neither walk, wave, jumping-jacks, sit-down, bend, march nor an existing BVH file",
+                    "--motion {}: neither walk, treadmill, wave, jumping-jacks, sit-down, bend, march nor an existing BVH file",
                     a.motion
                 )));
             }
@@ -110,18 +110,21 @@ pub fn run(a: &SynthArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             "frames": result.frames,
             "focal_px": result.camera.focal_px,
             "render_ms_per_frame": result.render_s_per_frame * 1e3,
+            "person_px": [result.stature_px.0, result.stature_px.1],
         });
         println!("{summary}");
     } else {
         say(
             global,
             &format!(
-                "wrote {} frames: {}, {}, {} ({:.1} ms per frame to render)",
+                "wrote {} frames: {}, {}, {} ({:.1} ms per frame to render; the person {:.0}–{:.0} px tall)",
                 result.frames,
                 result.video.display(),
                 result.ground_truth.display(),
                 result.marks.display(),
-                result.render_s_per_frame * 1e3
+                result.render_s_per_frame * 1e3,
+                result.stature_px.0,
+                result.stature_px.1
             ),
         );
     }

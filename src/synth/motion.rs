@@ -24,6 +24,9 @@ pub struct Motion {
 pub enum ProceduralMotion {
     /// Walking forward at 1.2 m/s, 1 stride per second.
     Walk,
+    /// The same walk on a treadmill: the feet go back with the belt and the body stays put (a
+    /// gait lab's set-up; it keeps the person's size in the image while seen at an angle).
+    Treadmill,
     /// Standing and waving the right hand above the head.
     Wave,
     /// Jumping jacks at one per second.
@@ -38,10 +41,11 @@ pub enum ProceduralMotion {
 }
 
 impl ProceduralMotion {
-    /// Parses `walk`, `wave`, `jumping-jacks`, `sit-down` or `bend`.
+    /// Parses `walk`, `treadmill`, `wave`, `jumping-jacks`, `sit-down`, `bend` or `march`.
     pub fn from_name(name: &str) -> Option<Self> {
         match name {
             "walk" => Some(Self::Walk),
+            "treadmill" => Some(Self::Treadmill),
             "wave" => Some(Self::Wave),
             "jumping-jacks" | "jumping_jacks" => Some(Self::JumpingJacks),
             "sit-down" | "sit_down" | "sit" => Some(Self::SitDown),
@@ -55,6 +59,7 @@ impl ProceduralMotion {
     pub fn name(self) -> &'static str {
         match self {
             Self::Walk => "walk",
+            Self::Treadmill => "treadmill",
             Self::Wave => "wave",
             Self::JumpingJacks => "jumping-jacks",
             Self::SitDown => "sit-down",
@@ -163,7 +168,7 @@ pub fn procedural(
             let t = i as f64 / fps;
             let w = 2.0 * PI * t; // one cycle per second
             match kind {
-                ProceduralMotion::Walk => {
+                ProceduralMotion::Walk | ProceduralMotion::Treadmill => {
                     let hip = 0.42 * w.sin();
                     let legs = [
                         LimbAngles {
@@ -189,7 +194,12 @@ pub fn procedural(
                             bend: 0.3,
                         },
                     ];
-                    let pelvis = Point3::new(0.0, stand - 0.03 + 0.02 * (2.0 * w).cos(), 1.2 * t);
+                    let speed = if kind == ProceduralMotion::Walk {
+                        1.2
+                    } else {
+                        0.0
+                    };
+                    let pelvis = Point3::new(0.0, stand - 0.03 + 0.02 * (2.0 * w).cos(), speed * t);
                     pose(subject, pelvis, arms, legs)
                 }
                 ProceduralMotion::Wave => {
