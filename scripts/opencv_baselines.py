@@ -3,10 +3,10 @@
 same marks: OpenCV pyramidal Lucas-Kanade (all 16 joints as points, frame to frame) and CSRT
 (one tracker per joint, a square box of 8% of the marked stature around it).
 
-Clips: every directory with video.mp4, marks.json and gt.json under out/bench-suite/ (made by
-`videomocap bench track`) and the real sample. Prints the same metrics as `bench track`:
-mean error (px), error over torso length, PCK@0.1, PCK@0.2, lost (> 0.5 torso). Derived joints
-in gt.json (the real sample's chest) are not scored.
+Clips: the suite's clips listed in out/bench-suite/clips.txt (made by `videomocap bench track`;
+without it, every directory there with video.mp4, marks.json and gt.json) and the real sample.
+Prints the same metrics as `bench track`: mean error (px), error over torso length, PCK@0.1,
+PCK@0.2, lost (> 0.5 torso). Derived joints in gt.json (the real sample's chest) are not scored.
 
     python3 -m pip install opencv-contrib-python-headless numpy   # once
     python3 scripts/opencv_baselines.py [suite_dir]
@@ -118,9 +118,15 @@ def score(gt, tracks):
 
 def main():
     suite = sys.argv[1] if len(sys.argv) > 1 else os.path.join(ROOT, "out", "bench-suite")
+    # The current suite's clips are listed in clips.txt (an older render may have left others).
+    index = os.path.join(suite, "clips.txt")
+    if os.path.isfile(index):
+        names = [n.strip() for n in open(index) if n.strip()]
+    else:
+        names = os.listdir(suite) if os.path.isdir(suite) else []
     clips = sorted(
-        os.path.join(suite, d) for d in os.listdir(suite) if os.path.isfile(os.path.join(suite, d, "gt.json"))
-    ) if os.path.isdir(suite) else []
+        os.path.join(suite, d) for d in names if os.path.isfile(os.path.join(suite, d, "gt.json"))
+    )
     real = os.path.join(ROOT, "sample_videos", "pose2sim_balancing_cam01")
     print(f"{'clip':<34} {'mean px':>8} {'err/torso':>9} {'PCK@0.1':>8} {'PCK@0.2':>8} {'lost':>8}")
     totals = {"LK": Acc(), "CSRT": Acc()}

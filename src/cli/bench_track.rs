@@ -168,6 +168,9 @@ const SUITE: &[ClipSpec] = &[
 /// Bumped whenever the suite's clips or the renderer change, so rendered clips are redone.
 const SUITE_VERSION: u32 = 2;
 
+/// The file in the suite's folder listing its clips, one name per line.
+const SUITE_INDEX: &str = "clips.txt";
+
 /// The file in each rendered clip's folder naming the spec it was rendered from.
 const SPEC_FILE: &str = "suite_spec.txt";
 
@@ -197,8 +200,8 @@ fn synth_params(spec: &ClipSpec, k: usize, root: &Path) -> SynthParams {
     params
 }
 
-/// Renders the clips missing from `dir`, or rendered from another spec, and returns every
-/// clip's directory.
+/// Renders the clips missing from `dir`, or rendered from another spec, lists the suite's clips
+/// in its [`SUITE_INDEX`], and returns every clip's directory.
 pub fn ensure_suite(dir: &Path, global: &GlobalArgs) -> Result<Vec<(String, PathBuf)>, ExitError> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut out = Vec::new();
@@ -220,6 +223,11 @@ pub fn ensure_suite(dir: &Path, global: &GlobalArgs) -> Result<Vec<(String, Path
         }
         out.push((spec.name.to_owned(), clip));
     }
+    // The current clips by name, for scripts/opencv_baselines.py (an older suite's clips may
+    // still lie beside them).
+    let names: String = SUITE.iter().map(|s| format!("{}\n", s.name)).collect();
+    videomocap::formats::write_atomically(&dir.join(SUITE_INDEX), names.as_bytes())
+        .map_err(ExitError::failed)?;
     Ok(out)
 }
 
