@@ -243,10 +243,29 @@ fn place_camera(
 /// `f · stature / depth of the pelvis` over its frames (a person walking in depth grows and
 /// shrinks). The tracking benchmark's suite keeps it within 200–450 px at 640×480.
 pub fn stature_range_px(params: &SynthParams) -> Result<(f64, f64), SynthError> {
+    check_params(params)?;
     let motion = load_motion(params)?;
     let camera = PinholeCamera::centred(params.focal_px, params.width, params.height);
     let (camera_from_world, centre) = place_camera(&motion, params, &camera);
     Ok(stature_range(&motion, &camera, &camera_from_world, &centre))
+}
+
+/// Refuses parameters no clip can be made from: no frames, under 16×16 pixels, 0 fps, or a
+/// focal length that is not positive.
+fn check_params(params: &SynthParams) -> Result<(), SynthError> {
+    if params.frames == 0 || params.width < 16 || params.height < 16 || params.fps == 0 {
+        return Err(SynthError::Params(format!(
+            "{} frames of {}×{} at {} fps: need at least 1 frame, 16×16 pixels and 1 fps",
+            params.frames, params.width, params.height, params.fps
+        )));
+    }
+    if !(params.focal_px.is_finite() && params.focal_px > 0.0) {
+        return Err(SynthError::Params(format!(
+            "focal length {} px must be positive",
+            params.focal_px
+        )));
+    }
+    Ok(())
 }
 
 /// [`stature_range_px`] for a motion seen by a placed camera.
@@ -286,18 +305,7 @@ pub fn render_clip(
     progress: &mut dyn FnMut(usize, usize),
     cancel: &AtomicBool,
 ) -> Result<SynthResult, SynthError> {
-    if params.frames == 0 || params.width < 16 || params.height < 16 || params.fps == 0 {
-        return Err(SynthError::Params(format!(
-            "{} frames of {}×{} at {} fps: need at least 1 frame, 16×16 pixels and 1 fps",
-            params.frames, params.width, params.height, params.fps
-        )));
-    }
-    if !(params.focal_px.is_finite() && params.focal_px > 0.0) {
-        return Err(SynthError::Params(format!(
-            "focal length {} px must be positive",
-            params.focal_px
-        )));
-    }
+    check_params(params)?;
     std::fs::create_dir_all(out_dir).map_err(|source| SynthError::Io {
         path: out_dir.to_owned(),
         source,
