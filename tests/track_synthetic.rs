@@ -153,6 +153,24 @@ fn a_correction_on_a_later_frame_is_kept_and_anchors_the_track() {
     let p = again.tracks.frames[10].points[Joint::LeftAnkle];
     assert!((p.pos - truth).norm() < 1e-9);
     assert_eq!(p.confidence, 1.0);
+    // The re-track starts from what the user saw on frame 10, with the correction put in: the
+    // joints not dragged keep their confidence, and the reliable ones stay where they were
+    // tracked (they do not go back to where they were marked on frame 0; weak ones may be
+    // interpolated anew between the new neighbours).
+    let weak = TrackerParams::default().weak_reliability;
+    let mut kept = 0;
+    for j in Joint::ALL.into_iter().filter(|&j| j != Joint::LeftAnkle) {
+        let (now, before) = (
+            again.tracks.frames[10].points[j],
+            first.tracks.frames[10].points[j],
+        );
+        assert_eq!(now.confidence, before.confidence, "{}", j.name());
+        if before.confidence >= weak {
+            assert!((now.pos - before.pos).norm() < 1e-6, "{}", j.name());
+            kept += 1;
+        }
+    }
+    assert!(kept >= 5, "only {kept} reliable joints on frame 10");
     // Frames before the correction keep the earlier result (except where the new key frame
     // re-interpolates a weak run before it).
     for f in 0..5 {

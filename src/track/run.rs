@@ -269,7 +269,9 @@ fn track_at_working_scale(
                 .as_ref()
                 .filter(|p| p.frames.len() == n && from < n)
                 .ok_or(TrackError::NoEarlierResult { frame: from })?;
-            for f in &prev.frames[..from] {
+            // Up to and including the corrected frame: the re-track starts there from what the
+            // user saw, with their corrections put in (not from the first key frame's pose).
+            for f in &prev.frames[..=from] {
                 raw[f.index] = Some(f.points.map(|_, p| JointResult {
                     pos: p.pos,
                     reliability: p.confidence,
@@ -306,9 +308,19 @@ fn track_at_working_scale(
             first_pose
         };
         let forward: Vec<usize> = (start..n).collect();
+        // The earlier result on the start frame: its joints that were not corrected keep
+        // their confidence (the pass vouches for its whole starting pose).
+        let before = raw[start];
         let results = ctx.pass(&forward, &pose, true)?;
         for (f, r) in forward.iter().zip(results) {
             raw[*f] = Some(r);
+        }
+        if let (Some(before), Some(now)) = (before, raw[start].as_mut()) {
+            for j in Joint::ALL {
+                if !job.keys.is_key(start, j) {
+                    now[j].reliability = before[j].reliability;
+                }
+            }
         }
         // Backward from the first key frame to the start.
         if job.from.is_none() && first_key > 0 {
