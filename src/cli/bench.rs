@@ -22,6 +22,9 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     if a.what == "track" {
         return super::bench_track::run(a, global);
     }
+    if a.what == "correct" {
+        return super::bench_correct::run(a, global);
+    }
     if a.what == "lift" {
         return super::bench_lift::run(a, global);
     }
@@ -77,7 +80,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     }
     if rows.is_empty() {
         return Err(ExitError::bad_input(anyhow!(
-            "bench {}: expected all, decode, synth or track",
+            "bench {}: expected all, decode, synth, track, correct, lift, volume or scrub",
             a.what
         )));
     }

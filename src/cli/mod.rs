@@ -3,6 +3,7 @@
 
 pub mod args;
 mod bench;
+mod bench_correct;
 mod bench_lift;
 mod bench_scrub;
 mod bench_track;

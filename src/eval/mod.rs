@@ -4,6 +4,7 @@
 //! occluded joints apart. Joints the reference marks as derived are not scored. The 3D
 //! measures live in [`pose3d`].
 
+pub mod correction;
 pub mod pose3d;
 pub mod volume;
 
@@ -12,6 +13,9 @@ use crate::skeleton::{Joint, PerJoint};
 use crate::synth::GroundTruth;
 use nalgebra::Point2;
 use serde::Serialize;
+
+/// A joint further than this from the reference, in torso lengths, counts as lost.
+pub const LOST_TORSO: f64 = 0.5;
 
 /// Accumulated errors of a set of (joint, frame) samples.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
@@ -39,7 +43,7 @@ impl Accuracy {
         self.sum_torso += rel;
         self.within_01 += usize::from(rel <= 0.1);
         self.within_02 += usize::from(rel <= 0.2);
-        self.lost += usize::from(rel > 0.5);
+        self.lost += usize::from(rel > LOST_TORSO);
     }
 
     /// Merges another accumulator into this one.

@@ -1,0 +1,186 @@
+//! A simulated user correcting tracks (beyond the paper, for `bench correct`): how many
+//! corrections the tool needs before its tracks are right, which is what its users pay for a
+//! tracker's mistakes.
+//!
+//! The user looks for the frame where the skeleton is furthest off (most joints lost, then the
+//! largest summed error), drags every joint there that is visibly wrong (more than
+//! [`DRAG_TORSO`] of the torso from the reference) onto the reference, and re-tracks from that
+//! frame. Joints the reference derives from others are never dragged (the user could not see
+//! where they are) and never scored.
+
+use super::LOST_TORSO;
+use crate::formats::Tracks2d;
+use crate::skeleton::Joint;
+use crate::synth::GroundTruth;
+use nalgebra::Point2;
+use std::collections::BTreeSet;
+
+/// A joint further than this from the reference, in torso lengths, is dragged: the same 0.2 as
+/// PCK@0.2, the error a user sees at a glance.
+pub const DRAG_TORSO: f64 = 0.2;
+
+/// One simulated correction: the frame and the joints dragged there, with where they go.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Correction {
+    /// Frame index.
+    pub frame: usize,
+    /// Joints dragged, and their reference positions.
+    pub drags: Vec<(Joint, Point2<f64>)>,
+}
+
+/// The correction the simulated user makes next on `tracks`, skipping frames in `done`; `None`
+/// when no frame has a joint beyond [`DRAG_TORSO`].
+pub fn next_correction(
+    gt: &GroundTruth,
+    tracks: &Tracks2d,
+    done: &BTreeSet<usize>,
+) -> Option<Correction> {
+    let derived: Vec<Joint> = gt
+        .derived_joints
+        .iter()
+        .filter_map(|n| Joint::from_name(n))
+        .collect();
+    // Per candidate frame: (joints lost, summed error in torso lengths, the correction).
+    let mut best: Option<(usize, f64, Correction)> = None;
+    for f in &tracks.frames {
+        if done.contains(&f.index) {
+            continue;
+        }
+        let Some(truth) = gt.frames.get(f.index).map(|g| g.points2d()) else {
+            continue;
+        };
+        let torso = (truth[Joint::Neck] - truth[Joint::Pelvis]).norm().max(1.0);
+        let (mut lost, mut sum, mut drags) = (0usize, 0.0, Vec::new());
+        for j in Joint::ALL {
+            if derived.contains(&j) {
+                continue;
+            }
+            let rel = (f.points[j].pos - truth[j]).norm() / torso;
+            sum += rel;
+            lost += usize::from(rel > LOST_TORSO);
+            if rel > DRAG_TORSO {
+                drags.push((j, truth[j]));
+            }
+        }
+        if drags.is_empty() {
+            continue;
+        }
+        let better = best
+            .as_ref()
+            .is_none_or(|(l, s, _)| lost > *l || (lost == *l && sum > *s));
+        if better {
+            best = Some((
+                lost,
+                sum,
+                Correction {
+                    frame: f.index,
+                    drags,
+                },
+            ));
+        }
+    }
+    best.map(|(_, _, c)| c)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::formats::{FrameTracks, PointSource, SourceInfo, TrackedPoint};
+    use crate::skeleton::PerJoint;
+    use crate::synth::GroundTruthFrame;
+
+    /// A reference of `n` frames: a standing figure 100 px from neck to pelvis.
+    fn reference(n: usize) -> GroundTruth {
+        let pose = |j: Joint| -> [f64; 2] {
+            let k = j.index() as f64;
+            match j {
+                Joint::Neck => [100.0, 100.0],
+                Joint::Pelvis => [100.0, 200.0],
+                _ => [50.0 + 10.0 * k, 50.0 + 15.0 * k],
+            }
+        };
+        GroundTruth {
+            source: "test".into(),
+            fps: 30.0,
+            width: 320,
+            height: 320,
+            focal_px: 300.0,
+            cx: 160.0,
+            cy: 160.0,
+            joints: Joint::ALL.iter().map(|j| j.name().to_owned()).collect(),
+            derived_joints: vec!["chest".into()],
+            bone_lengths_m: Default::default(),
+            frames: (0..n)
+                .map(|index| GroundTruthFrame {
+                    index,
+                    points2d: Joint::ALL.iter().map(|&j| pose(j)).collect(),
+                    points3d: vec![[0.0, 0.0, 3.0]; 16],
+                    visible: vec![true; 16],
+                })
+                .collect(),
+        }
+    }
+
+    /// Tracks equal to the reference, with `offsets[(frame, joint)]` pixels added along x.
+    fn tracks(gt: &GroundTruth, offsets: &[(usize, Joint, f64)]) -> Tracks2d {
+        Tracks2d {
+            source: SourceInfo {
+                path: "clip.mp4".into(),
+                width: gt.width,
+                height: gt.height,
+                fps: gt.fps,
+                frame_count: gt.frames.len(),
+            },
+            frames: gt
+                .frames
+                .iter()
+                .map(|g| FrameTracks {
+                    index: g.index,
+                    points: PerJoint::from_fn(|j| {
+                        let dx: f64 = offsets
+                            .iter()
+                            .filter(|(f, k, _)| *f == g.index && *k == j)
+                            .map(|o| o.2)
+                            .sum();
+                        TrackedPoint {
+                            pos: g.points2d()[j] + nalgebra::Vector2::new(dx, 0.0),
+                            confidence: 1.0,
+                            source: PointSource::Tracked,
+                        }
+                    }),
+                })
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn the_user_fixes_the_frame_with_most_lost_joints_and_drags_only_the_wrong_ones() {
+        let gt = reference(6);
+        // Frame 2: one joint far off (lost), large sum. Frame 4: two lost joints and one
+        // visibly off. The chest is off everywhere but derived: never dragged.
+        let t = tracks(
+            &gt,
+            &[
+                (2, Joint::LeftWrist, 300.0),
+                (4, Joint::LeftKnee, 60.0),
+                (4, Joint::RightKnee, 60.0),
+                (4, Joint::LeftElbow, 25.0),
+                (4, Joint::RightElbow, 15.0),
+                (1, Joint::Chest, 90.0),
+            ],
+        );
+        let c = next_correction(&gt, &t, &BTreeSet::new()).expect("a frame to fix");
+        assert_eq!(c.frame, 4);
+        let dragged: Vec<Joint> = c.drags.iter().map(|d| d.0).collect();
+        assert_eq!(
+            dragged,
+            vec![Joint::LeftElbow, Joint::LeftKnee, Joint::RightKnee]
+        );
+        assert_eq!(c.drags[0].1, gt.frames[4].points2d()[Joint::LeftElbow]);
+        // With frame 4 done, frame 2 is next; with both done, nothing is visibly wrong.
+        let done: BTreeSet<usize> = [4].into();
+        assert_eq!(next_correction(&gt, &t, &done).map(|c| c.frame), Some(2));
+        let done: BTreeSet<usize> = [2, 4].into();
+        assert_eq!(next_correction(&gt, &t, &done), None);
+    }
+}
