@@ -1,8 +1,9 @@
 //! `videomocap bench correct`: what correcting the tracks costs a user.
 //!
 //! Each clip of the tracking suite, and the real sample, is tracked from its marks; then a
-//! simulated user ([`videomocap::eval::correction`]) fixes the worst frame (drags every joint
-//! more than 0.2 torso off onto the reference) and re-tracks from there, as the app's
+//! simulated user ([`videomocap::eval::correction`]) goes to the first frame with a lost joint
+//! (the guide's advice), drags every joint there more than 0.2 torso off onto the reference and
+//! re-tracks from there, as the app's
 //! correction does (that frame becomes a key frame, the forward pass restarts there, a backward
 //! pass fills the weak frames before it). The table gives the accuracy after each round, the
 //! joints dragged so far, and how many rounds each clip needs to reach PCK@0.2 ≥ 0.95.
@@ -115,8 +116,9 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     }
     let mut lines = vec![
         format!(
-            "simulated correction: each round drags every joint over 0.2 torso off on the worst \
-             frame onto the reference and re-tracks from there ({rounds} rounds at most)"
+            "simulated correction: each round goes to the first frame with a joint lost (over 0.5 \
+             torso off), drags every joint there over 0.2 torso off onto the reference and \
+             re-tracks from there ({rounds} rounds at most)"
         ),
         String::new(),
         format!(

@@ -2,10 +2,10 @@
 //! corrections the tool needs before its tracks are right, which is what its users pay for a
 //! tracker's mistakes.
 //!
-//! The user looks for the frame where the skeleton is furthest off (most joints lost, then the
-//! largest summed error), drags every joint there that is visibly wrong (more than
-//! [`DRAG_TORSO`] of the torso from the reference) onto the reference, and re-tracks from that
-//! frame. Joints the reference derives from others are never dragged (the user could not see
+//! The user does what the guide advises: goes to the first frame where a joint is lost (more
+//! than half the torso from the reference; when none is, the first frame with a joint visibly
+//! off), drags every joint there that is visibly wrong (more than [`DRAG_TORSO`] of the torso
+//! from the reference) onto the reference, and re-tracks from that frame. Joints the reference derives from others are never dragged (the user could not see
 //! where they are) and never scored.
 
 use super::LOST_TORSO;
@@ -40,8 +40,8 @@ pub fn next_correction(
         .iter()
         .filter_map(|n| Joint::from_name(n))
         .collect();
-    // Per candidate frame: (joints lost, summed error in torso lengths, the correction).
-    let mut best: Option<(usize, f64, Correction)> = None;
+    // The first frame with a joint lost, and the first with a joint visibly off.
+    let mut first_off: Option<Correction> = None;
     for f in &tracks.frames {
         if done.contains(&f.index) {
             continue;
@@ -50,14 +50,13 @@ pub fn next_correction(
             continue;
         };
         let torso = (truth[Joint::Neck] - truth[Joint::Pelvis]).norm().max(1.0);
-        let (mut lost, mut sum, mut drags) = (0usize, 0.0, Vec::new());
+        let (mut lost, mut drags) = (false, Vec::new());
         for j in Joint::ALL {
             if derived.contains(&j) {
                 continue;
             }
             let rel = (f.points[j].pos - truth[j]).norm() / torso;
-            sum += rel;
-            lost += usize::from(rel > LOST_TORSO);
+            lost |= rel > LOST_TORSO;
             if rel > DRAG_TORSO {
                 drags.push((j, truth[j]));
             }
@@ -65,21 +64,16 @@ pub fn next_correction(
         if drags.is_empty() {
             continue;
         }
-        let better = best
-            .as_ref()
-            .is_none_or(|(l, s, _)| lost > *l || (lost == *l && sum > *s));
-        if better {
-            best = Some((
-                lost,
-                sum,
-                Correction {
-                    frame: f.index,
-                    drags,
-                },
-            ));
+        let correction = Correction {
+            frame: f.index,
+            drags,
+        };
+        if lost {
+            return Some(correction);
         }
+        first_off.get_or_insert(correction);
     }
-    best.map(|(_, _, c)| c)
+    first_off
 }
 
 #[cfg(test)]
@@ -154,19 +148,21 @@ mod tests {
     }
 
     #[test]
-    fn the_user_fixes_the_frame_with_most_lost_joints_and_drags_only_the_wrong_ones() {
+    fn the_user_fixes_the_first_frame_with_a_lost_joint_and_drags_only_the_wrong_ones() {
         let gt = reference(6);
-        // Frame 2: one joint far off (lost), large sum. Frame 4: two lost joints and one
-        // visibly off. The chest is off everywhere but derived: never dragged.
+        // Frame 1: a joint visibly off but not lost. Frame 4: two lost joints, one visibly off,
+        // one a little off. Frame 5: a joint lost. The chest is off on frame 0 but derived:
+        // never dragged.
         let t = tracks(
             &gt,
             &[
-                (2, Joint::LeftWrist, 300.0),
+                (1, Joint::LeftWrist, 30.0),
                 (4, Joint::LeftKnee, 60.0),
                 (4, Joint::RightKnee, 60.0),
                 (4, Joint::LeftElbow, 25.0),
                 (4, Joint::RightElbow, 15.0),
-                (1, Joint::Chest, 90.0),
+                (5, Joint::HeadTop, 300.0),
+                (0, Joint::Chest, 90.0),
             ],
         );
         let c = next_correction(&gt, &t, &BTreeSet::new()).expect("a frame to fix");
@@ -177,10 +173,13 @@ mod tests {
             vec![Joint::LeftElbow, Joint::LeftKnee, Joint::RightKnee]
         );
         assert_eq!(c.drags[0].1, gt.frames[4].points2d()[Joint::LeftElbow]);
-        // With frame 4 done, frame 2 is next; with both done, nothing is visibly wrong.
-        let done: BTreeSet<usize> = [4].into();
-        assert_eq!(next_correction(&gt, &t, &done).map(|c| c.frame), Some(2));
-        let done: BTreeSet<usize> = [2, 4].into();
-        assert_eq!(next_correction(&gt, &t, &done), None);
+        // Then the next lost frame; with none lost, the first frame visibly off; then nothing.
+        let next = |done: &[usize]| {
+            let done: BTreeSet<usize> = done.iter().copied().collect();
+            next_correction(&gt, &t, &done).map(|c| c.frame)
+        };
+        assert_eq!(next(&[4]), Some(5));
+        assert_eq!(next(&[4, 5]), Some(1));
+        assert_eq!(next(&[1, 4, 5]), None);
     }
 }
