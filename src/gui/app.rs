@@ -2012,6 +2012,7 @@ mod tests {
         // Correct a joint on frame 3 by dragging it: frame 3 becomes a key frame for it and
         // tracking re-runs from there, keeping the correction.
         let wrist = h.state().points(3)[Joint::LeftWrist].unwrap().0;
+        let before = h.state().project().unwrap().tracks.as_ref().unwrap().frames[3].points;
         let moved_to = wrist + nalgebra::Vector2::new(6.0, -4.0);
         let (from, to) = (screen(&h, wrist), screen(&h, moved_to));
         drag(&mut h, from, to);
@@ -2024,6 +2025,21 @@ mod tests {
         assert!((key - moved_to).norm() < 1.5, "key {key} vs {moved_to}");
         let tracked = &p.tracks.as_ref().unwrap().frames[3].points[Joint::LeftWrist];
         assert!((tracked.pos - key).norm() < 1e-9, "the track keeps the key");
+        // The joints not dragged stay where they were on frame 3 (the re-track starts from
+        // what the user saw there, not from the marks of frame 0).
+        let after = &p.tracks.as_ref().unwrap().frames[3].points;
+        let marked = p.marks().unwrap().points;
+        let mut kept = 0;
+        for j in Joint::ALL.into_iter().filter(|&j| j != Joint::LeftWrist) {
+            if before[j].confidence >= p.settings.tracker.weak_reliability {
+                assert!((after[j].pos - before[j].pos).norm() < 1e-6, "{}", j.name());
+                kept += usize::from((before[j].pos - marked[j]).norm() > 1.0);
+            }
+        }
+        assert!(
+            kept >= 3,
+            "too few joints moved since frame 0 to tell ({kept})"
+        );
 
         // Flip a limb's depth on this frame: an override is recorded and the lift re-runs;
         // after undoing it, the earlier result's choices are still known and it flips again.
