@@ -9,7 +9,7 @@
 //! joints dragged so far, and how many rounds each clip needs to reach PCK@0.2 ≥ 0.95.
 
 use super::args::{BenchArgs, GlobalArgs};
-use super::bench_track::{ensure_suite, track_opened};
+use super::bench_track::{ensure_suite, threads_and_settings, track_opened};
 use super::{ExitError, say};
 use std::collections::BTreeSet;
 use std::path::Path;
@@ -95,13 +95,7 @@ fn at_round(r: &Rounds, k: usize) -> &Accuracy {
 
 /// Runs the correction benchmark and prints its table.
 pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
-    let threads = std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1);
-    let params = match &a.tracker_settings {
-        Some(p) => super::track::load_settings(p)?,
-        None => TrackerParams::default(),
-    };
+    let (threads, params) = threads_and_settings(a)?;
     let rounds = a.corrections;
     let mut clips = ensure_suite(&a.suite_dir, global)?;
     let suite_len = clips.len();

@@ -388,8 +388,9 @@ fn score_clip(dir: &Path, threads: usize, params: TrackerParams) -> Result<Score
 /// Runs per speed figure; the fastest counts.
 const SPEED_RUNS: usize = 3;
 
-/// Runs the accuracy and speed benchmark and prints its tables.
-pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+/// The tracking benchmarks' threads (all the machine has) and tracker settings (`--tracker-
+/// settings`, else the defaults).
+pub fn threads_and_settings(a: &BenchArgs) -> Result<(usize, TrackerParams), ExitError> {
     let threads = std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(1);
@@ -397,6 +398,12 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         Some(p) => super::track::load_settings(p)?,
         None => TrackerParams::default(),
     };
+    Ok((threads, params))
+}
+
+/// Runs the accuracy and speed benchmark and prints its tables.
+pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+    let (threads, params) = threads_and_settings(a)?;
     let clips = ensure_suite(&a.suite_dir, global)?;
     let mut total_vba = ClipScore::default();
     let mut total_base = ClipScore::default();
