@@ -79,8 +79,7 @@ pub fn next_correction(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::formats::{FrameTracks, PointSource, SourceInfo, TrackedPoint};
-    use crate::skeleton::PerJoint;
+    use crate::eval::pose3d::tracks_from_truth;
     use crate::synth::GroundTruthFrame;
 
     /// A reference of `n` frames: a standing figure 100 px from neck to pelvis.
@@ -117,34 +116,11 @@ mod tests {
 
     /// Tracks equal to the reference, with `offsets[(frame, joint)]` pixels added along x.
     fn tracks(gt: &GroundTruth, offsets: &[(usize, Joint, f64)]) -> Tracks2d {
-        Tracks2d {
-            source: SourceInfo {
-                path: "clip.mp4".into(),
-                width: gt.width,
-                height: gt.height,
-                fps: gt.fps,
-                frame_count: gt.frames.len(),
-            },
-            frames: gt
-                .frames
-                .iter()
-                .map(|g| FrameTracks {
-                    index: g.index,
-                    points: PerJoint::from_fn(|j| {
-                        let dx: f64 = offsets
-                            .iter()
-                            .filter(|(f, k, _)| *f == g.index && *k == j)
-                            .map(|o| o.2)
-                            .sum();
-                        TrackedPoint {
-                            pos: g.points2d()[j] + nalgebra::Vector2::new(dx, 0.0),
-                            confidence: 1.0,
-                            source: PointSource::Tracked,
-                        }
-                    }),
-                })
-                .collect(),
+        let mut t = tracks_from_truth(gt, 0.0, 0);
+        for &(f, j, dx) in offsets {
+            t.frames[f].points[j].pos.x += dx;
         }
+        t
     }
 
     #[test]
