@@ -68,7 +68,8 @@ pub enum Command {
     Carve(CarveArgs),
     /// Render a synthetic clip with ground truth.
     Synth(SynthArgs),
-    /// Measure decoding and rendering speed and print a table.
+    /// Measure speed and accuracy (decoding, rendering, tracking, correction, lifting, frame
+    /// access, point volumes) and print a table.
     Bench(BenchArgs),
     /// (Testing) Save a project and write its exports over and over until killed; the
     /// crash-safety test kills it at random moments and checks every file left behind.
