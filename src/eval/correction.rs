@@ -35,11 +35,7 @@ pub fn next_correction(
     tracks: &Tracks2d,
     done: &BTreeSet<usize>,
 ) -> Option<Correction> {
-    let derived: Vec<Joint> = gt
-        .derived_joints
-        .iter()
-        .filter_map(|n| Joint::from_name(n))
-        .collect();
+    let derived = gt.derived();
     // The first frame with a joint lost, and the first with a joint visibly off.
     let mut first_off: Option<Correction> = None;
     for f in &tracks.frames {

@@ -116,11 +116,7 @@ pub fn score_positions(
     gt: &GroundTruth,
     frames: impl IntoIterator<Item = (usize, PerJoint<Point2<f64>>)>,
 ) -> Result<ClipScore, EvalError> {
-    let derived: Vec<Joint> = gt
-        .derived_joints
-        .iter()
-        .filter_map(|n| Joint::from_name(n))
-        .collect();
+    let derived = gt.derived();
     let mut s = ClipScore::default();
     for (index, predicted) in frames {
         let f = gt.frames.get(index).ok_or(EvalError {

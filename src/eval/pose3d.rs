@@ -96,11 +96,7 @@ fn procrustes(a: &[Point3<f64>], b: &[Point3<f64>]) -> Vec<Point3<f64>> {
 
 /// Scores a skeleton against the reference (frames matched by index).
 pub fn score_skeleton(gt: &GroundTruth, skeleton: &Skeleton3d) -> Result<Pose3dScore, EvalError> {
-    let derived: Vec<Joint> = gt
-        .derived_joints
-        .iter()
-        .filter_map(|n| Joint::from_name(n))
-        .collect();
+    let derived = gt.derived();
     let scored: Vec<Joint> = Joint::ALL
         .into_iter()
         .filter(|j| !derived.contains(j))

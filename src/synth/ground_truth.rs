@@ -53,6 +53,15 @@ pub struct GroundTruth {
 }
 
 impl GroundTruth {
+    /// The joints computed from others rather than measured ([`GroundTruth::derived_joints`]
+    /// by name), which are never scored.
+    pub fn derived(&self) -> Vec<Joint> {
+        self.derived_joints
+            .iter()
+            .filter_map(|n| Joint::from_name(n))
+            .collect()
+    }
+
     /// Reads a gt.json file and checks that it lists the 16 joints in model order.
     pub fn load(path: &Path) -> Result<GroundTruth, FormatError> {
         let text = std::fs::read_to_string(path).map_err(|source| FormatError::Io {
