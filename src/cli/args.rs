@@ -300,10 +300,9 @@ pub struct BenchArgs {
     /// What to measure: all (decode and synth), decode, synth, track (tracking accuracy on
     /// the synthetic suite and the real sample, and tracking speed; takes a few minutes), lift
     /// (3D accuracy from true, noisy and tracked 2D, focal estimate, speed), correct (how
-    /// the tracks improve as a simulated user corrects the worst frame, round by round), or
-    /// scrub (the
-    /// desktop app's frame access on a long 1080p clip: open time, random seeks, scrubbing,
-    /// peak memory), or volume (the point-volume pipeline: topology, joint error, labels, time
+    /// the tracks improve as a simulated user fixes the first frame with a lost joint, round
+    /// by round), scrub (the desktop app's frame access on a long 1080p clip: open time, random
+    /// seeks, scrubbing, peak memory), or volume (the point-volume pipeline: topology, joint error, labels, time
     /// per frame at 3k/10k/30k points).
     #[arg(default_value = "all")]
     pub what: String,

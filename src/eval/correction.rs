@@ -5,8 +5,9 @@
 //! The user does what the guide advises: goes to the first frame where a joint is lost (more
 //! than half the torso from the reference; when none is, the first frame with a joint visibly
 //! off), drags every joint there that is visibly wrong (more than [`DRAG_TORSO`] of the torso
-//! from the reference) onto the reference, and re-tracks from that frame. Joints the reference derives from others are never dragged (the user could not see
-//! where they are) and never scored.
+//! from the reference) onto the reference, and re-tracks from that frame. Joints the reference
+//! derives from others are never dragged (the user could not see where they are) and never
+//! scored.
 
 use super::LOST_TORSO;
 use crate::formats::Tracks2d;
