@@ -26,7 +26,7 @@ use videomocap::synth::{
     GroundTruth, MotionSource, ProceduralMotion, SynthParams, VideoOutput, View, render_clip,
     stature_range_px,
 };
-use videomocap::track::similarity::FrameView;
+use videomocap::track::similarity::FloatFrame;
 use videomocap::track::{TrackJob, TrackerParams, track_video};
 use videomocap::video::{OpenOptions, Video};
 
@@ -263,7 +263,8 @@ pub fn fixed_template_track(
     let half = ((0.04 * stature_px).round() as i64).max(4);
     let radius = ((0.2 * stature_px).round() as i64).max(8);
     let first = video.frame(0).map_err(ExitError::failed)?.image;
-    let f0 = FrameView::new(&first);
+    let first_floats = FloatFrame::new(&first);
+    let f0 = first_floats.view();
     let (w, h) = (first.width() as i64, first.height() as i64);
     let clampi = |v: i64, hi: i64| v.clamp(0, hi - 1) as usize;
     let templates: Vec<Vec<[f32; 3]>> = Joint::ALL
@@ -286,7 +287,8 @@ pub fn fixed_template_track(
     let mut out = vec![*marks];
     for index in 1..video.info().frame_count {
         let image = video.frame(index).map_err(ExitError::failed)?.image;
-        let f = FrameView::new(&image);
+        let floats = FloatFrame::new(&image);
+        let f = floats.view();
         let sad = |t: &[[f32; 3]], cx: i64, cy: i64, bound: f32| -> f32 {
             let mut s = 0.0;
             let mut k = 0;

@@ -12,13 +12,12 @@ use super::block::{MorphBlock, wrap_angle};
 use super::head::HeadPredictor;
 use super::params::TrackerParams;
 use super::search::{AngularParams, Found, Prior, SpiralParams, angular, spiral};
-use super::similarity::{Extent, FrameView, Template};
+use super::similarity::{Extent, FloatFrame, FrameView, Template};
 use crate::camera::point_in_frame;
 use crate::skeleton::{BodyPart, Joint, PerJoint, Proportions};
 use image::RgbImage;
 use nalgebra::Point2;
 use rayon::prelude::*;
-use std::sync::Arc;
 
 /// The four limb chains: root joint, middle joint, end joint.
 pub const CHAINS: [[Joint; 3]; 4] = [
@@ -147,7 +146,10 @@ pub struct BodyTracker {
     zoom: f64,
     /// The head's displacement over the last frame, pixels.
     head_velocity: nalgebra::Vector2<f64>,
-    prev_image: Arc<RgbImage>,
+    /// The last frame, converted for sampling.
+    prev: FloatFrame,
+    /// A spare buffer the next frame is converted into (reused: no allocation per frame).
+    spare: FloatFrame,
 }
 
 fn reliability(cost: f32, c0: f32) -> f32 {
@@ -162,14 +164,15 @@ impl BodyTracker {
     /// Starts from a pose on `image` (a key frame): blocks from the pose, widths from the
     /// proportions scaled to it, colour models sampled from the image.
     pub fn new(
-        image: Arc<RgbImage>,
+        image: &RgbImage,
         pose: &PerJoint<Point2<f64>>,
         proportions: &Proportions,
         params: TrackerParams,
     ) -> BodyTracker {
         let width = widths(pose, proportions, params.block_width_scale);
         let stature = stature_px(pose, proportions);
-        let frame = FrameView::new(&image);
+        let floats = FloatFrame::new(image);
+        let frame = floats.view();
         let w = params.weights;
         let part = |block: MorphBlock, kind: BodyPart| {
             let (a, b) = kind.ends();
@@ -251,7 +254,8 @@ impl BodyTracker {
             marked_head_m: pose_head_m,
             zoom: 1.0,
             head_velocity: nalgebra::Vector2::zeros(),
-            prev_image: image,
+            prev: floats,
+            spare: FloatFrame::default(),
         }
     }
 
@@ -303,10 +307,15 @@ impl BodyTracker {
     }
 
     /// Tracks the body into the next frame and returns its pose.
-    pub fn step(&mut self, image: Arc<RgbImage>) -> PerJoint<JointResult> {
+    pub fn step(&mut self, image: &RgbImage) -> PerJoint<JointResult> {
         let p = self.params;
-        let frame = FrameView::new(&image);
-        let prev = FrameView::new(&self.prev_image);
+        // Both frames are taken out of `self` while the parts are updated, and put back at the
+        // end with their roles swapped.
+        let mut floats = std::mem::take(&mut self.spare);
+        floats.fill(image);
+        let previous = std::mem::take(&mut self.prev);
+        let frame = floats.view();
+        let prev = previous.view();
 
         // Head: image-difference prediction (eqs. 1–5), then the spiral search path (Fig. 6).
         // Beyond the paper, the spiral also starts from the constant-velocity prediction and
@@ -414,7 +423,8 @@ impl BodyTracker {
             track_chain(c, roots[2]);
             track_chain(d, roots[3]);
         }
-        self.prev_image = image;
+        self.spare = previous;
+        self.prev = floats;
         self.pose()
     }
 }

@@ -157,6 +157,7 @@ impl HeadPredictor {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::track::similarity::FloatFrame;
     use image::{Rgb, RgbImage};
 
     /// A grey background with a uniform red disc of diameter `l` at `centre`.
@@ -180,8 +181,12 @@ mod tests {
             let (a, b) = (disc(c0, l), disc(c1, l));
             let top = c0 - Vector2::new(0.0, l / 2.0);
             let neck = c0 + Vector2::new(0.0, l / 2.0);
-            let m =
-                HeadPredictor::default().predict(FrameView::new(&a), FrameView::new(&b), top, neck);
+            let m = HeadPredictor::default().predict(
+                FloatFrame::new(&a).view(),
+                FloatFrame::new(&b).view(),
+                top,
+                neck,
+            );
             let err = (m.displacement - Vector2::new(dx, dy)).norm();
             assert!(
                 err < 3.0,
@@ -195,8 +200,8 @@ mod tests {
     fn a_still_head_is_predicted_still() {
         let a = disc(Point2::new(100.0, 100.0), 30.0);
         let m = HeadPredictor::default().predict(
-            FrameView::new(&a),
-            FrameView::new(&a),
+            FloatFrame::new(&a).view(),
+            FloatFrame::new(&a).view(),
             Point2::new(100.0, 85.0),
             Point2::new(100.0, 115.0),
         );

@@ -517,7 +517,7 @@ impl PassContext<'_, '_> {
             let result = match tracker.as_mut() {
                 None => {
                     let work = pose.map(|_, p| scale.to_work(*p));
-                    let t = BodyTracker::new(image, &work, &proportions, params);
+                    let t = BodyTracker::new(&image, &work, &proportions, params);
                     let mut r = t.pose();
                     for j in Joint::ALL {
                         r[j].reliability = 1.0;
@@ -526,12 +526,12 @@ impl PassContext<'_, '_> {
                     r
                 }
                 Some(t) => {
-                    let mut r = t.step(Arc::clone(&image));
+                    let mut r = t.step(&image);
                     if rekey && keys.frames.contains_key(&index) {
                         let tracked = r.map(|_, j| j.pos);
                         let work_keys = keys.frames[&index].map(|_, k| k.map(|p| scale.to_work(p)));
                         let fixed = tracked.map(|j, p| work_keys[j].unwrap_or(*p));
-                        *t = BodyTracker::new(image, &fixed, &proportions, params);
+                        *t = BodyTracker::new(&image, &fixed, &proportions, params);
                         for j in Joint::ALL {
                             if work_keys[j].is_some() {
                                 r[j] = JointResult {

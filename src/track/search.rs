@@ -396,7 +396,7 @@ pub fn angular(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::track::similarity::{Extent, SimilarityWeights};
+    use crate::track::similarity::{Extent, FloatFrame, SimilarityWeights};
     use image::{Rgb, RgbImage};
 
     /// A textured bar from `a` to `b` over a differently textured background.
@@ -424,14 +424,14 @@ mod tests {
         let b = bar(shoulder, end, 16.0);
         let block = MorphBlock::along(shoulder, Point2::new(80.0, 110.0), 16.0);
         let t = Template::sample(
-            FrameView::new(&a),
+            FloatFrame::new(&a).view(),
             &block,
             Extent::BLOCK,
             SimilarityWeights::default(),
         );
         let found = angular(
             &t,
-            FrameView::new(&b),
+            FloatFrame::new(&b).view(),
             &block,
             &AngularParams {
                 range_theta: 0.7,
@@ -470,14 +470,14 @@ mod tests {
         let b = bar(Point2::new(66.0, 46.0), Point2::new(76.0, 96.0), 20.0);
         let block = MorphBlock::along(Point2::new(60.0, 50.0), Point2::new(70.0, 100.0), 20.0);
         let t = Template::sample(
-            FrameView::new(&a),
+            FloatFrame::new(&a).view(),
             &block,
             Extent::BLOCK,
             SimilarityWeights::default(),
         );
         let found = spiral(
             &t,
-            FrameView::new(&b),
+            FloatFrame::new(&b).view(),
             &block,
             &SpiralParams {
                 step_px: 2.0,
@@ -521,7 +521,7 @@ mod tests {
         let block = MorphBlock::along(Point2::new(60.0, 50.0), Point2::new(70.0, 100.0), 20.0);
         let a = bar(block.origin, block.end(), 20.0);
         let t = Template::sample(
-            FrameView::new(&a),
+            FloatFrame::new(&a).view(),
             &block,
             Extent::BLOCK,
             SimilarityWeights::default(),
@@ -538,13 +538,13 @@ mod tests {
         {
             let d = Vector2::new(shift.0, shift.1);
             let b = bar(block.origin + d, block.end() + d, 20.0);
-            let expected = spiral_in_order(&t, FrameView::new(&b), &block, &p);
+            let expected = spiral_in_order(&t, FloatFrame::new(&b).view(), &block, &p);
             for threads in [1, 3] {
                 let pool = rayon::ThreadPoolBuilder::new()
                     .num_threads(threads)
                     .build()
                     .expect("a thread pool");
-                let found = pool.install(|| spiral(&t, FrameView::new(&b), &block, &p));
+                let found = pool.install(|| spiral(&t, FloatFrame::new(&b).view(), &block, &p));
                 assert_eq!(found.block, expected.block, "shift {k}, {threads} threads");
                 assert_eq!(found.cost, expected.cost, "shift {k}, {threads} threads");
             }
