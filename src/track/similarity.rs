@@ -163,10 +163,12 @@ impl FrameView<'_> {
     /// after all.
     #[inline]
     fn bilinear_inside(&self, x: f32, y: f32) -> Option<[f32; 4]> {
-        let x0 = x as usize; // x ≥ 0, so truncation is floor
-        let y0 = y as usize;
-        let fx = x - x0 as f32;
-        let fy = y - y0 as f32;
+        // x, y ≥ 0, so truncation is floor; through i32, whose conversion is cheaper than
+        // usize's (a point that is not inside after all gives an index `get` refuses).
+        let (xi, yi) = (x as i32, y as i32);
+        let fx = x - xi as f32;
+        let fy = y - yi as f32;
+        let (x0, y0) = (xi as usize, yi as usize);
         let i0 = y0 * self.width + x0;
         let i1 = i0 + self.width;
         let pair = |i: usize| self.px.get(i..).and_then(|s| s.first_chunk::<2>());
@@ -373,7 +375,7 @@ impl Template {
             let region = &self.region[base..base + self.cols];
             let mut row = [0.0f32; 4];
             for (j, ([key, ada], r)) in cells.iter().zip(region).enumerate().step_by(step) {
-                let fj = j as f32;
+                let fj = j as i32 as f32; // through i32: cheaper than from usize, and j < MAX_COLS
                 let c = sample(row_x + fj * g.dv[0], row_y + fj * g.dv[1]);
                 for k in 0..4 {
                     row[k] +=
