@@ -62,11 +62,21 @@ impl Default for SimilarityWeights {
 /// A frame as four `f32` lanes per pixel (R, G, B and 0), converted once per frame (0.3 ms at
 /// 640×480): the hot loop then loads a pixel as one vector instead of widening its bytes at
 /// every sample.
-#[derive(Debug, Clone, Default)]
+#[derive(Clone, Default)]
 pub struct FloatFrame {
     px: Vec<[f32; 4]>,
     width: usize,
     height: usize,
+}
+
+/// Its size only: a frame's pixels would fill a log.
+impl std::fmt::Debug for FloatFrame {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FloatFrame")
+            .field("width", &self.width)
+            .field("height", &self.height)
+            .finish_non_exhaustive()
+    }
 }
 
 impl FloatFrame {
