@@ -298,12 +298,12 @@ pub struct SynthArgs {
 #[derive(Debug, Args)]
 pub struct BenchArgs {
     /// What to measure: all (decode and synth), decode, synth, track (tracking accuracy on
-    /// the synthetic suite and the real sample, and tracking speed; takes a few minutes), lift
-    /// (3D accuracy from true, noisy and tracked 2D, focal estimate, speed), correct (how
-    /// the tracks improve as a simulated user fixes the first frame with a lost joint, round
-    /// by round), scrub (the desktop app's frame access on a long 1080p clip: open time, random
-    /// seeks, scrubbing, peak memory), or volume (the point-volume pipeline: topology, joint error, labels, time
-    /// per frame at 3k/10k/30k points).
+    /// the synthetic suite and the real sample, and tracking speed; takes 6 to 13 minutes on
+    /// two cores), lift (3D accuracy from true, noisy and tracked 2D, focal estimate, speed),
+    /// correct (how the tracks improve as a simulated user fixes the first frame with a lost
+    /// joint, round by round), scrub (the desktop app's frame access on a long 1080p clip:
+    /// open time, random seeks, scrubbing, peak memory), or volume (the point-volume pipeline:
+    /// topology, joint error, labels, time per frame at 3k/10k/30k points).
     #[arg(default_value = "all")]
     pub what: String,
     /// Frames per measured clip (decode).

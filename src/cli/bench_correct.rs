@@ -4,8 +4,9 @@
 //! simulated user ([`videomocap::eval::correction`]) goes to the first frame with a lost joint
 //! (the guide's advice), drags every joint there more than 0.2 torso off onto the reference and
 //! re-tracks from there, as the app's correction does (that frame becomes a key frame, the
-//! forward pass restarts there, a backward pass fills the weak frames before it). The table gives the accuracy after each round, the
-//! joints dragged so far, and how many rounds each clip needs to reach PCK@0.2 ≥ 0.95.
+//! forward pass restarts there, a backward pass fills the weak frames before it). The table
+//! gives the accuracy after each round, the joints dragged so far, and how many rounds each
+//! clip needs to reach PCK@0.2 ≥ 0.95.
 
 use super::args::{BenchArgs, GlobalArgs};
 use super::bench_track::{ensure_suite, threads_and_settings, track_opened};

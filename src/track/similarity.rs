@@ -218,9 +218,9 @@ struct GridGeometry {
 }
 
 impl GridGeometry {
-    /// Whether every cell of a `rows × cols` grid lies inside `[0, width − 1) × [0, height − 1)`,
-    /// with a hundredth of a pixel to spare for rounding (the grid is a parallelogram: its four
-    /// corner cells bound it).
+    /// Whether every cell of a `rows × cols` grid lies inside `[0, width − 1) ×
+    /// [0, height − 1)`, with a hundredth of a pixel to spare for rounding (the grid is a
+    /// parallelogram: its four corner cells bound it).
     fn inside(&self, rows: usize, cols: usize, frame: &FrameView) -> bool {
         let (fi, fj) = ((rows - 1) as f32, (cols - 1) as f32);
         let (xmax, ymax) = ((frame.width - 1) as f32, (frame.height - 1) as f32);
