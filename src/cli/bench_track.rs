@@ -285,9 +285,11 @@ pub fn fixed_template_track(
         .map(|&j| (marks[j].x.round() as i64, marks[j].y.round() as i64))
         .collect();
     let mut out = vec![*marks];
+    // One buffer for every frame (a fresh one per frame costs its page faults).
+    let mut floats = first_floats;
     for index in 1..video.info().frame_count {
         let image = video.frame(index).map_err(ExitError::failed)?.image;
-        let floats = FloatFrame::new(&image);
+        floats.fill(&image);
         let f = floats.view();
         let sad = |t: &[[f32; 3]], cx: i64, cy: i64, bound: f32| -> f32 {
             let mut s = 0.0;
