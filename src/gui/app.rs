@@ -1309,6 +1309,8 @@ impl App {
                     .on_hover_text(format!("How strongly a limb is pulled back to its full length when it looks shorter (legs crossing); lower it for limbs pointing at the camera, such as a seated person's thighs seen from the front; default {}", d.short_penalty));
                 ui.checkbox(&mut t.hip_patch, "hold the hips when the back bends")
                     .on_hover_text(format!("A patch around the hips holds the pelvis when the spine bends (a bow, a reach), and the trunk is re-hung from the neck to it; default {}", if d.hip_patch { "on" } else { "off" }));
+                ui.checkbox(&mut t.chain_refine, "refine each limb as one chain")
+                    .on_hover_text(format!("After each limb's two segments are found, the elbow or knee and the wrist or ankle are nudged together so both segments fit; default {}", if d.chain_refine { "on" } else { "off" }));
                 if ui.button("Defaults").clicked() {
                     *t = d;
                 }

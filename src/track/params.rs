@@ -82,6 +82,11 @@ pub struct TrackerParams {
     /// the head's zoom. Default 8 (0 turns it off); it also resists true foreshortening, which
     /// costs a frontal seated knee.
     pub short_penalty: f32,
+    /// Refine each limb chain as one figure after its segments are found (beyond the paper):
+    /// the elbow or knee and the wrist or ankle move by sub-pixel steps while the sum of both
+    /// segments' costs falls, so a middle joint the upper segment put a pixel off no longer
+    /// leaves the lower segment anchored wrongly. Default true.
+    pub chain_refine: bool,
 }
 
 impl Default for TrackerParams {
@@ -113,6 +118,7 @@ impl Default for TrackerParams {
             hip_margin: 3.0,
             fold_limit_deg: 165.0,
             short_penalty: 8.0,
+            chain_refine: true,
         }
     }
 }

@@ -1,6 +1,7 @@
 //! Where to look for a block in the next frame: the spiral search path of the head (Pan et al.,
 //! Fig. 6) and the angular search of blocks anchored at a tracked parent joint (trunk, limbs).
-//! Both end with a local refinement that halves its steps down to sub-pixel size.
+//! Both end with a local refinement that halves its steps down to sub-pixel size; a limb's two
+//! segments are then refined together as one chain ([`refine_chain`]).
 
 use super::block::{MorphBlock, wrap_angle};
 use super::similarity::{FrameView, Template};
@@ -393,6 +394,106 @@ pub fn angular(
     best
 }
 
+/// One segment of a two-segment chain (upper arm and forearm, thigh and shank): its colour
+/// model, its width and its motion prior.
+#[derive(Clone, Copy)]
+pub struct ChainSegment<'a> {
+    /// The segment's colour model.
+    pub template: &'a Template,
+    /// Its width, pixels.
+    pub n: f64,
+    /// Its motion prior.
+    pub prior: &'a Prior,
+}
+
+/// Beyond the paper: a two-segment chain from a fixed root refined as one figure. The middle
+/// joint (elbow, knee) is shared: the segment-by-segment search fixes the upper segment first,
+/// so a middle joint a pixel or two off leaves the lower segment anchored wrongly, and on a thin
+/// limb it then shortens or turns to fit. Here the middle and end joints move by ± a step in x
+/// and y (the other joint staying put) while the sum of both segments' costs falls; steps start
+/// at `step_px` and are halved `levels − 1` times. `allowed` refuses a pair of blocks (a lower
+/// segment folded back). Returns the two blocks and their summed cost.
+pub fn refine_chain(
+    frame: FrameView,
+    root: Point2<f64>,
+    segments: [ChainSegment; 2],
+    start: [Point2<f64>; 2],
+    step_px: f64,
+    levels: usize,
+    allowed: impl Fn(&MorphBlock, &MorphBlock) -> bool,
+) -> ([MorphBlock; 2], f32) {
+    let blocks = |[mid, end]: [Point2<f64>; 2]| {
+        [
+            MorphBlock::along(root, mid, segments[0].n),
+            MorphBlock::along(mid, end, segments[1].n),
+        ]
+    };
+    // Each segment's cost (appearance plus prior) with early exit against `bound`; a
+    // refused pair costs infinity.
+    let segment_cost = |k: usize, b: &MorphBlock, bound: f32| {
+        total_cost(
+            segments[k].template,
+            frame,
+            b,
+            segments[k].prior,
+            false,
+            bound,
+        )
+    };
+    let mut joints = start;
+    let [u, l] = blocks(joints);
+    let mut best = if allowed(&u, &l) {
+        [
+            segment_cost(0, &u, f32::INFINITY),
+            segment_cost(1, &l, f32::INFINITY),
+        ]
+    } else {
+        [f32::INFINITY; 2]
+    };
+    let mut step = step_px;
+    for _ in 0..levels {
+        for _ in 0..8 {
+            let mut improved = false;
+            for which in 0..2 {
+                for d in [
+                    Vector2::new(step, 0.0),
+                    Vector2::new(-step, 0.0),
+                    Vector2::new(0.0, step),
+                    Vector2::new(0.0, -step),
+                ] {
+                    let mut cand = joints;
+                    cand[which] += d;
+                    let [u, l] = blocks(cand);
+                    if !allowed(&u, &l) {
+                        continue;
+                    }
+                    let total = best[0] + best[1];
+                    // Moving the end joint leaves the upper segment as it was.
+                    let cu = if which == 0 {
+                        segment_cost(0, &u, total)
+                    } else {
+                        best[0]
+                    };
+                    if !cu.is_finite() {
+                        continue;
+                    }
+                    let cl = segment_cost(1, &l, total - cu);
+                    if cu + cl < total {
+                        best = [cu, cl];
+                        joints = cand;
+                        improved = true;
+                    }
+                }
+            }
+            if !improved {
+                break;
+            }
+        }
+        step /= 2.0;
+    }
+    (blocks(joints), best[0] + best[1])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -413,6 +514,79 @@ mod tests {
                 Rgb([70 + 30 * s, 110, 90 + 20 * s])
             }
         })
+    }
+
+    /// An arm: an upper bar from `joints[0]` to `joints[1]` and a differently textured lower
+    /// bar from `joints[1]` to `joints[2]`, 14 px wide, over the background of [`bar`].
+    fn arm(joints: [Point2<f64>; 3]) -> RgbImage {
+        let upper = MorphBlock::along(joints[0], joints[1], 14.0);
+        let lower = MorphBlock::along(joints[1], joints[2], 14.0);
+        let background = bar(joints[0], joints[0], 0.0);
+        RgbImage::from_fn(160, 160, |x, y| {
+            let p = Point2::new(f64::from(x), f64::from(y));
+            let on = |b: &MorphBlock| {
+                let (u, v) = b.to_block(p);
+                ((0.0..=1.0).contains(&u) && v.abs() <= 0.5).then_some((u, v))
+            };
+            if let Some((u, v)) = on(&lower) {
+                let s = ((u * 5.0).floor() as i64 + (v * 3.0 + 2.0).floor() as i64) & 1;
+                Rgb([60 + 120 * s as u8, 200, 40])
+            } else if let Some((u, v)) = on(&upper) {
+                let s = ((u * 6.0).floor() as i64 + (v * 4.0 + 2.0).floor() as i64) & 1;
+                Rgb([180 + 40 * s as u8, 60, 60 + 80 * s as u8])
+            } else {
+                *background.get_pixel(x, y)
+            }
+        })
+    }
+
+    /// Both joints of a bent arm started off (the elbow 2.5 px, the wrist 1.5 px) come back to
+    /// within half a pixel, and the cost returned is that of the blocks returned.
+    #[test]
+    fn the_chain_refinement_moves_both_joints_onto_the_arm() {
+        let truth = [
+            Point2::new(60.0, 30.0),
+            Point2::new(72.0, 85.0),
+            Point2::new(115.0, 110.0),
+        ];
+        let frame_image = arm(truth);
+        let floats = FloatFrame::new(&frame_image);
+        let frame = floats.view();
+        let template = |a: Point2<f64>, b: Point2<f64>| {
+            let block = MorphBlock::along(a, b, 14.0);
+            Template::sample(frame, &block, Extent::BLOCK, SimilarityWeights::default())
+        };
+        let (upper, lower) = (template(truth[0], truth[1]), template(truth[1], truth[2]));
+        let segments = [
+            ChainSegment {
+                template: &upper,
+                n: 14.0,
+                prior: &Prior::NONE,
+            },
+            ChainSegment {
+                template: &lower,
+                n: 14.0,
+                prior: &Prior::NONE,
+            },
+        ];
+        let start = [
+            truth[1] + Vector2::new(2.0, -1.5),
+            truth[2] + Vector2::new(-1.2, 0.9),
+        ];
+        let ([u, l], cost) = refine_chain(frame, truth[0], segments, start, 1.0, 3, |_, _| true);
+        let elbow = (u.end() - truth[1]).norm();
+        let wrist = (l.end() - truth[2]).norm();
+        assert!(
+            elbow < 0.5 && wrist < 0.5,
+            "elbow {elbow:.2} px, wrist {wrist:.2} px off"
+        );
+        assert_eq!(u.end(), l.origin, "the segments share the elbow");
+        let sum = upper.cost(frame, &u, false, f32::INFINITY)
+            + lower.cost(frame, &l, false, f32::INFINITY);
+        assert!((cost - sum).abs() < 1e-4, "cost {cost} against {sum}");
+        // A refusal of every move leaves the joints where they started.
+        let ([u, l], _) = refine_chain(frame, truth[0], segments, start, 1.0, 3, |_, _| false);
+        assert!((u.end() - start[0]).norm() < 1e-9 && (l.end() - start[1]).norm() < 1e-9);
     }
 
     /// A 70 px limb hanging from (80, 40) that ends at `end` in the next frame, searched with
