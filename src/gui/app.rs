@@ -1311,6 +1311,8 @@ impl App {
                     .on_hover_text(format!("A patch around the hips holds the pelvis when the spine bends (a bow, a reach), and the trunk is re-hung from the neck to it; default {}", if d.hip_patch { "on" } else { "off" }));
                 ui.checkbox(&mut t.chain_refine, "refine each limb as one chain")
                     .on_hover_text(format!("After each limb's two segments are found, the elbow or knee and the wrist or ankle are nudged together so both segments fit; default {}", if d.chain_refine { "on" } else { "off" }));
+                ui.add(egui::Slider::new(&mut t.shoulder_spring, 0.0..=0.5).text("shoulder spring"))
+                    .on_hover_text(format!("Cost per square pixel that a shoulder pays for leaving the place the rigid trunk gives it, so it can rise with a raised arm (part of the chain refinement); higher holds it closer; 0 holds it on the trunk; default {}", d.shoulder_spring));
                 if ui.button("Defaults").clicked() {
                     *t = d;
                 }

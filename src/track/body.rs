@@ -12,7 +12,8 @@ use super::block::{MorphBlock, wrap_angle};
 use super::head::HeadPredictor;
 use super::params::TrackerParams;
 use super::search::{
-    AngularParams, ChainSegment, Found, Prior, SpiralParams, angular, refine_chain, spiral,
+    AngularParams, ChainRoot, ChainSegment, Found, Prior, SpiralParams, angular, refine_chain,
+    spiral,
 };
 use super::similarity::{Extent, FloatFrame, FrameView, Template};
 use crate::camera::point_in_frame;
@@ -140,6 +141,9 @@ pub struct BodyTracker {
     hips: Part,
     /// Chest, shoulders and hips in the trunk block's (u, v) coordinates.
     trunk_points: [(f64, f64); 5],
+    /// Per chain: its root joint's shift from where the rigid trunk puts it, in the trunk
+    /// block's (u, v) units (a shoulder rising with its arm).
+    root_shift: [(f64, f64); 4],
     predictor: HeadPredictor,
     /// The head block's length on the marked frame, pixels.
     marked_head_m: f64,
@@ -252,6 +256,7 @@ impl BodyTracker {
             hips,
             limbs,
             trunk_points,
+            root_shift: [(0.0, 0.0); 4],
             predictor: HeadPredictor::default(),
             marked_head_m: pose_head_m,
             zoom: 1.0,
@@ -292,7 +297,7 @@ impl BodyTracker {
             self.trunk.reliability,
         );
         for (k, j) in TRUNK_JOINTS.iter().enumerate() {
-            let (u, v) = self.trunk_points[k];
+            let (u, v) = self.trunk_point(k);
             set(
                 &mut out,
                 *j,
@@ -306,6 +311,16 @@ impl BodyTracker {
             set(&mut out, chain[2], lower.block.end(), lower.reliability);
         }
         out
+    }
+
+    /// Trunk point `k` of [`TRUNK_JOINTS`] in the trunk block's (u, v), with its chain's root
+    /// shift.
+    fn trunk_point(&self, k: usize) -> (f64, f64) {
+        let (u, v) = self.trunk_points[k];
+        match CHAINS.iter().position(|c| c[0] == TRUNK_JOINTS[k]) {
+            Some(c) => (u + self.root_shift[c].0, v + self.root_shift[c].1),
+            None => (u, v),
+        }
     }
 
     /// Tracks the body into the next frame and returns its pose.
@@ -410,20 +425,43 @@ impl BodyTracker {
         // Limbs, each chain from its root joint on the trunk; chains in parallel.
         let trunk_angles = [self.trunk.block.theta, trunk_before.0, trunk_before.1];
         let roots = CHAINS.map(|c| pose_now[c[0]].pos);
+        let rigid = CHAINS.map(|c| {
+            let k = TRUNK_JOINTS.iter().position(|&j| j == c[0]).unwrap_or(0);
+            let (u, v) = self.trunk_points[k];
+            self.trunk.block.to_image(u, v)
+        });
         let [a, b, c, d] = &mut self.limbs;
-        let track_chain = |parts: &mut [Part; 2], root: Point2<f64>| {
-            track_limb(parts, root, trunk_angles, frame, &p, zoom);
+        let track_chain = |parts: &mut [Part; 2], k: usize| {
+            let root = ChainRoot {
+                at: roots[k],
+                spring: shoulder_spring(k, &p).map(|s| (rigid[k], s)),
+            };
+            track_limb(parts, root, trunk_angles, frame, &p, zoom)
         };
-        if p.parallel {
-            rayon::join(
-                || rayon::join(|| track_chain(a, roots[0]), || track_chain(b, roots[1])),
-                || rayon::join(|| track_chain(c, roots[2]), || track_chain(d, roots[3])),
+        let new_roots = if p.parallel {
+            let ((ra, rb), (rc, rd)) = rayon::join(
+                || rayon::join(|| track_chain(a, 0), || track_chain(b, 1)),
+                || rayon::join(|| track_chain(c, 2), || track_chain(d, 3)),
             );
+            [ra, rb, rc, rd]
         } else {
-            track_chain(a, roots[0]);
-            track_chain(b, roots[1]);
-            track_chain(c, roots[2]);
-            track_chain(d, roots[3]);
+            [
+                track_chain(a, 0),
+                track_chain(b, 1),
+                track_chain(c, 2),
+                track_chain(d, 3),
+            ]
+        };
+        for (c, r) in new_roots.iter().enumerate() {
+            if shoulder_spring(c, &p).is_none() {
+                continue;
+            }
+            let k = TRUNK_JOINTS
+                .iter()
+                .position(|&j| j == CHAINS[c][0])
+                .unwrap_or(0);
+            let (u, v) = self.trunk.block.to_block(*r);
+            self.root_shift[c] = (u - self.trunk_points[k].0, v - self.trunk_points[k].1);
         }
         self.spare = previous;
         self.prev = floats;
@@ -588,14 +626,14 @@ const CHAIN_LEVELS: usize = 3;
 /// learns its new appearance.
 fn track_limb(
     parts: &mut [Part; 2],
-    root: Point2<f64>,
+    root: ChainRoot,
     trunk_angles: [f64; 3],
     frame: FrameView,
     p: &TrackerParams,
     zoom: f64,
-) {
+) -> Point2<f64> {
     let mut parent = trunk_angles;
-    let mut anchor = root;
+    let mut anchor = root.at;
     // The segments moved this frame (not held), with their priors; they learn their new
     // appearance once the chain is settled.
     let mut moved: [Option<Prior>; 2] = [None, None];
@@ -683,11 +721,24 @@ fn track_limb(
         parts[0].block = u;
         parts[1].block = l;
     }
+    let new_root = parts[0].block.origin;
     for (part, moved) in parts.iter_mut().zip(moved) {
         if moved.is_some() {
             learn(part, frame, p);
         }
     }
+    if moved[0].is_some() && moved[1].is_some() {
+        new_root
+    } else {
+        root.at
+    }
+}
+
+/// The spring that ties chain `chain`'s root to the rigid trunk in its joint refinement: the
+/// shoulders' (`shoulder_spring`, when above 0); the hips stay on the trunk (letting them move
+/// measured worse on the side views, where the far leg pulls its hip onto the near one).
+fn shoulder_spring(chain: usize, p: &TrackerParams) -> Option<f32> {
+    (chain < 2 && p.shoulder_spring > 0.0).then_some(p.shoulder_spring)
 }
 
 /// Holds a part at its angle to its parent (no angular velocity, which would spin it) with

@@ -87,6 +87,12 @@ pub struct TrackerParams {
     /// segments' costs falls, so a middle joint the upper segment put a pixel off no longer
     /// leaves the lower segment anchored wrongly. Default true.
     pub chain_refine: bool,
+    /// Beyond the paper: in the chain refinement each shoulder may leave the place the rigid
+    /// trunk block gives it (a shoulder rises with a raised arm, and sinks as the body bends
+    /// sideways), paying this cost (8-bit levels) per square tracker pixel of the shift; the
+    /// shift carries over to the next frame. Default 0.05 (10 px cost 5); 0 holds the shoulders
+    /// on the trunk.
+    pub shoulder_spring: f32,
 }
 
 impl Default for TrackerParams {
@@ -119,6 +125,7 @@ impl Default for TrackerParams {
             fold_limit_deg: 165.0,
             short_penalty: 8.0,
             chain_refine: true,
+            shoulder_spring: 0.05,
         }
     }
 }

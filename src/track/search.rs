@@ -406,27 +406,41 @@ pub struct ChainSegment<'a> {
     pub prior: &'a Prior,
 }
 
-/// Beyond the paper: a two-segment chain from a fixed root refined as one figure. The middle
-/// joint (elbow, knee) is shared: the segment-by-segment search fixes the upper segment first,
-/// so a middle joint a pixel or two off leaves the lower segment anchored wrongly, and on a thin
-/// limb it then shortens or turns to fit. Here the middle and end joints move by ± a step in x
-/// and y (the other joint staying put) while the sum of both segments' costs falls; steps start
-/// at `step_px` and are halved `levels − 1` times. `allowed` refuses a pair of blocks (a lower
-/// segment folded back). Returns the two blocks and their summed cost.
+/// Where a two-segment chain hangs from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChainRoot {
+    /// The root joint (shoulder, hip).
+    pub at: Point2<f64>,
+    /// When the root may move: its rest point and the cost per square pixel of leaving it.
+    pub spring: Option<(Point2<f64>, f32)>,
+}
+
+/// Beyond the paper: a two-segment chain refined as one figure. The middle joint (elbow, knee)
+/// is shared: the segment-by-segment search fixes the upper segment first, so a middle joint a
+/// pixel or two off leaves the lower segment anchored wrongly, and on a thin limb it then
+/// shortens or turns to fit. Here the middle and end joints (and the root, when it has a
+/// spring) move by ± a step in x and y, one joint at a time, while the sum of both segments'
+/// costs (plus the spring's) falls; steps start at `step_px` and are halved `levels − 1` times.
+/// `allowed` refuses a pair of blocks (a lower segment folded back). Returns the two blocks and
+/// their summed cost.
 pub fn refine_chain(
     frame: FrameView,
-    root: Point2<f64>,
+    root: ChainRoot,
     segments: [ChainSegment; 2],
     start: [Point2<f64>; 2],
     step_px: f64,
     levels: usize,
     allowed: impl Fn(&MorphBlock, &MorphBlock) -> bool,
 ) -> ([MorphBlock; 2], f32) {
-    let blocks = |[mid, end]: [Point2<f64>; 2]| {
+    let blocks = |[root, mid, end]: [Point2<f64>; 3]| {
         [
             MorphBlock::along(root, mid, segments[0].n),
             MorphBlock::along(mid, end, segments[1].n),
         ]
+    };
+    let spring = |r: Point2<f64>| {
+        root.spring
+            .map_or(0.0, |(rest, k)| k * (r - rest).norm_squared() as f32)
     };
     // Each segment's cost (appearance plus prior) with early exit against `bound`; a
     // refused pair costs infinity.
@@ -440,21 +454,23 @@ pub fn refine_chain(
             bound,
         )
     };
-    let mut joints = start;
+    let mut joints = [root.at, start[0], start[1]];
     let [u, l] = blocks(joints);
+    // The upper segment's cost carries the root's spring.
     let mut best = if allowed(&u, &l) {
         [
-            segment_cost(0, &u, f32::INFINITY),
+            segment_cost(0, &u, f32::INFINITY) + spring(root.at),
             segment_cost(1, &l, f32::INFINITY),
         ]
     } else {
         [f32::INFINITY; 2]
     };
+    let first = if root.spring.is_some() { 0 } else { 1 };
     let mut step = step_px;
     for _ in 0..levels {
         for _ in 0..8 {
             let mut improved = false;
-            for which in 0..2 {
+            for which in first..3 {
                 for d in [
                     Vector2::new(step, 0.0),
                     Vector2::new(-step, 0.0),
@@ -468,16 +484,23 @@ pub fn refine_chain(
                         continue;
                     }
                     let total = best[0] + best[1];
-                    // Moving the end joint leaves the upper segment as it was.
-                    let cu = if which == 0 {
-                        segment_cost(0, &u, total)
+                    // Moving the end joint leaves the upper segment as it was; moving the root
+                    // leaves the lower one.
+                    let cu = if which < 2 {
+                        let sp = spring(cand[0]);
+                        let rest = if which == 0 { best[1] } else { 0.0 };
+                        segment_cost(0, &u, total - rest - sp) + sp
                     } else {
                         best[0]
                     };
                     if !cu.is_finite() {
                         continue;
                     }
-                    let cl = segment_cost(1, &l, total - cu);
+                    let cl = if which > 0 {
+                        segment_cost(1, &l, total - cu)
+                    } else {
+                        best[1]
+                    };
                     if cu + cl < total {
                         best = [cu, cl];
                         joints = cand;
@@ -540,6 +563,11 @@ mod tests {
         })
     }
 
+    /// A root that stays put.
+    fn fixed(at: Point2<f64>) -> ChainRoot {
+        ChainRoot { at, spring: None }
+    }
+
     /// Both joints of a bent arm started off (the elbow 2.5 px, the wrist 1.5 px) come back to
     /// within half a pixel, and the cost returned is that of the blocks returned.
     #[test]
@@ -573,7 +601,8 @@ mod tests {
             truth[1] + Vector2::new(2.0, -1.5),
             truth[2] + Vector2::new(-1.2, 0.9),
         ];
-        let ([u, l], cost) = refine_chain(frame, truth[0], segments, start, 1.0, 3, |_, _| true);
+        let ([u, l], cost) =
+            refine_chain(frame, fixed(truth[0]), segments, start, 1.0, 3, |_, _| true);
         let elbow = (u.end() - truth[1]).norm();
         let wrist = (l.end() - truth[2]).norm();
         assert!(
@@ -585,8 +614,54 @@ mod tests {
             + lower.cost(frame, &l, false, f32::INFINITY);
         assert!((cost - sum).abs() < 1e-4, "cost {cost} against {sum}");
         // A refusal of every move leaves the joints where they started.
-        let ([u, l], _) = refine_chain(frame, truth[0], segments, start, 1.0, 3, |_, _| false);
+        let ([u, l], _) = refine_chain(frame, fixed(truth[0]), segments, start, 1.0, 3, |_, _| {
+            false
+        });
         assert!((u.end() - start[0]).norm() < 1e-9 && (l.end() - start[1]).norm() < 1e-9);
+    }
+
+    /// A shoulder 2.9 px from where the trunk puts it: with a weak spring the refinement moves
+    /// the root onto the arm; with a stiff one the root stays.
+    #[test]
+    fn the_chain_refinement_moves_the_root_only_as_far_as_its_spring_allows() {
+        let truth = [
+            Point2::new(62.5, 28.5),
+            Point2::new(72.0, 85.0),
+            Point2::new(115.0, 110.0),
+        ];
+        let floats = FloatFrame::new(&arm(truth));
+        let frame = floats.view();
+        let template = |a: Point2<f64>, b: Point2<f64>| {
+            let block = MorphBlock::along(a, b, 14.0);
+            Template::sample(frame, &block, Extent::BLOCK, SimilarityWeights::default())
+        };
+        let (upper, lower) = (template(truth[0], truth[1]), template(truth[1], truth[2]));
+        let segments = [
+            ChainSegment {
+                template: &upper,
+                n: 14.0,
+                prior: &Prior::NONE,
+            },
+            ChainSegment {
+                template: &lower,
+                n: 14.0,
+                prior: &Prior::NONE,
+            },
+        ];
+        let rest = Point2::new(60.0, 30.0);
+        let refine = |k: f32| {
+            let start = [truth[1], truth[2]];
+            let root = ChainRoot {
+                at: rest,
+                spring: Some((rest, k)),
+            };
+            let ([u, _], _) = refine_chain(frame, root, segments, start, 1.0, 3, |_, _| true);
+            u.origin
+        };
+        let weak = (refine(0.05) - truth[0]).norm();
+        assert!(weak < 0.8, "root {weak:.2} px off with a weak spring");
+        let stiff = (refine(100.0) - rest).norm();
+        assert!(stiff < 1e-9, "root moved {stiff:.2} px with a stiff spring");
     }
 
     /// A 70 px limb hanging from (80, 40) that ends at `end` in the next frame, searched with
