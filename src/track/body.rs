@@ -39,6 +39,9 @@ const TRUNK_JOINTS: [Joint; 5] = [
     Joint::RightHip,
 ];
 
+/// Per chain of [`CHAINS`]: where its root joint is in [`TRUNK_JOINTS`].
+const CHAIN_ROOTS: [usize; 4] = [1, 2, 3, 4];
+
 /// One joint's result in one frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointResult {
@@ -317,7 +320,7 @@ impl BodyTracker {
     /// shift.
     fn trunk_point(&self, k: usize) -> (f64, f64) {
         let (u, v) = self.trunk_points[k];
-        match CHAINS.iter().position(|c| c[0] == TRUNK_JOINTS[k]) {
+        match CHAIN_ROOTS.iter().position(|&r| r == k) {
             Some(c) => (u + self.root_shift[c].0, v + self.root_shift[c].1),
             None => (u, v),
         }
@@ -425,8 +428,7 @@ impl BodyTracker {
         // Limbs, each chain from its root joint on the trunk; chains in parallel.
         let trunk_angles = [self.trunk.block.theta, trunk_before.0, trunk_before.1];
         let roots = CHAINS.map(|c| pose_now[c[0]].pos);
-        let rigid = CHAINS.map(|c| {
-            let k = TRUNK_JOINTS.iter().position(|&j| j == c[0]).unwrap_or(0);
+        let rigid = CHAIN_ROOTS.map(|k| {
             let (u, v) = self.trunk_points[k];
             self.trunk.block.to_image(u, v)
         });
@@ -453,15 +455,11 @@ impl BodyTracker {
             ]
         };
         for (c, r) in new_roots.iter().enumerate() {
-            if shoulder_spring(c, &p).is_none() {
-                continue;
+            if shoulder_spring(c, &p).is_some() {
+                let (u, v) = self.trunk.block.to_block(*r);
+                let (u0, v0) = self.trunk_points[CHAIN_ROOTS[c]];
+                self.root_shift[c] = (u - u0, v - v0);
             }
-            let k = TRUNK_JOINTS
-                .iter()
-                .position(|&j| j == CHAINS[c][0])
-                .unwrap_or(0);
-            let (u, v) = self.trunk.block.to_block(*r);
-            self.root_shift[c] = (u - self.trunk_points[k].0, v - self.trunk_points[k].1);
         }
         self.spare = previous;
         self.prev = floats;
@@ -664,9 +662,7 @@ fn track_limb(
         // and knees flex to about 150°; seen from the side, the image angle is the true one).
         // A lower segment found folded further than `fold_limit_deg` is a lock on the wrong
         // thing (the other leg, the floor); it is held like a joint off the image.
-        let folded = |b: &MorphBlock| {
-            k == 1 && wrap_angle(b.theta - parent[0]).abs() > p.fold_limit_deg.to_radians()
-        };
+        let folded = |b: &MorphBlock| k == 1 && folded_back(parent[0], b.theta, p);
         let mut found = angular(&part.template, frame, &pred, &narrow, &prior);
         let weak = reliability(found.cost, p.reliability_c0) < p.weak_reliability;
         if weak && predicted_off {
@@ -697,7 +693,6 @@ fn track_limb(
     if let [Some(upper), Some(lower)] = &moved
         && p.chain_refine
     {
-        let fold = p.fold_limit_deg.to_radians();
         let ([u, l], _) = refine_chain(
             frame,
             root,
@@ -716,7 +711,7 @@ fn track_limb(
             [parts[0].block.end(), parts[1].block.end()],
             CHAIN_STEP_PX,
             CHAIN_LEVELS,
-            |u, l| wrap_angle(l.theta - u.theta).abs() <= fold,
+            |u, l| !folded_back(u.theta, l.theta, p),
         );
         parts[0].block = u;
         parts[1].block = l;
@@ -734,6 +729,12 @@ fn track_limb(
     }
 }
 
+/// Whether a lower segment at image angle `lower` is folded back onto its upper segment at
+/// `upper` further than `fold_limit_deg` (elbows and knees flex to about 150°).
+fn folded_back(upper: f64, lower: f64, p: &TrackerParams) -> bool {
+    wrap_angle(lower - upper).abs() > p.fold_limit_deg.to_radians()
+}
+
 /// The spring that ties chain `chain`'s root to the rigid trunk in its joint refinement: the
 /// shoulders' (`shoulder_spring`, when above 0); the hips stay on the trunk (letting them move
 /// measured worse on the side views, where the far leg pulls its hip onto the near one).
@@ -747,4 +748,16 @@ fn hold(part: &mut Part, anchor: Point2<f64>, parent: [f64; 3]) {
     part.prev_theta = part.block.theta;
     part.block = predict_anchored(part, anchor, Some(parent), 0.0);
     part.reliability = 0.0;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_chain_root_index_names_that_chains_root_joint() {
+        for (c, chain) in CHAINS.iter().enumerate() {
+            assert_eq!(TRUNK_JOINTS[CHAIN_ROOTS[c]], chain[0]);
+        }
+    }
 }
