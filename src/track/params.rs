@@ -91,7 +91,9 @@ pub struct TrackerParams {
     /// trunk block gives it (a shoulder rises with a raised arm, and sinks as the body bends
     /// sideways), paying this cost (8-bit levels) per square tracker pixel of the shift; the
     /// shift carries over to the next frame. Default 0.05 (10 px cost 5); 0 holds the shoulders
-    /// on the trunk.
+    /// on the trunk. Where the shoulders truly stay put (the synthetic suite's bodies) it moves
+    /// them by about a pixel, and the lift, which holds the shoulders and chest as a rigid
+    /// triangle, feels that: there 0 gives the better 3D.
     pub shoulder_spring: f32,
 }
 
