@@ -568,6 +568,32 @@ mod tests {
         ChainRoot { at, spring: None }
     }
 
+    /// The arm of [`arm`] through `truth` as a frame, with each segment's colour model sampled
+    /// on it.
+    fn arm_models(truth: [Point2<f64>; 3]) -> (FloatFrame, [Template; 2]) {
+        let floats = FloatFrame::new(&arm(truth));
+        let model = |a: Point2<f64>, b: Point2<f64>| {
+            let block = MorphBlock::along(a, b, 14.0);
+            Template::sample(
+                floats.view(),
+                &block,
+                Extent::BLOCK,
+                SimilarityWeights::default(),
+            )
+        };
+        let models = [model(truth[0], truth[1]), model(truth[1], truth[2])];
+        (floats, models)
+    }
+
+    /// The two segments of an arm of [`arm`], without priors.
+    fn segments(models: &[Template; 2]) -> [ChainSegment<'_>; 2] {
+        [0, 1].map(|k| ChainSegment {
+            template: &models[k],
+            n: 14.0,
+            prior: &Prior::NONE,
+        })
+    }
+
     /// Both joints of a bent arm started off (the elbow 2.5 px, the wrist 1.5 px) come back to
     /// within half a pixel, and the cost returned is that of the blocks returned.
     #[test]
@@ -577,26 +603,8 @@ mod tests {
             Point2::new(72.0, 85.0),
             Point2::new(115.0, 110.0),
         ];
-        let frame_image = arm(truth);
-        let floats = FloatFrame::new(&frame_image);
-        let frame = floats.view();
-        let template = |a: Point2<f64>, b: Point2<f64>| {
-            let block = MorphBlock::along(a, b, 14.0);
-            Template::sample(frame, &block, Extent::BLOCK, SimilarityWeights::default())
-        };
-        let (upper, lower) = (template(truth[0], truth[1]), template(truth[1], truth[2]));
-        let segments = [
-            ChainSegment {
-                template: &upper,
-                n: 14.0,
-                prior: &Prior::NONE,
-            },
-            ChainSegment {
-                template: &lower,
-                n: 14.0,
-                prior: &Prior::NONE,
-            },
-        ];
+        let (floats, models) = arm_models(truth);
+        let (frame, segments) = (floats.view(), segments(&models));
         let start = [
             truth[1] + Vector2::new(2.0, -1.5),
             truth[2] + Vector2::new(-1.2, 0.9),
@@ -610,8 +618,8 @@ mod tests {
             "elbow {elbow:.2} px, wrist {wrist:.2} px off"
         );
         assert_eq!(u.end(), l.origin, "the segments share the elbow");
-        let sum = upper.cost(frame, &u, false, f32::INFINITY)
-            + lower.cost(frame, &l, false, f32::INFINITY);
+        let sum = models[0].cost(frame, &u, false, f32::INFINITY)
+            + models[1].cost(frame, &l, false, f32::INFINITY);
         assert!((cost - sum).abs() < 1e-4, "cost {cost} against {sum}");
         // A refusal of every move leaves the joints where they started.
         let ([u, l], _) = refine_chain(frame, fixed(truth[0]), segments, start, 1.0, 3, |_, _| {
@@ -629,25 +637,8 @@ mod tests {
             Point2::new(72.0, 85.0),
             Point2::new(115.0, 110.0),
         ];
-        let floats = FloatFrame::new(&arm(truth));
-        let frame = floats.view();
-        let template = |a: Point2<f64>, b: Point2<f64>| {
-            let block = MorphBlock::along(a, b, 14.0);
-            Template::sample(frame, &block, Extent::BLOCK, SimilarityWeights::default())
-        };
-        let (upper, lower) = (template(truth[0], truth[1]), template(truth[1], truth[2]));
-        let segments = [
-            ChainSegment {
-                template: &upper,
-                n: 14.0,
-                prior: &Prior::NONE,
-            },
-            ChainSegment {
-                template: &lower,
-                n: 14.0,
-                prior: &Prior::NONE,
-            },
-        ];
+        let (floats, models) = arm_models(truth);
+        let (frame, segments) = (floats.view(), segments(&models));
         let rest = Point2::new(60.0, 30.0);
         let refine = |k: f32| {
             let start = [truth[1], truth[2]];
