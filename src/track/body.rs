@@ -621,7 +621,7 @@ const CHAIN_LEVELS: usize = 3;
 /// range (fast limbs), unless the prediction has left the image: then the part is held at its
 /// angle to its parent, reliability 0, until its prediction comes back. When both segments
 /// moved, the chain is refined as one figure ([`refine_chain`], `chain_refine`) before either
-/// learns its new appearance.
+/// learns its new appearance. Returns the root joint, moved when it has a spring.
 fn track_limb(
     parts: &mut [Part; 2],
     root: ChainRoot,
@@ -716,17 +716,14 @@ fn track_limb(
         parts[0].block = u;
         parts[1].block = l;
     }
-    let new_root = parts[0].block.origin;
     for (part, moved) in parts.iter_mut().zip(moved) {
         if moved.is_some() {
             learn(part, frame, p);
         }
     }
-    if moved[0].is_some() && moved[1].is_some() {
-        new_root
-    } else {
-        root.at
-    }
+    // The upper segment hangs from the root: where the chain refinement moved it, or where it
+    // was (a found or held upper segment keeps its anchor).
+    parts[0].block.origin
 }
 
 /// Whether a lower segment at image angle `lower` is folded back onto its upper segment at
