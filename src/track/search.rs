@@ -396,7 +396,7 @@ pub fn angular(
 
 /// One segment of a two-segment chain (upper arm and forearm, thigh and shank): its colour
 /// model, its width and its motion prior.
-#[derive(Clone, Copy)]
+#[derive(Debug, Clone, Copy)]
 pub struct ChainSegment<'a> {
     /// The segment's colour model.
     pub template: &'a Template,
