@@ -1311,7 +1311,8 @@ impl App {
                     .on_hover_text(format!("A patch around the hips holds the pelvis when the spine bends (a bow, a reach), and the trunk is re-hung from the neck to it; default {}", if d.hip_patch { "on" } else { "off" }));
                 ui.checkbox(&mut t.chain_refine, "refine each limb as one chain")
                     .on_hover_text(format!("After each limb's two segments are found, the elbow or knee and the wrist or ankle are nudged together so both segments fit; default {}", if d.chain_refine { "on" } else { "off" }));
-                ui.add(egui::Slider::new(&mut t.shoulder_spring, 0.0..=0.5).text("shoulder spring"))
+                // The spring is part of the chain refinement: greyed out without it.
+                ui.add_enabled(t.chain_refine, egui::Slider::new(&mut t.shoulder_spring, 0.0..=0.5).text("shoulder spring"))
                     .on_hover_text(format!("Cost per square pixel that a shoulder pays for leaving the place the rigid trunk gives it, so it can rise with a raised arm (part of the chain refinement); higher holds it closer; 0 holds it on the trunk; default {}", d.shoulder_spring));
                 if ui.button("Defaults").clicked() {
                     *t = d;
@@ -2182,6 +2183,27 @@ mod tests {
         assert!(!h.state().project().unwrap().settings.tracker.hip_patch);
         h.state_mut().undo();
         assert!(h.state().project().unwrap().settings.tracker.hip_patch);
+    }
+
+    /// The shoulder spring is part of the chain refinement: its slider is greyed out while the
+    /// chain refinement is off.
+    #[test]
+    fn the_shoulder_spring_is_greyed_out_without_the_chain_refinement() {
+        use egui_kittest::kittest::NodeT;
+        let dir = tempfile::tempdir().unwrap();
+        let mut h = with_project(dir.path());
+        h.get_by_label("Tracker").click();
+        h.run();
+        let disabled = |h: &Harness<'_, App>| {
+            h.get_by_role_and_label(egui::accesskit::Role::Slider, "shoulder spring")
+                .accesskit_node()
+                .is_disabled()
+        };
+        assert!(!disabled(&h));
+        h.get_by_label("refine each limb as one chain").click();
+        h.run();
+        assert!(!h.state().project().unwrap().settings.tracker.chain_refine);
+        assert!(disabled(&h));
     }
 
     /// A slider drag changes the settings many times but is one undo step.
