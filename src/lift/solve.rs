@@ -428,7 +428,8 @@ fn plausible_key(key: &[Point3<f64>; 3], max_depth: f64) -> bool {
 /// (behind the camera, too): three rays are also met by such a triangle, and on the suite from
 /// the tracker's output one of them, chained in, tipped a bending trunk seen from the side over
 /// (bend_side, true lengths: 136.0 → 115.4 mm). When every pose is dropped, the closest point
-/// fit, brought along its rays to `max_depth` at most (and `false`).
+/// fit (its twin in front when it lies behind the camera), brought along its rays to
+/// `max_depth` at most (and `false`).
 fn key_candidates(
     job: &LiftJob<'_>,
     triangle: &KeyTriangle,
