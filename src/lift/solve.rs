@@ -24,14 +24,13 @@ use std::sync::atomic::{AtomicBool, Ordering};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct LiftParams {
-    /// Run the global refinement after the per-frame solve (default false). It lowers the
-    /// error a little or leaves it, and raises it in no overall row of `bench lift` (which
-    /// reports both): on the synthetic suite with true lengths 49.5 → 48.0 mm with 2 px white
-    /// noise (four draws), 117.7 → 117.5 mm with the tracker's output, exact tracks
-    /// 20.4 → 20.3 mm; on the real sample 69.3 → 67.9 mm with its reference 2D and
-    /// 165.5 → 165.5 mm from the tracker's output and the height. It stays off because its
-    /// bones keep their lengths only within about a millimetre (σ 5 mm), so the BVH, whose
-    /// offsets are fixed, no longer reads back exactly (0.75 mm on the bundled synthetic clip).
+    /// Run the global refinement after the per-frame solve (default true), then set every bone
+    /// back to exactly its refined length ([`super::refine::snap_to_lengths`]), so the BVH's
+    /// fixed offsets give the skeleton back exactly. `bench lift` reports both; on the synthetic
+    /// suite with true lengths it lowers the error 49.5 → 48.0 mm with 2 px white noise (four
+    /// draws), 117.7 → 117.5 mm with the tracker's output, exact tracks 20.4 → 20.3 mm; on the
+    /// real sample 69.3 → 67.9 mm with its reference 2D. The one overall row it does not lower
+    /// is the real sample from the tracker's output and the height: 165.5 → 165.6 mm.
     pub refine: bool,
     /// A key-triangle calibration fits when its residual is below this RMS, pixels (default 1).
     pub calibration_tolerance_px: f64,
@@ -66,7 +65,7 @@ pub struct LiftParams {
 impl Default for LiftParams {
     fn default() -> Self {
         LiftParams {
-            refine: false,
+            refine: true,
             calibration_tolerance_px: 1.0,
             propagation_tolerance_m: 0.005,
             smoothing_s: 0.0,
