@@ -96,8 +96,11 @@ struct Group {
 
 use Joint::*;
 
+/// How many groups of bones have their roots chosen together.
+pub const GROUP_COUNT: usize = 7;
+
 /// Centre outwards: every group's first parent is known when it is solved.
-const GROUPS: [Group; 7] = [
+const GROUPS: [Group; GROUP_COUNT] = [
     Group {
         bones: &[Bone::new(Chest, Neck), Bone::new(Neck, HeadTop)],
         prior: Prior::Head,
@@ -157,8 +160,10 @@ pub struct Resolved {
     pub choices: Vec<[Root; BONE_COUNT]>,
     /// Whether each bone was too long for its 2D image (flagged, placed off its ray).
     pub too_long: Vec<[bool; BONE_COUNT]>,
-    /// The minimised total: priors plus squared accelerations (squared metres).
-    pub cost: f64,
+    /// The minimised total of each group of bones, priors plus squared accelerations (squared
+    /// metres), centre outwards: head and neck, spine, hips, left arm, right arm, left leg,
+    /// right leg.
+    pub group_costs: [f64; GROUP_COUNT],
 }
 
 /// The key triangle's directions in one frame: left, up, forward (unit vectors).
@@ -313,8 +318,8 @@ pub fn resolve(
     let trunks: Vec<TrunkFrame> = points.iter().map(TrunkFrame::of).collect();
     let mut choices = vec![[Root::Near; BONE_COUNT]; n];
     let mut too_long = vec![[false; BONE_COUNT]; n];
-    let mut total = 0.0;
-    for group in &GROUPS {
+    let mut group_costs = [0.0; GROUP_COUNT];
+    for (group, group_cost) in GROUPS.iter().zip(&mut group_costs) {
         let combos = 1usize << group.bones.len();
         let candidates: Vec<Vec<Candidate>> = (0..n)
             .map(|t| {
@@ -364,7 +369,7 @@ pub fn resolve(
             })
             .collect();
         let (path, cost) = viterbi(&candidates);
-        total += cost;
+        *group_cost = cost;
         for (t, &combo) in path.iter().enumerate() {
             let c = &candidates[t][combo];
             for (k, bone) in group.bones.iter().enumerate() {
@@ -383,7 +388,7 @@ pub fn resolve(
         points,
         choices,
         too_long,
-        cost: total,
+        group_costs,
     }
 }
 

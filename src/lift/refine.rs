@@ -33,9 +33,10 @@ pub struct RefineParams {
     /// Expected 2D error of a fully trusted track point, pixels (default 20: the tracker's
     /// errors are drift and jumps of several to tens of pixels, and the per-frame solve already
     /// lies on the smoothed tracks' rays, so the pass mostly smooths and evens the lengths).
-    /// Swept with `bench lift` (per-frame → refined, mm; suite with true lengths (b) four draws
-    /// of 2 px noise, (c) the tracker's output; real sample (a) its reference 2D, (c) the
-    /// tracker's output from the height):
+    /// Swept with `bench lift` before the calibration pose was chosen by `fit_score`
+    /// (per-frame → refined, mm; suite with true lengths (b) four draws of 2 px noise, (c) the
+    /// tracker's output; real sample (a) its reference 2D, (c) the tracker's output from the
+    /// height):
     ///
     /// | σ px | suite (b) | suite (c) | real (a) | real (c), height |
     /// |---|---|---|---|---|
