@@ -110,13 +110,14 @@ pub const MIN_NOISE_PX: f64 = 0.1;
 pub struct RefineSummary {
     /// Iterations run.
     pub iterations: usize,
-    /// Weighted cost before and after.
+    /// Weighted cost before.
     pub cost_before: f64,
-    /// Weighted cost after.
+    /// Weighted cost at the least-squares minimum (before the bones are snapped to their
+    /// lengths).
     pub cost_after: f64,
     /// RMS reprojection error before, pixels.
     pub reprojection_px_before: f64,
-    /// RMS reprojection error after, pixels.
+    /// RMS reprojection error of the returned (snapped) points, pixels.
     pub reprojection_px_after: f64,
 }
 
@@ -402,12 +403,16 @@ pub fn refine(
     progress(params.max_iterations, params.max_iterations);
     let mut bone_lengths = [0.0; BONE_COUNT];
     bone_lengths.copy_from_slice(&x.as_slice()[n * PER_FRAME..n * PER_FRAME + BONE_COUNT]);
-    let points = (0..n)
+    let points: Vec<PerJoint<Point3<f64>>> = (0..n)
         .map(|t| {
             let free = PerJoint::from_fn(|j| Problem::point(&x, t, j));
             snap_to_lengths(&free, &start[t], &bone_lengths)
         })
         .collect();
+    let mut lengths = [0.0; LENGTHS];
+    lengths.copy_from_slice(&x.as_slice()[n * PER_FRAME..]);
+    // The reprojection reported is that of the snapped points, which are what is returned.
+    let reprojection_px_after = problem.reprojection_rms(&Problem::pack(&points, &lengths));
     Ok(Refined {
         points,
         bone_lengths,
@@ -417,7 +422,7 @@ pub fn refine(
             cost_before: minimum.cost_before,
             cost_after: minimum.cost_after,
             reprojection_px_before,
-            reprojection_px_after: problem.reprojection_rms(&x),
+            reprojection_px_after,
         },
     })
 }
