@@ -390,9 +390,10 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
     })
 }
 
-/// The least a part's cost counts as in [`fit_score`], squared metres over the clip: a part
-/// that fits exactly (cost 0) would otherwise outvote every other. 0.01 and 0.1 chose the same
-/// poses on every clip of `bench lift`.
+/// The least a part's cost counts as in [`fit_score`] (in the part's own unit: metres for the
+/// miss, squared metres for a group's cost, both summed over the clip): a part that fits
+/// exactly (cost 0) would otherwise outvote every other. 0.01 and 0.1 chose the same poses on
+/// every clip of `bench lift`.
 pub const FIT_FLOOR: f64 = 0.01;
 
 /// How badly a calibration pose, carried through the clip, fits: the sum of the logarithms of
@@ -408,7 +409,7 @@ pub const FIT_FLOOR: f64 = 0.01;
 pub fn fit_score(miss_m: f64, group_costs: &[f64]) -> f64 {
     std::iter::once(miss_m)
         .chain(group_costs.iter().copied())
-        .map(|c| c.max(0.0).max(FIT_FLOOR).ln())
+        .map(|c| c.max(FIT_FLOOR).ln())
         .sum()
 }
 
