@@ -332,7 +332,8 @@ impl Residuals for Problem<'_> {
 /// the direction the refinement gave the bone. The least-squares pass holds lengths only within
 /// `length_sigma_m`, and a BVH's offsets are fixed: without this the exported file would not
 /// give the skeleton back exactly (0.75 mm off on the bundled synthetic clip). A bone the
-/// refinement shrank to nothing takes its direction from `fallback` (the per-frame solve).
+/// refinement shrank to nothing takes its direction from `fallback` (the per-frame solve), or
+/// straight down (+Y) when that one is nothing too.
 pub fn snap_to_lengths(
     free: &PerJoint<Point3<f64>>,
     fallback: &PerJoint<Point3<f64>>,
@@ -340,14 +341,10 @@ pub fn snap_to_lengths(
 ) -> PerJoint<Point3<f64>> {
     let mut snapped = *free;
     for (bone, &len) in Bone::ALL.iter().zip(lengths) {
-        let dir = free[bone.child] - free[bone.parent];
-        let dir = if dir.norm() > 1e-9 {
-            dir.normalize()
-        } else {
-            (fallback[bone.child] - fallback[bone.parent])
-                .try_normalize(1e-12)
-                .unwrap_or_else(Vector3::y)
-        };
+        let dir = (free[bone.child] - free[bone.parent])
+            .try_normalize(1e-9)
+            .or_else(|| (fallback[bone.child] - fallback[bone.parent]).try_normalize(1e-12))
+            .unwrap_or_else(Vector3::y);
         snapped[bone.child] = snapped[bone.parent] + len * dir;
     }
     snapped
@@ -401,22 +398,22 @@ pub fn refine(
     .ok_or(LiftError::Cancelled)?;
     let x = minimum.x;
     progress(params.max_iterations, params.max_iterations);
+    let mut lengths = [0.0; LENGTHS];
+    lengths.copy_from_slice(&x.as_slice()[n * PER_FRAME..]);
     let mut bone_lengths = [0.0; BONE_COUNT];
-    bone_lengths.copy_from_slice(&x.as_slice()[n * PER_FRAME..n * PER_FRAME + BONE_COUNT]);
+    bone_lengths.copy_from_slice(&lengths[..BONE_COUNT]);
     let points: Vec<PerJoint<Point3<f64>>> = (0..n)
         .map(|t| {
             let free = PerJoint::from_fn(|j| Problem::point(&x, t, j));
             snap_to_lengths(&free, &start[t], &bone_lengths)
         })
         .collect();
-    let mut lengths = [0.0; LENGTHS];
-    lengths.copy_from_slice(&x.as_slice()[n * PER_FRAME..]);
     // The reprojection reported is that of the snapped points, which are what is returned.
     let reprojection_px_after = problem.reprojection_rms(&Problem::pack(&points, &lengths));
     Ok(Refined {
         points,
         bone_lengths,
-        shoulder_width: x[n * PER_FRAME + BONE_COUNT],
+        shoulder_width: lengths[BONE_COUNT],
         summary: RefineSummary {
             iterations: minimum.iterations,
             cost_before: minimum.cost_before,
