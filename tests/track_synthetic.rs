@@ -257,7 +257,8 @@ fn a_tall_person_is_tracked_on_frames_the_decoder_shrinks() {
         &AtomicBool::new(false),
     )
     .unwrap();
-    assert_eq!(out.shrink, 2);
+    // The person (about 200 px) is brought to the working stature: a factor near 200 / 110.
+    assert!((1.5..2.2).contains(&out.shrink), "shrink {}", out.shrink);
     assert_eq!((video.info().width, video.info().height), (320, 240));
     assert_eq!(video.frame(3).unwrap().image.dimensions(), (320, 240));
     // Tracks are in video pixels, at the accuracy of the full-size test above.

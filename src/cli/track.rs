@@ -87,7 +87,7 @@ pub fn report(out: &TrackOutput, global: &GlobalArgs) {
     say(
         global,
         &format!(
-            "{} frames tracked (working scale 1/{}); {} short weak runs interpolated, {} weak spans left for review ({} of them off the frame)",
+            "{} frames tracked (working scale 1/{:.2}); {} short weak runs interpolated, {} weak spans left for review ({} of them off the frame)",
             out.tracks.frames.len(),
             out.shrink,
             interpolated,

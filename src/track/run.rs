@@ -135,8 +135,8 @@ pub struct TrackOutput {
     pub tracks: Tracks2d,
     /// Every run of weak frames per joint, interpolated or left weak.
     pub spans: Vec<WeakSpan>,
-    /// The integer shrink factor of the working scale.
-    pub shrink: u32,
+    /// The shrink factor of the working scale: video pixels per tracker pixel (1 = full size).
+    pub shrink: f64,
     /// Frames the decoder could not read (damaged or cut-short files), ascending. They are
     /// tracked as lost (reliability 0) and filled like occlusions, not fatal.
     pub damaged: Vec<usize>,
@@ -204,17 +204,22 @@ fn first_full_key(job: &TrackJob) -> Option<(usize, PerJoint<Point2<f64>>)> {
     })
 }
 
-/// The integer shrink factor that brings the marked person to at most the working stature, and
-/// the frame size it gives.
+/// The shrink factor that brings the marked person to the working stature (1 when they are no
+/// taller), and the frame size it gives. Any factor, not only whole ones: a whole factor halved
+/// a person just over the working stature and left one just under it at full size.
 fn working_scale(
     job: &TrackJob,
     pose: &PerJoint<Point2<f64>>,
     width: u32,
     height: u32,
-) -> (u32, (u32, u32)) {
+) -> (f64, (u32, u32)) {
     let stature = stature_px(pose, &Proportions::default());
-    let shrink = (stature / job.params.working_stature_px).ceil().max(1.0) as u32;
-    (shrink, ((width / shrink).max(2), (height / shrink).max(2)))
+    let shrink = (stature / job.params.working_stature_px).max(1.0);
+    if shrink <= 1.0 {
+        return (1.0, (width, height));
+    }
+    let side = |full: u32| ((f64::from(full) / shrink).round() as u32).clamp(2, full.max(2));
+    (shrink, (side(width), side(height)))
 }
 
 /// [`track_video`] with the video's full-size info.
@@ -248,7 +253,8 @@ fn track_at_working_scale(
         height: wh,
     };
     // Frames come out at the working size if the backend can make them so.
-    let decoded = if shrink > 1 && job.params.decoder_scaling && video.output_size(Some((ww, wh))) {
+    let decoded = if shrink > 1.0 && job.params.decoder_scaling && video.output_size(Some((ww, wh)))
+    {
         (ww, wh)
     } else {
         (info.width, info.height)
@@ -675,4 +681,40 @@ fn decode_order(order: &[usize]) -> Vec<DecodeChunk> {
             reverse: true,
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn job(working_stature_px: f64) -> TrackJob {
+        TrackJob {
+            keys: KeyFrames::default(),
+            params: TrackerParams {
+                working_stature_px,
+                ..TrackerParams::default()
+            },
+            threads: 1,
+            from: None,
+            previous: None,
+        }
+    }
+
+    /// A person a tenth over the working stature is shrunk by 1.1, not halved; one under it
+    /// is tracked at full size.
+    #[test]
+    fn the_working_scale_brings_the_person_to_the_working_stature() {
+        let pose = PerJoint::from_fn(|j| {
+            let k = j.index() as f64;
+            Point2::new(300.0 + 7.0 * k, 200.0 + 45.0 * k)
+        });
+        let stature = stature_px(&pose, &Proportions::default());
+        let (shrink, size) = working_scale(&job(stature / 1.1), &pose, 1080, 1920);
+        assert!((shrink - 1.1).abs() < 1e-9, "shrink {shrink}");
+        assert_eq!(size, (982, 1745));
+        assert_eq!(
+            working_scale(&job(stature * 1.5), &pose, 1080, 1920),
+            (1.0, (1080, 1920))
+        );
+    }
 }
