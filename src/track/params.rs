@@ -54,7 +54,7 @@ pub struct TrackerParams {
     /// pixels (speed on large videos; the sampling grids are capped anyway). Default 300: on
     /// the 1080×1920 sample (a person of 840 px) the tracker runs 1.2–1.5 times as fast as at
     /// 480, and `bench track` measured the suite and the sample no worse (PCK@0.2 0.898 →
-    /// 0.904 and 0.759 → 0.771).
+    /// 0.904 and 0.759 → 0.771). 0 keeps every video at full size.
     pub working_stature_px: f64,
     /// Have FFmpeg deliver frames at the working scale, converting them to RGB at that size
     /// (at 1080×1920 cheaper than converting at full size and shrinking). The video's frame

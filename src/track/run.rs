@@ -213,9 +213,10 @@ fn working_scale(
     width: u32,
     height: u32,
 ) -> (f64, (u32, u32)) {
-    let stature = stature_px(pose, &Proportions::default());
-    let shrink = (stature / job.params.working_stature_px).max(1.0);
-    if shrink <= 1.0 {
+    let working = job.params.working_stature_px;
+    let shrink = stature_px(pose, &Proportions::default()) / working;
+    // A working stature of 0 or less (or a person of no size) keeps the full size.
+    if !(working > 0.0 && shrink.is_finite() && shrink > 1.0) {
         return (1.0, (width, height));
     }
     let side = |full: u32| ((f64::from(full) / shrink).round() as u32).clamp(2, full.max(2));
@@ -700,8 +701,8 @@ mod tests {
         }
     }
 
-    /// A person a tenth over the working stature is shrunk by 1.1, not halved; one under it
-    /// is tracked at full size.
+    /// A person a tenth over the working stature is shrunk by 1.1, not halved; one under it,
+    /// or any person when the working stature is 0 or less, is tracked at full size.
     #[test]
     fn the_working_scale_brings_the_person_to_the_working_stature() {
         let pose = PerJoint::from_fn(|j| {
@@ -712,9 +713,12 @@ mod tests {
         let (shrink, size) = working_scale(&job(stature / 1.1), &pose, 1080, 1920);
         assert!((shrink - 1.1).abs() < 1e-9, "shrink {shrink}");
         assert_eq!(size, (982, 1745));
-        assert_eq!(
-            working_scale(&job(stature * 1.5), &pose, 1080, 1920),
-            (1.0, (1080, 1920))
-        );
+        for working in [stature * 1.5, 0.0, -1.0] {
+            assert_eq!(
+                working_scale(&job(working), &pose, 1080, 1920),
+                (1.0, (1080, 1920)),
+                "working stature {working}"
+            );
+        }
     }
 }
