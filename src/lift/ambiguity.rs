@@ -35,10 +35,7 @@ pub struct AmbiguityWeights {
     /// Knees bend in the leg's own plane, not sideways (the knee is a hinge; hip rotation
     /// turns its plane only a little).
     pub knee_side: f64,
-    /// Elbows of hanging arms bend forwards. Default 5, as firm as an elbow that cannot bend
-    /// backwards: at 0.5 a sitting person's forearm reaching forwards was taken backwards on
-    /// every frame from 1 px of tracking change (`bench lift`, tracker's output, true lengths:
-    /// that clip 119.1 → 77.2 mm, the suite 104.7 → 102.5 mm; 10 chose the same).
+    /// Elbows of hanging arms bend forwards.
     pub elbow: f64,
     /// Upper arms and thighs hang along the trunk, a little outwards (a weak preference for
     /// the rest pose).
@@ -61,7 +58,7 @@ impl Default for AmbiguityWeights {
             hips_parallel: 1.0,
             knee: 2.0,
             knee_side: 1.0,
-            elbow: 5.0,
+            elbow: 0.5,
             hanging: 0.05,
             medial: 1.0,
             straight: 0.05,

@@ -27,9 +27,9 @@ pub struct LiftParams {
     /// Run the global refinement after the per-frame solve (default true), then set every bone
     /// back to exactly its refined length ([`super::refine::snap_to_lengths`]), so the BVH's
     /// fixed offsets give the skeleton back exactly. `bench lift` reports both; on the synthetic
-    /// suite with true lengths it lowers the error 49.2 → 47.8 mm with 2 px white noise (four
-    /// draws), 102.7 → 102.5 mm with the tracker's output, exact tracks 20.4 → 20.3 mm; on the
-    /// real sample 69.3 → 67.9 mm with its reference 2D and 169.3 → 167.4 mm with the
+    /// suite with true lengths it lowers the error 49.6 → 48.0 mm with 2 px white noise (four
+    /// draws), 104.8 → 104.7 mm with the tracker's output, exact tracks 20.4 → 20.3 mm; on the
+    /// real sample 69.3 → 67.9 mm with its reference 2D and 172.2 → 169.8 mm with the
     /// tracker's output. It lowers every overall row, least the real sample from the tracker's
     /// output and the height (147.4 → 147.3 mm).
     pub refine: bool,
