@@ -711,9 +711,10 @@ mod tests {
     /// costs more than the whole wrong pose does.
     #[test]
     fn a_part_lost_under_every_pose_does_not_outvote_the_parts_that_agree() {
-        let right = (0.464, [0.02, 0.02, 0.0, 0.05, 0.16, 2.20, 6.95]);
-        let wrong = (0.049, [0.08, 0.72, 0.06, 0.09, 0.17, 4.27, 1.55]);
-        let sum = |(m, g): (f64, [f64; 7])| m + g.iter().sum::<f64>();
+        use super::super::ambiguity::GROUP_COUNT;
+        let right: (f64, [f64; GROUP_COUNT]) = (0.464, [0.02, 0.02, 0.0, 0.05, 0.16, 2.20, 6.95]);
+        let wrong: (f64, [f64; GROUP_COUNT]) = (0.049, [0.08, 0.72, 0.06, 0.09, 0.17, 4.27, 1.55]);
+        let sum = |(m, g): (f64, [f64; GROUP_COUNT])| m + g.iter().sum::<f64>();
         assert!(
             sum(right) > sum(wrong),
             "the plain sum picks the wrong pose"
@@ -727,7 +728,7 @@ mod tests {
         let d = fit_score(right.0, &right.1) - fit_score(wrong.0, &wrong.1);
         assert!((fit_score(right.0, &r) - fit_score(wrong.0, &w) - d).abs() < 1e-9);
         // A part that fits exactly counts at the floor, not as minus infinity.
-        assert!(fit_score(0.0, &[0.0; 7]).is_finite());
+        assert!(fit_score(0.0, &[0.0; GROUP_COUNT]).is_finite());
     }
 
     #[test]
