@@ -25,7 +25,8 @@
 //! float-to-integer conversion cost a compare and two conditional moves per coordinate); the
 //! rest clamp every sample. The template is sampled the same way, so a block compared with
 //! itself costs nothing. A row-by-row early exit drops a candidate as soon as it cannot win.
-//! Fixed point took the tracker from 93 to 132–146 frames/s at 640×480 on one thread.
+//! Fixed point took `bench track`'s 640×480 one-thread figure from 85.4 to 104.4 frames/s and
+//! the 1080×1920 tracking-to-decoding ratio from 2.04 to 1.57.
 
 use super::block::MorphBlock;
 use image::RgbImage;
@@ -433,12 +434,16 @@ impl Template {
             let cells = &self.cells[base..base + self.cols];
             let region = &self.region[base..base + self.cols];
             let mut row = [0.0f32; 4];
-            for (j, ([key, ada], r)) in cells.iter().zip(region).enumerate().step_by(STEP) {
+            // An index loop: `enumerate().step_by()` kept its state in memory.
+            let mut j = 0;
+            while j < cells.len() {
+                let ([key, ada], r) = (&cells[j], region[j]);
                 let c = sample(i, j);
                 for k in 0..4 {
                     row[k] +=
                         r * (w_key[k] * (c[k] - key[k]).abs() + w_ada[k] * (c[k] - ada[k]).abs());
                 }
+                j += STEP;
             }
             // The fourth lane has zero weight, but summing it keeps all four lanes one vector
             // operation.
