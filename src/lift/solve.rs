@@ -28,10 +28,10 @@ pub struct LiftParams {
     /// back to exactly its refined length ([`super::refine::snap_to_lengths`]), so the BVH's
     /// fixed offsets give the skeleton back exactly. `bench lift` reports both; on the synthetic
     /// suite with true lengths it lowers the error 49.6 → 48.0 mm with 2 px white noise (four
-    /// draws), 104.8 → 104.7 mm with the tracker's output, exact tracks 20.4 → 20.3 mm; on the
-    /// real sample 69.3 → 67.9 mm with its reference 2D and 172.2 → 169.8 mm with the
-    /// tracker's output. It lowers every overall row, least the real sample from the tracker's
-    /// output and the height (147.4 → 147.3 mm).
+    /// draws), 104.7 → 104.5 mm with the tracker's output, exact tracks 20.4 → 20.3 mm; on the
+    /// real sample 69.3 → 67.9 mm with its reference 2D and 184.4 → 181.9 mm with the
+    /// tracker's output. It lowers every overall row but one: the real sample from the
+    /// tracker's output and the height (152.5 → 152.6 mm).
     pub refine: bool,
     /// A key-triangle calibration fits when its residual is below this RMS, pixels (default 1).
     pub calibration_tolerance_px: f64,
