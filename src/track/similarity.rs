@@ -21,7 +21,7 @@
 //! Speed: each frame is converted once to four `f32` lanes per pixel ([`FloatFrame`]), so a
 //! sample loads pixels as vectors instead of widening bytes. A candidate whose grid lies wholly
 //! inside the frame (nearly all of them) is sampled without clamping and in fixed point
-//! ([`FixedGrid`]: a cell's pixel and fraction are a shift and a mask, where Rust's saturating
+//! (`FixedGrid`: a cell's pixel and fraction are a shift and a mask, where Rust's saturating
 //! float-to-integer conversion cost a compare and two conditional moves per coordinate); the
 //! rest clamp every sample. The template is sampled the same way, so a block compared with
 //! itself costs nothing. A row-by-row early exit drops a candidate as soon as it cannot win.
