@@ -1301,6 +1301,8 @@ impl App {
                     .on_hover_text(format!("Reliability under which a joint counts as weak (orange) and may be interpolated; default {}", d.weak_reliability));
                 ui.add(egui::Slider::new(&mut t.max_gap_s, 0.0..=2.0).text("interpolate up to (s)"))
                     .on_hover_text(format!("Longest weak run filled by interpolation between reliable frames; default {} s", d.max_gap_s));
+                ui.add(egui::Slider::new(&mut t.twin_merge_s, 0.0..=1.0).text("twins merged after (s)"))
+                    .on_hover_text(format!("Left and right elbows, wrists, knees or ankles tracked onto one spot this long: the one that followed the other is made weak (0 = off); default {} s", d.twin_merge_s));
                 ui.add(egui::Slider::new(&mut t.working_stature_px, 100.0..=800.0).text("working size (px)"))
                     .on_hover_text(format!("Frames are shrunk so the person is about this tall while tracking (faster, smoother); default {} px", d.working_stature_px));
                 ui.add(egui::Slider::new(&mut t.limb_range_deg, 5.0..=90.0).text("limb search (°)"))

@@ -10,7 +10,7 @@
 //! thread while the tracker works, unless one thread is asked for.
 
 use super::body::{BodyTracker, JointResult, stature_px};
-use super::occlusion::{WeakSpan, fill_weak_runs};
+use super::occlusion::{WeakSpan, fill_weak_runs, weaken_merged_twins};
 use super::params::TrackerParams;
 use crate::camera::point_in_frame;
 use crate::formats::{FrameTracks, PointSource, SourceInfo, TrackedPoint, Tracks2d};
@@ -410,6 +410,14 @@ fn track_at_working_scale(
         })
         .collect();
     let max_gap = (job.params.max_gap_s * info.fps).round().max(1.0) as usize;
+    if job.params.twin_merge_s > 0.0 {
+        weaken_merged_twins(
+            &mut frames,
+            job.params.weak_reliability,
+            (job.params.twin_merge_s * info.fps).round().max(2.0) as usize,
+            &|i, j| job.keys.is_key(i, j),
+        );
+    }
     let spans = fill_weak_runs(
         &mut frames,
         job.params.weak_reliability,
