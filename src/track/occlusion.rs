@@ -132,7 +132,7 @@ fn moves_with_its_anchors(
 
 /// Twin joints closer than this, in torso lengths (neck to pelvis, median over the clip), are
 /// on one spot for [`weaken_merged_twins`].
-const MERGE_TORSO: f64 = 0.05;
+pub const MERGE_TORSO: f64 = 0.05;
 
 /// Frames before and after a merge begins over which each twin's velocity is measured.
 const FOLLOW_FRAMES: usize = 3;
@@ -140,21 +140,22 @@ const FOLLOW_FRAMES: usize = 3;
 /// The least change of velocity, torso lengths per frame, that marks a twin as the follower:
 /// two joints resting together (a side view's feet side by side) change nothing. At 0.02 the
 /// suite lost 2.16 % of joint-frames unflagged, at 0.01 1.94 %.
-const FOLLOW_FLOOR_TORSO: f64 = 0.01;
+pub const FOLLOW_FLOOR_TORSO: f64 = 0.01;
 
-/// Left and right joints of one kind, which a tracker can confuse where the limbs overlap.
-const TWINS: [(Joint, Joint); 4] = [
-    (Joint::LeftElbow, Joint::RightElbow),
-    (Joint::LeftWrist, Joint::RightWrist),
-    (Joint::LeftKnee, Joint::RightKnee),
-    (Joint::LeftAnkle, Joint::RightAnkle),
+/// The left joints whose right twins ([`Joint::mirrored`]) a tracker can confuse with them
+/// where the limbs overlap.
+const TWINS: [Joint; 4] = [
+    Joint::LeftElbow,
+    Joint::LeftWrist,
+    Joint::LeftKnee,
+    Joint::LeftAnkle,
 ];
 
 /// Beyond the paper: a block that followed its twin. Twin joints (left and right elbows,
-/// wrists, knees, ankles) tracked within 0.05 torso lengths of each other for at least
+/// wrists, knees, ankles) tracked within [`MERGE_TORSO`] of each other for at least
 /// `min_frames` consecutive frames: limbs cross in a few frames, so a longer merge means one
 /// block rides on the other (a side view's far leg on the near one), confidently wrong. The
-/// twin whose velocity changed more when they met (by at least 0.01 torso lengths per frame) is the
+/// twin whose velocity changed more when they met (by at least [`FOLLOW_FLOOR_TORSO`]) is the
 /// follower; its confidence is capped at half of `weak` over the merge, so that
 /// [`fill_weak_runs`] interpolates or reports it. Merges present from the first frame (the
 /// marks put the joints together) and frames with a key or an off-frame twin are left alone.
@@ -165,7 +166,7 @@ pub fn weaken_merged_twins(
     is_key: &dyn Fn(usize, Joint) -> bool,
 ) {
     let torso = median_torso(frames);
-    for (a, b) in TWINS {
+    for (a, b) in TWINS.map(|j| (j, j.mirrored())) {
         let merged: Vec<bool> = frames
             .iter()
             .enumerate()
