@@ -1303,6 +1303,8 @@ impl App {
                     .on_hover_text(format!("Longest weak run filled by interpolation between reliable frames; default {} s", d.max_gap_s));
                 ui.add(egui::Slider::new(&mut t.twin_merge_s, 0.0..=1.0).text("twins merged after (s)"))
                     .on_hover_text(format!("Left and right elbows, wrists, knees or ankles tracked onto one spot this long: the one that followed the other is made weak (0 = off); default {} s", d.twin_merge_s));
+                ui.add(egui::Slider::new(&mut t.twin_guard_torso, 0.0..=0.5).text("legs second look (torso)"))
+                    .on_hover_text(format!("Legs whose knees or ankles are tracked this close (fraction of the torso) are each searched again away from the other, and one moves where it matches as well (0 = off); default {}", d.twin_guard_torso));
                 ui.add(egui::Slider::new(&mut t.working_stature_px, 100.0..=800.0).text("working size (px)"))
                     .on_hover_text(format!("Frames are shrunk so the person is about this tall while tracking (faster, smoother); default {} px", d.working_stature_px));
                 ui.add(egui::Slider::new(&mut t.limb_range_deg, 5.0..=90.0).text("limb search (°)"))

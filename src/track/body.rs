@@ -432,28 +432,35 @@ impl BodyTracker {
             let (u, v) = self.trunk_points[k];
             self.trunk.block.to_image(u, v)
         });
-        let [a, b, c, d] = &mut self.limbs;
-        let track_chain = |parts: &mut [Part; 2], k: usize| {
-            let root = ChainRoot {
-                at: roots[k],
-                spring: shoulder_spring(k, &p).map(|s| (rigid[k], s)),
-            };
-            track_limb(parts, root, trunk_angles, frame, &p, zoom)
+        // The legs as they were, for their second look.
+        let before =
+            (p.twin_guard_torso > 0.0).then(|| [LEGS.0, LEGS.1].map(|c| self.limbs[c].clone()));
+        let chain_root = |k: usize| ChainRoot {
+            at: roots[k],
+            spring: shoulder_spring(k, &p).map(|s| (rigid[k], s)),
         };
-        let new_roots = if p.parallel {
+        let track_chain = |parts: &mut [Part; 2], k: usize, guard: Guard| {
+            track_limb(parts, chain_root(k), trunk_angles, frame, &p, zoom, guard)
+        };
+        let [a, b, c, d] = &mut self.limbs;
+        let free = Guard::default();
+        let mut new_roots = if p.parallel {
             let ((ra, rb), (rc, rd)) = rayon::join(
-                || rayon::join(|| track_chain(a, 0), || track_chain(b, 1)),
-                || rayon::join(|| track_chain(c, 2), || track_chain(d, 3)),
+                || rayon::join(|| track_chain(a, 0, free), || track_chain(b, 1, free)),
+                || rayon::join(|| track_chain(c, 2, free), || track_chain(d, 3, free)),
             );
             [ra, rb, rc, rd]
         } else {
             [
-                track_chain(a, 0),
-                track_chain(b, 1),
-                track_chain(c, 2),
-                track_chain(d, 3),
+                track_chain(a, 0, free),
+                track_chain(b, 1, free),
+                track_chain(c, 2, free),
+                track_chain(d, 3, free),
             ]
         };
+        if let Some(before) = before {
+            self.reacquire_legs(&before, &mut new_roots, &track_chain, &p);
+        }
         for (c, r) in new_roots.iter().enumerate() {
             if shoulder_spring(c, &p).is_some() {
                 let (u, v) = self.trunk.block.to_block(*r);
@@ -481,6 +488,54 @@ fn hip_patch(pelvis: Point2<f64>, theta: f64, trunk_m: f64, trunk_n: f64) -> Mor
 }
 
 impl BodyTracker {
+    /// Beyond the paper: a second look at the legs when their knees or ankles were tracked
+    /// onto one spot, within [`TrackerParams::twin_guard_torso`] of the torso's length. In a
+    /// side view the far leg's blocks slide onto the near leg (the same trousers) and stay
+    /// there with a good score while the far leg runs on in plain view. Each leg is searched
+    /// again from where it was a frame earlier (`before`, left then right), over the wide
+    /// range, without the angle prior (its prediction rode on the other leg) and with the
+    /// other leg's joints barred within [`TWIN_BAR`] times that distance; when a leg matches
+    /// there at least as well as it did on the shared spot (the sum of its two segments'
+    /// reliabilities), it moves, the better of the two if both do. Legs truly together (feet
+    /// side by side) find nothing as good elsewhere and stay. Arms are left alone: the same
+    /// second look for them never moved one on the suite or the real sample, and in side
+    /// views, where the arms overlap all the time, it doubled the tracking time. `track`
+    /// tracks chain `k` under a guard and returns its root.
+    fn reacquire_legs(
+        &mut self,
+        before: &[[Part; 2]; 2],
+        roots: &mut [Point2<f64>; 4],
+        track: &TrackChain,
+        p: &TrackerParams,
+    ) {
+        let (a, b) = LEGS;
+        let near = p.twin_guard_torso * self.trunk.block.m;
+        let end = |c: usize, k: usize| self.limbs[c][k].block.end();
+        let close = [0, 1].map(|k| (end(a, k) - end(b, k)).norm() <= near);
+        if !close.contains(&true) {
+            return;
+        }
+        let reliability = |parts: &[Part; 2]| parts[0].reliability + parts[1].reliability;
+        let mut best: Option<(f32, usize, [Part; 2], Point2<f64>)> = None;
+        for (i, (c, other)) in [(a, b), (b, a)].into_iter().enumerate() {
+            let guard = Guard {
+                avoid: [0, 1].map(|k| close[k].then(|| (end(other, k), TWIN_BAR * near))),
+                reacquire: true,
+            };
+            let mut trial = before[i].clone();
+            let root = track(&mut trial, c, guard);
+            let gain = reliability(&trial) - reliability(&self.limbs[c]);
+            let sound = trial.iter().all(|t| t.reliability >= p.weak_reliability);
+            if sound && gain >= 0.0 && best.as_ref().is_none_or(|(g, ..)| gain > *g) {
+                best = Some((gain, c, trial, root));
+            }
+        }
+        if let Some((_, c, trial, root)) = best {
+            self.limbs[c] = trial;
+            roots[c] = root;
+        }
+    }
+
     /// The hip patch searched by the head's spiral from where it was (for [`Self::hips_hold`]).
     fn hips_spiral(&self, frame: FrameView, p: &TrackerParams) -> Found {
         spiral(
@@ -577,6 +632,7 @@ fn prior(part: &Part, pred: &MorphBlock, p: &TrackerParams, zoom: f64, short: f3
         m_full: part.max_len * zoom / LENGTH_SLACK,
         m_min: 0.2 * part.max_len * zoom,
         m_max: part.max_len * zoom,
+        avoid: None,
     }
 }
 
@@ -610,6 +666,14 @@ fn off_image(q: Point2<f64>, frame: FrameView) -> bool {
     !point_in_frame(&q, frame.width() as u32, frame.height() as u32)
 }
 
+/// The two leg chains of [`CHAINS`] (left, right).
+const LEGS: (usize, usize) = (2, 3);
+
+/// How far [`BodyTracker::reacquire_legs`] bars the other leg's joints, in multiples of the
+/// closeness that calls it (`twin_guard_torso`). Measured on `bench track`'s suite: 1 and 1.5
+/// moved limbs to the rim of the bar, still on the twin; 3 barred legs that were truly close.
+const TWIN_BAR: f64 = 2.0;
+
 /// First step of a limb chain's joint refinement, tracker pixels (see [`refine_chain`]).
 const CHAIN_STEP_PX: f64 = 1.0;
 /// Steps of a limb chain's joint refinement: 1, ½ and ¼ px. Measured on the suite and the real
@@ -629,6 +693,7 @@ fn track_limb(
     frame: FrameView,
     p: &TrackerParams,
     zoom: f64,
+    guard: Guard,
 ) -> Point2<f64> {
     let mut parent = trunk_angles;
     let mut anchor = root.at;
@@ -645,7 +710,16 @@ fn track_limb(
             m_count: 5,
             scale_width: false,
         };
-        let prior = prior(part, &pred, p, zoom, p.short_penalty);
+        let free = prior(part, &pred, p, zoom, p.short_penalty);
+        let prior = if guard.reacquire {
+            Prior {
+                avoid: guard.avoid[k],
+                per_degree: 0.0,
+                ..free
+            }
+        } else {
+            free
+        };
         let predicted_off = off_image(pred.end(), frame);
         let narrow = if off_image(pred.to_image(part.extent.end, 0.0), frame) {
             // The far end of the sampled part is cut off by the image's edge, so its length
@@ -669,7 +743,7 @@ fn track_limb(
             // The joint left the frame: nothing to match until its prediction is back.
             hold(part, anchor, parent);
         } else {
-            if weak || folded(&found.block) {
+            if weak || guard.reacquire || folded(&found.block) {
                 let wide = AngularParams {
                     range_theta: p.wide_range_deg.to_radians(),
                     step_theta: 2.0 * p.coarse_step_deg.to_radians(),
@@ -724,6 +798,19 @@ fn track_limb(
     // The upper segment hangs from the root: where the chain refinement moved it, or where it
     // was (a found or held upper segment keeps its anchor).
     parts[0].block.origin
+}
+
+/// Tracks limb chain `k` (its two parts) into the frame under a guard; returns its root.
+type TrackChain<'a> = dyn Fn(&mut [Part; 2], usize, Guard) -> Point2<f64> + 'a;
+
+/// A limb chain's search for [`BodyTracker::reacquire_legs`]: joints barred from discs, and
+/// the wide range searched without the angle prior. The default is the plain search.
+#[derive(Debug, Clone, Copy, Default)]
+struct Guard {
+    /// Per joint (middle, end): a disc (centre, radius in pixels) it may not end in.
+    avoid: [Option<(Point2<f64>, f64)>; 2],
+    /// Search the wide range as well as the narrow one, without the angle prior.
+    reacquire: bool,
 }
 
 /// Whether a lower segment at image angle `lower` is folded back onto its upper segment at
