@@ -38,6 +38,27 @@ fn bundled_bvh(file: &str) -> MotionSource {
     }
 }
 
+/// Renders a side view of `bvh` (from `tests/data`) into `dir` as `bench track`'s suite clip
+/// number `k` is rendered (its background and noise seeds, the room photograph behind):
+/// `frames` frames at `fps`, the person `person_px` tall, as PNG frames.
+fn render_side_view(dir: &Path, bvh: &str, frames: usize, fps: u32, person_px: f64, k: u64) {
+    let mut params = SynthParams {
+        motion: bundled_bvh(bvh),
+        frames,
+        fps,
+        view: View::Side,
+        person_px,
+        background_seed: 11 + k,
+        background_image: Some(
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/backgrounds/pose2sim_room.jpg"),
+        ),
+        output: VideoOutput::PngSequence,
+        ..SynthParams::default()
+    };
+    params.effects.seed = 100 + k;
+    render_clip(&params, dir, &mut |_, _| {}, &AtomicBool::new(false)).unwrap();
+}
+
 fn job(marks: &Marks, threads: usize) -> TrackJob {
     TrackJob::from_marks(marks, TrackerParams::default(), threads)
 }
@@ -372,20 +393,8 @@ fn a_running_shank_never_folds_back_onto_its_thigh() {
 #[test]
 fn a_leg_shortened_where_the_legs_cross_grows_back() {
     let dir = tempfile::tempdir().unwrap();
-    let mut params = SynthParams {
-        motion: bundled_bvh("cmu_02_01_walk.bvh"),
-        frames: 86,
-        view: View::Side,
-        person_px: 300.0,
-        background_seed: 11,
-        background_image: Some(
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/backgrounds/pose2sim_room.jpg"),
-        ),
-        output: VideoOutput::PngSequence,
-        ..SynthParams::default()
-    };
-    params.effects.seed = 100;
-    render_clip(&params, dir.path(), &mut |_, _| {}, &AtomicBool::new(false)).unwrap();
+    let fps = SynthParams::default().fps;
+    render_side_view(dir.path(), "cmu_02_01_walk.bvh", 86, fps, 300.0, 0);
     let run = |short_penalty: f32| {
         let s = track_rendered(
             dir.path(),
@@ -424,21 +433,7 @@ fn a_leg_shortened_where_the_legs_cross_grows_back() {
 #[test]
 fn a_far_leg_that_slid_onto_the_near_one_goes_back_to_its_own() {
     let dir = tempfile::tempdir().unwrap();
-    let mut params = SynthParams {
-        motion: bundled_bvh("cmu_02_03_run.bvh"),
-        frames: 60,
-        fps: 120,
-        view: View::Side,
-        person_px: 240.0,
-        background_seed: 14,
-        background_image: Some(
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/backgrounds/pose2sim_room.jpg"),
-        ),
-        output: VideoOutput::PngSequence,
-        ..SynthParams::default()
-    };
-    params.effects.seed = 103;
-    render_clip(&params, dir.path(), &mut |_, _| {}, &AtomicBool::new(false)).unwrap();
+    render_side_view(dir.path(), "cmu_02_03_run.bvh", 60, 120, 240.0, 3);
     let run = |twin_guard_torso: f64| {
         let s = track_rendered(
             dir.path(),
