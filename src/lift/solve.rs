@@ -28,7 +28,7 @@ pub struct LiftParams {
     /// back to exactly its refined length ([`super::refine::snap_to_lengths`]), so the BVH's
     /// fixed offsets give the skeleton back exactly. `bench lift` reports both; on the synthetic
     /// suite with true lengths it lowers the error 49.2 → 47.8 mm with 2 px white noise (four
-    /// draws), 97.6 → 97.4 mm with the tracker's output, exact tracks 20.4 → 20.3 mm; on the
+    /// draws), 96.1 → 95.9 mm with the tracker's output, exact tracks 20.4 → 20.3 mm; on the
     /// real sample 69.3 → 67.9 mm with its reference 2D and 181.4 → 179.5 mm with the
     /// tracker's output. It lowers every overall row but one: the real sample from the
     /// tracker's output and the height (152.5 → 152.6 mm).
