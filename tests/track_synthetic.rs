@@ -427,7 +427,7 @@ fn a_leg_shortened_where_the_legs_cross_grows_back() {
 /// Running across the view (CMU 02_03 at 120 frames/s, side view, as `bench track`'s
 /// run_side): after the knees pass each other the far leg's thigh and shank slid onto the near
 /// leg, which looks the same, and stayed there with a good score while the far leg ran on in
-/// plain view. Twins tracked close together now get a second look with the other's joints
+/// plain view. Legs tracked close together now get a second look with the other's joints
 /// barred (`twin_guard_torso`), and the far leg goes back to its own (measured on these 60
 /// frames: right knee 24.5 → 3.7 px, PCK@0.2 0.834 → 0.904).
 #[test]

@@ -439,11 +439,19 @@ impl BodyTracker {
             at: roots[k],
             spring: shoulder_spring(k, &p).map(|s| (rigid[k], s)),
         };
-        let track_chain = |parts: &mut [Part; 2], k: usize, guard: Guard| {
-            track_limb(parts, chain_root(k), trunk_angles, frame, &p, zoom, guard)
+        let track_chain = |parts: &mut [Part; 2], k: usize, second_look: Option<Bars>| {
+            track_limb(
+                parts,
+                chain_root(k),
+                trunk_angles,
+                frame,
+                &p,
+                zoom,
+                second_look,
+            )
         };
         let [a, b, c, d] = &mut self.limbs;
-        let free = Guard::default();
+        let free = None;
         let mut new_roots = if p.parallel {
             let ((ra, rb), (rc, rd)) = rayon::join(
                 || rayon::join(|| track_chain(a, 0, free), || track_chain(b, 1, free)),
@@ -500,7 +508,7 @@ impl BodyTracker {
     /// side by side) find nothing as good elsewhere and stay. Arms are left alone: the same
     /// second look for them never moved one on the suite or the real sample, and in side
     /// views, where the arms overlap all the time, it doubled the tracking time. `track`
-    /// tracks chain `k` under a guard and returns its root.
+    /// tracks chain `k` (with bars: its second look) and returns its root.
     fn reacquire_legs(
         &mut self,
         before: &[[Part; 2]; 2],
@@ -518,12 +526,9 @@ impl BodyTracker {
         let reliability = |parts: &[Part; 2]| parts[0].reliability + parts[1].reliability;
         let mut best: Option<(f32, usize, [Part; 2], Point2<f64>)> = None;
         for (i, (c, other)) in [(a, b), (b, a)].into_iter().enumerate() {
-            let guard = Guard {
-                avoid: [0, 1].map(|k| close[k].then(|| (end(other, k), TWIN_BAR * near))),
-                reacquire: true,
-            };
+            let bars = [0, 1].map(|k| close[k].then(|| (end(other, k), TWIN_BAR * near)));
             let mut trial = before[i].clone();
-            let root = track(&mut trial, c, guard);
+            let root = track(&mut trial, c, Some(bars));
             let gain = reliability(&trial) - reliability(&self.limbs[c]);
             let sound = trial.iter().all(|t| t.reliability >= p.weak_reliability);
             if sound && gain >= 0.0 && best.as_ref().is_none_or(|(g, ..)| gain > *g) {
@@ -670,8 +675,10 @@ fn off_image(q: Point2<f64>, frame: FrameView) -> bool {
 const LEGS: (usize, usize) = (2, 3);
 
 /// How far [`BodyTracker::reacquire_legs`] bars the other leg's joints, in multiples of the
-/// closeness that calls it (`twin_guard_torso`). Measured on `bench track`'s suite: 1 and 1.5
-/// moved limbs to the rim of the bar, still on the twin; 3 barred legs that were truly close.
+/// closeness that calls it (`twin_guard_torso`). On `bench track`'s suite (measured with the
+/// angle prior kept at 0.3 of its weight) PCK@0.2 was 0.908 at 1.5, 0.911 at 2 and 0.904 at 3:
+/// a small bar leaves the leg on the rim, still on the other leg; a large one bars legs that
+/// are truly close.
 const TWIN_BAR: f64 = 2.0;
 
 /// First step of a limb chain's joint refinement, tracker pixels (see [`refine_chain`]).
@@ -693,7 +700,7 @@ fn track_limb(
     frame: FrameView,
     p: &TrackerParams,
     zoom: f64,
-    guard: Guard,
+    second_look: Option<Bars>,
 ) -> Point2<f64> {
     let mut parent = trunk_angles;
     let mut anchor = root.at;
@@ -711,14 +718,13 @@ fn track_limb(
             scale_width: false,
         };
         let free = prior(part, &pred, p, zoom, p.short_penalty);
-        let prior = if guard.reacquire {
-            Prior {
-                avoid: guard.avoid[k],
+        let prior = match second_look {
+            Some(bars) => Prior {
+                avoid: bars[k],
                 per_degree: 0.0,
                 ..free
-            }
-        } else {
-            free
+            },
+            None => free,
         };
         let predicted_off = off_image(pred.end(), frame);
         let narrow = if off_image(pred.to_image(part.extent.end, 0.0), frame) {
@@ -743,7 +749,7 @@ fn track_limb(
             // The joint left the frame: nothing to match until its prediction is back.
             hold(part, anchor, parent);
         } else {
-            if weak || guard.reacquire || folded(&found.block) {
+            if weak || second_look.is_some() || folded(&found.block) {
                 let wide = AngularParams {
                     range_theta: p.wide_range_deg.to_radians(),
                     step_theta: 2.0 * p.coarse_step_deg.to_radians(),
@@ -800,18 +806,14 @@ fn track_limb(
     parts[0].block.origin
 }
 
-/// Tracks limb chain `k` (its two parts) into the frame under a guard; returns its root.
-type TrackChain<'a> = dyn Fn(&mut [Part; 2], usize, Guard) -> Point2<f64> + 'a;
+/// Tracks limb chain `k` (its two parts) into the frame, as a second look when given bars;
+/// returns its root.
+type TrackChain<'a> = dyn Fn(&mut [Part; 2], usize, Option<Bars>) -> Point2<f64> + 'a;
 
-/// A limb chain's search for [`BodyTracker::reacquire_legs`]: joints barred from discs, and
-/// the wide range searched without the angle prior. The default is the plain search.
-#[derive(Debug, Clone, Copy, Default)]
-struct Guard {
-    /// Per joint (middle, end): a disc (centre, radius in pixels) it may not end in.
-    avoid: [Option<(Point2<f64>, f64)>; 2],
-    /// Search the wide range as well as the narrow one, without the angle prior.
-    reacquire: bool,
-}
+/// A chain's second look ([`BodyTracker::reacquire_legs`]): per joint (middle, end), a disc
+/// (centre, radius in pixels) it may not end in. With bars, [`track_limb`] also searches the
+/// wide range and drops the angle prior.
+type Bars = [Option<(Point2<f64>, f64)>; 2];
 
 /// Whether a lower segment at image angle `lower` is folded back onto its upper segment at
 /// `upper` further than `fold_limit_deg` (elbows and knees flex to about 150°).

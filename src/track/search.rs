@@ -40,8 +40,8 @@ pub struct Prior {
     pub m_min: f64,
     /// Longest allowed length, pixels.
     pub m_max: f64,
-    /// A disc the block's end may not lie in (centre, radius in pixels): where a limb's twin
-    /// is, when the limb jumped onto it (see `BodyTracker::separate_twins`).
+    /// A disc the block's end may not lie in (centre, radius in pixels): where the other leg's
+    /// joint is, in a leg's second look (`BodyTracker::reacquire_legs`).
     pub avoid: Option<(Point2<f64>, f64)>,
 }
 
