@@ -27,10 +27,10 @@ pub struct LiftParams {
     /// Run the global refinement after the per-frame solve (default true), then set every bone
     /// back to exactly its refined length ([`super::refine::snap_to_lengths`]), so the BVH's
     /// fixed offsets give the skeleton back exactly. `bench lift` reports both; on the synthetic
-    /// suite with true lengths it lowers the error 48.4 → 46.9 mm with 2 px white noise (four
-    /// draws) and 95.8 → 95.6 mm with the tracker's output (exact tracks stay at 18.1 mm); on
-    /// the real sample 69.3 → 67.9 mm with its reference 2D and 181.4 → 179.5 mm with the
-    /// tracker's output. It lowers every other overall row but one: the real sample from the
+    /// suite with true lengths it lowers the error 49.5 → 48.1 mm with 2 px white noise (four
+    /// draws), 94.6 → 94.3 mm with the tracker's output, exact tracks 14.3 → 14.2 mm; on the
+    /// real sample 69.3 → 67.9 mm with its reference 2D and 181.4 → 179.5 mm with the
+    /// tracker's output. It lowers every overall row but one: the real sample from the
     /// tracker's output and the height (152.5 → 152.6 mm).
     pub refine: bool,
     /// A key-triangle calibration fits when its residual is below this RMS, pixels (default 1).
