@@ -53,10 +53,10 @@ pub struct AmbiguityWeights {
     /// Upper arms out of the trunk's frontal plane, forwards or backwards (a weak preference,
     /// for two arms that fit otherwise equally: an arm raised sideways lies near the image
     /// plane of a frontal view, where its two roots differ by a small forward or backward tilt
-    /// that nothing else tells apart). `bench lift`'s suite, exact 2D and true lengths, at
-    /// 0.05 / 0.1 / 0.2 / 0.3: 19.3 / 18.1 / 18.0 / 19.1 mm (0 gives 20.3; at 0.3 the side
-    /// view's bow, whose hanging arms point along the trunk's forward direction, turns its
-    /// arms backwards).
+    /// that nothing else tells apart). `bench lift`'s suite, exact 2D and true lengths (before
+    /// the spine's lean, `SPINE_BACK`), at 0.05 / 0.1 / 0.2 / 0.3: 19.3 / 18.1 / 18.0 / 19.1 mm
+    /// (0 gives 20.3; at 0.3 the side view's bow, whose hanging arms point along the trunk's
+    /// forward direction, turns its arms backwards).
     pub frontal: f64,
     /// A joint off its viewing ray (its bone too short for its 2D image).
     pub miss: f64,
@@ -533,23 +533,34 @@ mod tests {
         }
     }
 
-    /// A standing body (Y up, facing +Z) with its limbs along the given directions, and the
-    /// prior of group `g` on it.
-    fn prior_of(g: usize, limbs: impl Fn(f64) -> [Vector3<f64>; 4]) -> f64 {
-        let subject = SubjectModel::default();
-        let p = crate::skeleton::standing_pose(
+    /// A standing body (Y up, facing +Z) with its limbs along the given directions.
+    fn standing(
+        subject: &SubjectModel,
+        limbs: impl Fn(f64) -> [Vector3<f64>; 4],
+    ) -> PerJoint<Point3<f64>> {
+        crate::skeleton::standing_pose(
             |b| subject.bone_length(b),
             subject.shoulder_width_m,
             Point3::new(0.0, 1.0, 0.0),
             limbs,
-        );
+        )
+    }
+
+    /// The prior of group `g` on pose `p`, with the default weights.
+    fn group_prior(g: usize, p: &PerJoint<Point3<f64>>, subject: &SubjectModel) -> f64 {
         prior_cost(
             &GROUPS[g],
-            &p,
-            &TrunkFrame::of(&p),
-            &subject,
+            p,
+            &TrunkFrame::of(p),
+            subject,
             &AmbiguityWeights::default(),
         )
+    }
+
+    /// The prior of group `g` on a standing body with its limbs along the given directions.
+    fn prior_of(g: usize, limbs: impl Fn(f64) -> [Vector3<f64>; 4]) -> f64 {
+        let subject = SubjectModel::default();
+        group_prior(g, &standing(&subject, limbs), &subject)
     }
 
     #[test]
@@ -587,22 +598,8 @@ mod tests {
     #[test]
     fn the_head_bent_back_costs_more_than_bent_forward() {
         let subject = SubjectModel::default();
-        let down = -Vector3::y();
-        let mut p = crate::skeleton::standing_pose(
-            |b| subject.bone_length(b),
-            subject.shoulder_width_m,
-            Point3::new(0.0, 1.0, 0.0),
-            |_| [down; 4],
-        );
-        let cost = |p: &PerJoint<Point3<f64>>| {
-            prior_cost(
-                &GROUPS[0],
-                p,
-                &TrunkFrame::of(p),
-                &subject,
-                &AmbiguityWeights::default(),
-            )
-        };
+        let mut p = standing(&subject, |_| [-Vector3::y(); 4]);
+        let cost = |p: &PerJoint<Point3<f64>>| group_prior(0, p, &subject);
         let len = subject.bone_length(Bone::new(Neck, HeadTop));
         p[HeadTop] = p[Neck] + Vector3::new(0.0, 0.8, 0.6) * len;
         let forward = cost(&p);
@@ -614,23 +611,11 @@ mod tests {
     #[test]
     fn the_pelvis_hangs_a_little_behind_the_chest() {
         let subject = SubjectModel::default();
-        let down = -Vector3::y();
-        let mut p = crate::skeleton::standing_pose(
-            |b| subject.bone_length(b),
-            subject.shoulder_width_m,
-            Point3::new(0.0, 1.0, 0.0),
-            |_| [down; 4],
-        );
+        let mut p = standing(&subject, |_| [-Vector3::y(); 4]);
         let len = subject.bone_length(Bone::new(Pelvis, Chest));
         let mut cost = |z: f64| {
             p[Pelvis] = p[Chest] + Vector3::new(0.0, -1.0, z).normalize() * len;
-            prior_cost(
-                &GROUPS[1],
-                &p,
-                &TrunkFrame::of(&p),
-                &subject,
-                &AmbiguityWeights::default(),
-            )
+            group_prior(1, &p, &subject)
         };
         // Facing +Z: the pelvis 0.15 behind the chest's down direction against 0.05 in front
         // (an upright spine would call the nearer to straight down the better).
