@@ -84,6 +84,13 @@ fn track_rendered(dir: &Path, params: TrackerParams) -> ClipScore {
     score_tracks(&gt, &out.tracks).unwrap()
 }
 
+/// Tracks the clip rendered in `dir` with `params`; returns `joint`'s mean error (pixels) and
+/// the clip's PCK@0.2.
+fn joint_and_pck(dir: &Path, joint: Joint, params: TrackerParams) -> (f64, f64) {
+    let s = track_rendered(dir, params);
+    (s.per_joint[joint].mean_px(), s.overall.pck02())
+}
+
 #[test]
 fn a_waving_person_is_tracked_within_a_fifth_of_the_torso() {
     let dir = tempfile::tempdir().unwrap();
@@ -316,14 +323,11 @@ fn a_bow_from_the_side_keeps_the_pelvis_where_the_hips_are() {
     let dir = tempfile::tempdir().unwrap();
     render(dir.path(), ProceduralMotion::Bend, 60, View::Side);
     let pelvis_error = |hip_patch: bool| {
-        let s = track_rendered(
-            dir.path(),
-            TrackerParams {
-                hip_patch,
-                ..TrackerParams::default()
-            },
-        );
-        (s.per_joint[Joint::Pelvis].mean_px(), s.overall.pck02())
+        let params = TrackerParams {
+            hip_patch,
+            ..TrackerParams::default()
+        };
+        joint_and_pck(dir.path(), Joint::Pelvis, params)
     };
     let (without, _) = pelvis_error(false);
     let (with, pck) = pelvis_error(true);
@@ -355,18 +359,15 @@ fn a_running_shank_never_folds_back_onto_its_thigh() {
     };
     render_clip(&params, dir.path(), &mut |_, _| {}, &AtomicBool::new(false)).unwrap();
     let run = |fold_limit_deg: f64, chain_refine: bool| {
-        let s = track_rendered(
-            dir.path(),
-            TrackerParams {
-                fold_limit_deg,
-                chain_refine,
-                // The legs' second look also puts this shank back (11.3 px with and without
-                // the check): off, to see the check alone.
-                twin_guard_torso: 0.0,
-                ..TrackerParams::default()
-            },
-        );
-        (s.per_joint[Joint::LeftAnkle].mean_px(), s.overall.pck02())
+        let params = TrackerParams {
+            fold_limit_deg,
+            chain_refine,
+            // The legs' second look also puts this shank back (11.3 px with and without the
+            // check): off, to see the check alone.
+            twin_guard_torso: 0.0,
+            ..TrackerParams::default()
+        };
+        joint_and_pck(dir.path(), Joint::LeftAnkle, params)
     };
     let (ankle_off, pck_off) = run(180.0, false);
     let (ankle_on, pck_on) = run(165.0, false);
@@ -435,14 +436,11 @@ fn a_far_leg_that_slid_onto_the_near_one_goes_back_to_its_own() {
     let dir = tempfile::tempdir().unwrap();
     render_side_view(dir.path(), "cmu_02_03_run.bvh", 60, 120, 240.0, 3);
     let run = |twin_guard_torso: f64| {
-        let s = track_rendered(
-            dir.path(),
-            TrackerParams {
-                twin_guard_torso,
-                ..TrackerParams::default()
-            },
-        );
-        (s.per_joint[Joint::RightKnee].mean_px(), s.overall.pck02())
+        let params = TrackerParams {
+            twin_guard_torso,
+            ..TrackerParams::default()
+        };
+        joint_and_pck(dir.path(), Joint::RightKnee, params)
     };
     let (knee_off, pck_off) = run(0.0);
     let (knee_on, pck_on) = run(TrackerParams::default().twin_guard_torso);
