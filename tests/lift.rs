@@ -422,7 +422,7 @@ fn a_subject_fitted_to_the_tracks_beats_the_table_for_a_different_build() {
     built.bone_length_m[Bone::new(Joint::Chest, Joint::RightShoulder).index()] = side;
     let (gt, built) = truth_of(built);
     let tracks = tracks_from_truth(&gt, 0.0, 3);
-    let (fitted, fit) = subject_from_height(table.height_m, &tracks).unwrap();
+    let (fitted, fit) = subject_from_height(table.height_m, &tracks, gt.camera()).unwrap();
     let drop = fit.chest_drop.unwrap();
     assert!((drop.measured - 0.335).abs() < 0.01, "{drop:?}");
     let error = |subject: &SubjectModel| {
@@ -435,10 +435,9 @@ fn a_subject_fitted_to_the_tracks_beats_the_table_for_a_different_build() {
         score_skeleton(&gt, &out.skeleton).unwrap().mpjpe_mm()
     };
     let (with_table, with_fit, exact) = (error(&table), error(&fitted), error(&built));
-    // Measured: table 221.6 mm, fitted to the tracks 82.6 mm (60.1 with the key triangle alone:
-    // this clip's shanks swing towards the camera and are never seen square, so they are read
-    // 6 % short), true lengths 43.4 mm (the clip swings its legs towards the camera: see
-    // `exact_tracks_give_back_the_skeleton`).
+    // Measured: table 221.6 mm, fitted to the tracks 81.4 mm (this clip's shanks swing towards
+    // the camera and are never seen square, so they are read short), true lengths 41.3 mm (the
+    // clip swings its legs towards the camera: see `exact_tracks_give_back_the_skeleton`).
     assert!(
         with_fit < 0.5 * with_table && exact < with_fit,
         "table {with_table:.1} mm, read from the tracks {with_fit:.1} mm, true lengths {exact:.1} mm"

@@ -98,7 +98,7 @@ fn run_clip(
         let i = *i;
         let subjects = [
             subject_from_truth(&gt),
-            subject_from_height(stature_from_truth(&gt), tracks)
+            subject_from_height(stature_from_truth(&gt), tracks, gt.camera())
                 .map_err(ExitError::failed)?
                 .0,
         ];

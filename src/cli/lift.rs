@@ -8,7 +8,7 @@ use std::sync::atomic::AtomicBool;
 use videomocap::camera::PinholeCamera;
 use videomocap::formats::Tracks2d;
 use videomocap::lift::focal::{DEFAULT_FOV_LONG_SIDE_DEG, default_focal, estimate_focal};
-use videomocap::lift::subject_fit::fit_to_tracks;
+use videomocap::lift::subject_fit::fit_in_perspective;
 use videomocap::lift::{FrameFlag, LiftError, LiftJob, LiftOutput, LiftParams, lift};
 use videomocap::skeleton::{DEFAULT_HEIGHT_M, Proportions, SubjectModel};
 
@@ -75,29 +75,24 @@ pub fn lift_with_progress(
         Proportions::default(),
     )
     .map_err(ExitError::bad_input)?;
-    let (subject, fit) = fit_to_tracks(&table, tracks);
-    say(global, &fit.to_string());
     let (w, h) = (tracks.source.width, tracks.source.height);
-    let mut job = LiftJob {
-        tracks,
-        camera: PinholeCamera::centred(1.0, w, h),
-        subject,
-        params,
-        overrides: Default::default(),
-    };
+    let mut camera = PinholeCamera::centred(1.0, w, h);
     if let Some(f) = o.focal_px {
-        job.camera.focal_px = f;
+        camera.focal_px = f;
     } else if let Some(fov) = o.fov_deg {
-        job.camera.focal_px = PinholeCamera::focal_from_horizontal_fov(fov, w);
+        camera.focal_px = PinholeCamera::focal_from_horizontal_fov(fov, w);
     } else if o.estimate_focal {
         say(global, "estimating the focal length …");
         // On the table's lengths: see `estimate_focal`.
         let table_job = LiftJob {
-            subject: table,
-            ..job.clone()
+            tracks,
+            camera,
+            subject: table.clone(),
+            params: params.clone(),
+            overrides: Default::default(),
         };
         let est = estimate_focal(&table_job).map_err(|e| lift_error(source, e))?;
-        job.camera.focal_px = est.focal_px;
+        camera.focal_px = est.focal_px;
         let fov = 2.0 * (f64::from(w) / 2.0 / est.focal_px).atan().to_degrees();
         say(
             global,
@@ -107,15 +102,24 @@ pub fn lift_with_progress(
             ),
         );
     } else {
-        job.camera.focal_px = default_focal(w, h);
+        camera.focal_px = default_focal(w, h);
         say(
             global,
             &format!(
                 "focal length {:.0} px: the default {DEFAULT_FOV_LONG_SIDE_DEG:.0}° across the longer image side (give --focal-px or --fov-deg if you know the camera)",
-                job.camera.focal_px
+                camera.focal_px
             ),
         );
     }
+    let (subject, fit) = fit_in_perspective(&table, tracks, camera);
+    say(global, &fit.to_string());
+    let job = LiftJob {
+        tracks,
+        camera,
+        subject,
+        params,
+        overrides: Default::default(),
+    };
     let bar = progress_bar(global, 1, "lifting");
     let cancel = AtomicBool::new(false);
     let out = lift(

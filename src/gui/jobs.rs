@@ -87,14 +87,14 @@ impl Job {
         let cancel = Arc::new(AtomicBool::new(false));
         let flag = cancel.clone();
         std::thread::spawn(move || {
-            let result = subject_from_height(height_m, &tracks)
+            let camera = videomocap::camera::PinholeCamera::centred(
+                focal_px,
+                tracks.source.width,
+                tracks.source.height,
+            );
+            let result = subject_from_height(height_m, &tracks, camera)
                 .map_err(|e| e.to_string())
                 .and_then(|(subject, fit)| {
-                    let camera = videomocap::camera::PinholeCamera::centred(
-                        focal_px,
-                        tracks.source.width,
-                        tracks.source.height,
-                    );
                     let job = LiftJob {
                         tracks: &tracks,
                         camera,
