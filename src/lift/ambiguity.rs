@@ -622,35 +622,31 @@ mod tests {
         assert!(forward < back, "{forward} {back}");
     }
 
-    #[test]
-    fn the_pelvis_hangs_a_little_behind_the_chest() {
+    /// The prior of group `g` on a standing body facing +Z whose `bone` points along `dir`
+    /// (normalised) from its parent end.
+    fn prior_along(g: usize, bone: Bone, dir: Vector3<f64>) -> f64 {
         let subject = SubjectModel::default();
         let mut p = standing(&subject, |_| [-Vector3::y(); 4]);
-        let len = subject.bone_length(Bone::new(Pelvis, Chest));
-        let mut cost = |z: f64| {
-            p[Pelvis] = p[Chest] + Vector3::new(0.0, -1.0, z).normalize() * len;
-            group_prior(1, &p, &subject)
-        };
-        // Facing +Z: the pelvis 0.15 behind the chest's down direction against 0.05 in front
-        // (an upright spine would call the nearer to straight down the better).
-        let behind = cost(-0.15);
-        let in_front = cost(0.05);
+        let (from, to) = lift_order(bone);
+        p[to] = p[from] + dir.normalize() * subject.bone_length(bone);
+        group_prior(g, &p, &subject)
+    }
+
+    #[test]
+    fn the_pelvis_hangs_a_little_behind_the_chest() {
+        let spine = |z: f64| prior_along(1, Bone::new(Pelvis, Chest), Vector3::new(0.0, -1.0, z));
+        // The pelvis 0.15 behind the chest's down direction against 0.05 in front (an upright
+        // spine would call the nearer to straight down the better).
+        let (behind, in_front) = (spine(-0.15), spine(0.05));
         assert!(behind < in_front, "{behind} {in_front}");
     }
 
     #[test]
     fn the_head_leans_a_little_forwards() {
-        let subject = SubjectModel::default();
-        let mut p = standing(&subject, |_| [-Vector3::y(); 4]);
-        let len = subject.bone_length(Bone::new(Neck, HeadTop));
-        let mut cost = |z: f64| {
-            p[HeadTop] = p[Neck] + Vector3::new(0.0, 1.0, z).normalize() * len;
-            group_prior(0, &p, &subject)
-        };
-        // Facing +Z: the head 0.35 forwards against 0.05 (an upright head would call the
-        // nearer to straight up the better).
-        let forward = cost(0.35);
-        let upright = cost(0.05);
+        let head = |z: f64| prior_along(0, Bone::new(Neck, HeadTop), Vector3::new(0.0, 1.0, z));
+        // The head 0.35 forwards against 0.05 (an upright head would call the nearer to
+        // straight up the better).
+        let (forward, upright) = (head(0.35), head(0.05));
         assert!(forward < upright, "{forward} {upright}");
     }
 

@@ -272,19 +272,21 @@ fn measure_limb(views: &[FrameView<'_>], bones: &[(Joint, Joint)]) -> Option<f64
 /// The subject with its key triangle's height and its limbs' lengths read from the tracks (see
 /// the module's text), and what was read; unchanged where nothing could be measured.
 pub fn fit_to_tracks(subject: &SubjectModel, tracks: &Tracks2d) -> (SubjectModel, SubjectFit) {
-    fit(subject, tracks, None)
+    let images = smoothed_images(tracks, &adaptive_sigmas(tracks));
+    fit(subject, &views(tracks, &images, None))
 }
 
 /// [`fit_to_tracks`], then the limbs read again with each image length scaled by the depth of
-/// its bone's parent over the trunk's in a first lift with that fit through `camera`: in a side
-/// view the near limbs are nearer the camera than the trunk and look several per cent longer.
-/// Falls back to the first fit when that lift fails.
+/// its bone's parent over the trunk's in a first lift (default settings) with that fit through
+/// `camera`: in a side view the near limbs are nearer the camera than the trunk and look several
+/// per cent longer. Falls back to the first fit when that lift fails.
 pub fn fit_in_perspective(
     subject: &SubjectModel,
     tracks: &Tracks2d,
     camera: PinholeCamera,
 ) -> (SubjectModel, SubjectFit) {
-    let first = fit(subject, tracks, None);
+    let images = smoothed_images(tracks, &adaptive_sigmas(tracks));
+    let first = fit(subject, &views(tracks, &images, None));
     let job = LiftJob {
         tracks,
         camera,
@@ -293,20 +295,13 @@ pub fn fit_in_perspective(
         overrides: Default::default(),
     };
     match lift_per_frame(&job) {
-        Ok(per) => fit(subject, tracks, Some(&per.resolved.points)),
+        Ok(per) => fit(subject, &views(tracks, &images, Some(&per.resolved.points))),
         Err(_) => first,
     }
 }
 
-/// The fit, with the limbs' image lengths scaled for perspective when `lifted` gives each
-/// frame's joints.
-fn fit(
-    subject: &SubjectModel,
-    tracks: &Tracks2d,
-    lifted: Option<&[PerJoint<Point3<f64>>]>,
-) -> (SubjectModel, SubjectFit) {
-    let images = smoothed_images(tracks, &adaptive_sigmas(tracks));
-    let views = views(tracks, &images, lifted);
+/// The fit on the tracks' views (see the module's text).
+fn fit(subject: &SubjectModel, views: &[FrameView<'_>]) -> (SubjectModel, SubjectFit) {
     let trunk = subject.trunk_m();
     let mut out = subject.clone();
     let mut fit = SubjectFit {
@@ -317,7 +312,7 @@ fn fit(
     if !(trunk.is_finite() && trunk > 0.0) {
         return (out, fit);
     }
-    if let (Some((h, x)), Some((drop, frames))) = (model_triangle(subject), measure_drop(&views)) {
+    if let (Some((h, x)), Some((drop, frames))) = (model_triangle(subject), measure_drop(views)) {
         let model = h / trunk;
         let measured = drop.clamp(model / MAX_DROP_FACTOR, model * MAX_DROP_FACTOR);
         let h_new = measured * trunk;
@@ -333,7 +328,7 @@ fn fit(
         });
     }
     for (name, bones) in LIMBS {
-        let Some(ratio) = measure_limb(&views, bones) else {
+        let Some(ratio) = measure_limb(views, bones) else {
             continue;
         };
         let measured = ratio * trunk;
