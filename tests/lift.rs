@@ -359,8 +359,10 @@ fn the_refinement_leaves_exact_tracks_nearly_alone() {
 /// A wrist the tracker put too far out for its forearm: the per-frame solve keeps the forearm's
 /// length and leaves the wrist off its ray. Fitting the refinement to that point tilted the
 /// whole trunk (jumping jacks on the suite: shoulders 7 → 57 mm); the anchor to the per-frame
-/// solve keeps the trunk near where the trunk's own points put it (measured here: trunk joints
-/// 1.1 mm per frame, 13.5 mm refined without the anchor, 5.2 mm with it).
+/// solve keeps the trunk near where the trunk's own points put it (measured here: shoulders,
+/// chest and neck 1.1 mm per frame, 8.8 mm refined without the anchor, 1.6 mm with it; the head
+/// top is left out: its root is a choice, and `HEAD_FORWARD` tips this body's upright head
+/// forwards on some frames, 8.4 mm per frame with it in).
 #[test]
 fn a_wrist_out_of_reach_does_not_tilt_the_trunk_in_the_refinement() {
     use Joint::*;
@@ -391,11 +393,11 @@ fn a_wrist_out_of_reach_does_not_tilt_the_trunk_in_the_refinement() {
             let mut sum = 0.0;
             for f in &s.frames {
                 let t = gt.frames[f.index].points3d();
-                for j in [LeftShoulder, RightShoulder, Chest, Neck, HeadTop] {
+                for j in [LeftShoulder, RightShoulder, Chest, Neck] {
                     sum += ((f.points[j] - f.points[Pelvis]) - (t[j] - t[Pelvis])).norm();
                 }
             }
-            1000.0 * sum / (5 * s.frames.len()) as f64
+            1000.0 * sum / (4 * s.frames.len()) as f64
         };
         (error(&out.per_frame), error(&out.skeleton))
     };
