@@ -4,11 +4,11 @@
 //! groups (the head and neck, the spine, the two hips, each arm, each leg); for each group every
 //! combination of its bones' roots is a candidate, scored per frame by a prior built on the joints'
 //! ranges of motion (the neck and spine lie along the key triangle's up direction, the pelvis a
-//! little behind it, and bend forwards rather than backwards; the hips are collinear with the
-//! pelvis and parallel to the shoulders; knees bend backwards, in the leg's own plane; hanging
-//! elbows bend forwards; upper arms and thighs do not cross the body's middle and weakly prefer to
-//! hang a little outwards; of two arms that fit equally, the straighter and the one nearer the
-//! trunk's frontal plane), and the candidates are chained over the frames by dynamic programming
+//! little behind it and the head top a little forward of it, and bend forwards rather than
+//! backwards; the hips are collinear with the pelvis and parallel to the shoulders; knees bend
+//! backwards, in the leg's own plane; hanging elbows bend forwards; upper arms and thighs do not
+//! cross the body's middle and weakly prefer to hang a little outwards; of two arms that fit
+//! equally, the straighter and the one nearer the trunk's frontal plane), and the candidates are chained over the frames by dynamic programming
 //! (Viterbi over pairs of consecutive choices) that minimises the joints' 3D acceleration relative
 //! to the group's root plus the priors. Groups are solved centre outwards, each on the trajectory
 //! chosen for its root. A user's choice for a bone on a frame ([`DepthOverrides`]) is a hard
@@ -226,6 +226,12 @@ impl TrunkFrame {
     }
 }
 
+/// The unit direction `base` tilted towards the perpendicular unit direction `toward` by the
+/// angle whose sine is `sine`.
+fn tilted(base: Vector3<f64>, toward: Vector3<f64>, sine: f64) -> Vector3<f64> {
+    base * (1.0 - sine * sine).sqrt() + toward * sine
+}
+
 /// A group's prior for one candidate (squared metres, weighted).
 fn prior_cost(
     group: &Group,
@@ -253,16 +259,14 @@ fn prior_cost(
     };
     match group.prior {
         Prior::Head => {
-            let head = trunk.up * (1.0 - HEAD_FORWARD * HEAD_FORWARD).sqrt()
-                + trunk.forward * HEAD_FORWARD;
+            let head = tilted(trunk.up, trunk.forward, HEAD_FORWARD);
             w.trunk_up
                 * (along(Bone::new(Chest, Neck), trunk.up)
                     + 0.5 * along(Bone::new(Neck, HeadTop), head))
                 + w.extension * behind(Bone::new(Neck, HeadTop))
         }
         Prior::Spine => {
-            let down =
-                -trunk.up * (1.0 - SPINE_BACK * SPINE_BACK).sqrt() - trunk.forward * SPINE_BACK;
+            let down = tilted(-trunk.up, -trunk.forward, SPINE_BACK);
             w.trunk_up * along(Bone::new(Pelvis, Chest), down)
                 + w.extension * behind(Bone::new(Pelvis, Chest))
         }
@@ -609,19 +613,6 @@ mod tests {
         assert!(frontal < tilted, "{frontal} {tilted}");
     }
 
-    #[test]
-    fn the_head_bent_back_costs_more_than_bent_forward() {
-        let subject = SubjectModel::default();
-        let mut p = standing(&subject, |_| [-Vector3::y(); 4]);
-        let cost = |p: &PerJoint<Point3<f64>>| group_prior(0, p, &subject);
-        let len = subject.bone_length(Bone::new(Neck, HeadTop));
-        p[HeadTop] = p[Neck] + Vector3::new(0.0, 0.8, 0.6) * len;
-        let forward = cost(&p);
-        p[HeadTop] = p[Neck] + Vector3::new(0.0, 0.8, -0.6) * len;
-        let back = cost(&p);
-        assert!(forward < back, "{forward} {back}");
-    }
-
     /// The prior of group `g` on a standing body facing +Z whose `bone` points along `dir`
     /// (normalised) from its parent end.
     fn prior_along(g: usize, bone: Bone, dir: Vector3<f64>) -> f64 {
@@ -630,6 +621,13 @@ mod tests {
         let (from, to) = lift_order(bone);
         p[to] = p[from] + dir.normalize() * subject.bone_length(bone);
         group_prior(g, &p, &subject)
+    }
+
+    #[test]
+    fn the_head_bent_back_costs_more_than_bent_forward() {
+        let head = |z: f64| prior_along(0, Bone::new(Neck, HeadTop), Vector3::new(0.0, 0.8, z));
+        let (forward, back) = (head(0.6), head(-0.6));
+        assert!(forward < back, "{forward} {back}");
     }
 
     #[test]

@@ -27,11 +27,11 @@ pub struct LiftParams {
     /// Run the global refinement after the per-frame solve (default true), then set every bone
     /// back to exactly its refined length ([`super::refine::snap_to_lengths`]), so the BVH's
     /// fixed offsets give the skeleton back exactly. `bench lift` reports both; on the synthetic
-    /// suite with true lengths it lowers the error 49.5 → 48.1 mm with 2 px white noise (four
-    /// draws), 94.6 → 94.3 mm with the tracker's output, exact tracks 14.3 → 14.2 mm; on the
-    /// real sample 69.3 → 67.9 mm with its reference 2D and 181.4 → 179.5 mm with the
+    /// suite with true lengths it lowers the error 49.9 → 48.5 mm with 2 px white noise (four
+    /// draws), 95.3 → 95.1 mm with the tracker's output, exact tracks 14.3 → 14.2 mm; on the
+    /// real sample 68.7 → 67.3 mm with its reference 2D and 174.0 → 172.3 mm with the
     /// tracker's output. It lowers every overall row but one: the real sample from the
-    /// tracker's output and the height (152.5 → 152.6 mm).
+    /// tracker's output and the height (161.8 → 162.1 mm).
     pub refine: bool,
     /// A key-triangle calibration fits when its residual is below this RMS, pixels (default 1).
     pub calibration_tolerance_px: f64,
