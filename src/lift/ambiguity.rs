@@ -735,6 +735,64 @@ mod tests {
         );
     }
 
+    #[test]
+    fn the_arms_swing_stays_out_of_the_reported_cost() {
+        // A body three metres in front of the camera, facing away from it, walking on the
+        // spot: each thigh swings forwards and backwards in depth and each arm against it.
+        let subject = SubjectModel::default();
+        let frames: Vec<PerJoint<Point3<f64>>> = (0..12)
+            .map(|t| {
+                let phase = (f64::from(t) * 0.5).sin();
+                let p = standing(&subject, |s| {
+                    let thigh = Vector3::new(0.0, -1.0, 0.4 * s * phase).normalize();
+                    let arm = Vector3::new(0.15 * s, -1.0, -0.3 * s * phase).normalize();
+                    [arm, arm, thigh, thigh]
+                });
+                p.map(|_, q| q + Vector3::new(0.0, 0.0, 3.0))
+            })
+            .collect();
+        let key: Vec<[Point3<f64>; 3]> = frames
+            .iter()
+            .map(|p| [p[LeftShoulder], p[RightShoulder], p[Chest]])
+            .collect();
+        let rays: Vec<PerJoint<Vector3<f64>>> = frames
+            .iter()
+            .map(|p| p.map(|_, q| q.coords.normalize()))
+            .collect();
+        let index: Vec<usize> = (0..frames.len()).collect();
+        let solve = |arm_swing: f64, overrides: &DepthOverrides| {
+            let w = AmbiguityWeights {
+                arm_swing,
+                ..AmbiguityWeights::default()
+            };
+            resolve(&key, &rays, &index, &subject, &w, overrides)
+        };
+        // The frames whose elbow (the upper arm's root) is not where the body put it.
+        let wrong = |r: &Resolved| -> Vec<(usize, Joint)> {
+            let elbows = frames.iter().enumerate().flat_map(|(t, p)| {
+                [LeftElbow, RightElbow]
+                    .into_iter()
+                    .filter(move |&j| (r.points[t][j] - p[j]).norm() > 1e-6)
+                    .map(move |j| (t, j))
+            });
+            elbows.collect()
+        };
+        let with = solve(1.0, &DepthOverrides::new());
+        assert!(wrong(&with).is_empty(), "{:?}", wrong(&with));
+        // The same roots without the swing: every group reports the same cost.
+        let arms = GROUPS.iter().filter(|g| g.prior == Prior::Arm);
+        let forced: DepthOverrides = arms
+            .flat_map(|g| g.bones.iter())
+            .flat_map(|&bone| (0..frames.len()).map(move |t| (t, bone)))
+            .map(|(t, bone)| ((t, bone), with.choices[t][bone.index()]))
+            .collect();
+        let without = solve(0.0, &forced);
+        assert_eq!(with.choices, without.choices);
+        for (a, b) in with.group_costs.iter().zip(&without.group_costs) {
+            assert!((a - b).abs() < 1e-9, "{a} {b}");
+        }
+    }
+
     /// The prior of group `g` on a standing body facing +Z whose `bone` points along `dir`
     /// (normalised) from its parent end.
     fn prior_along(g: usize, bone: Bone, dir: Vector3<f64>) -> f64 {
