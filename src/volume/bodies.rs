@@ -4,7 +4,7 @@
 //! that contains them.
 
 use super::curve::SkeletonCurve;
-use crate::skeleton::{Joint, SubjectModel};
+use crate::skeleton::{Joint, SubjectModel, segment_distance};
 use nalgebra::{Point3, Vector3};
 
 /// Body fitting settings.
@@ -98,13 +98,6 @@ fn quantile(mut v: Vec<f64>, q: f64) -> f64 {
     }
     v.sort_by(f64::total_cmp);
     v[((v.len() - 1) as f64 * q).round() as usize]
-}
-
-/// Distance from `p` to the segment `a`–`b`.
-fn segment_distance(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
-    let ab = b - a;
-    let t = ((p - a).dot(&ab) / ab.norm_squared().max(1e-18)).clamp(0.0, 1.0);
-    (p - (a + ab * t)).norm()
 }
 
 /// Distance from `p` to the infinite line through `a` along unit `u`.
