@@ -190,6 +190,15 @@ fn lift_writes_a_skeleton_and_refuses_a_bad_focal_length() {
         &["--focal-px", "positive"],
     );
     assert!(!out.exists());
+    // A settings file with a weight out of its range is named with the setting.
+    let settings = dir.path().join("settings.json");
+    std::fs::write(&settings, r#"{"ambiguity": {"elbow": -5}}"#).unwrap();
+    let ss = settings.to_str().unwrap();
+    assert_bad(
+        &["lift", tp, "-o", outs, "--lift-settings", ss],
+        &[ss, "ambiguity.elbow", "0 or more"],
+    );
+    assert!(!out.exists());
     let (code, stderr) = run(&[
         "lift",
         tp,

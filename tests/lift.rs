@@ -318,6 +318,38 @@ fn bad_tracks_are_refused_with_a_reason() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("frame 7") && e.contains("left_knee"), "{e}");
+    // Settings out of their range are named (a negative weight would reward what its prior
+    // forbids, a zero deviation divides by zero); a zero weight or anchor turns a term off.
+    let with = |params: LiftParams| LiftJob {
+        params,
+        ..job(&tracks, 700.0)
+    };
+    let mut params = LiftParams::default();
+    params.ambiguity.elbow = -5.0;
+    let e = lift_per_frame(&with(params)).unwrap_err().to_string();
+    assert!(e.contains("ambiguity.elbow") && e.contains("-5"), "{e}");
+    let mut params = LiftParams::default();
+    params.refinement.reprojection_sigma_px = 0.0;
+    let e = lift(&with(params), &mut |_| {}, &AtomicBool::new(false)).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            LiftError::BadSetting {
+                name: "refinement.reprojection_sigma_px",
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let params = LiftParams {
+        smoothing_s: f64::NAN,
+        ..LiftParams::default()
+    };
+    assert!(lift_per_frame(&with(params)).is_err());
+    let mut params = LiftParams::default();
+    params.ambiguity.contact = 0.0;
+    params.refinement.anchor_sigma_m = 0.0;
+    assert!(params.validate().is_ok());
 }
 
 #[test]

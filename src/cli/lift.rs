@@ -45,8 +45,12 @@ pub fn check_options(o: &LiftOptions) -> Result<(), ExitError> {
 pub fn load_settings(path: &Path) -> Result<LiftParams, ExitError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| ExitError::bad_input(anyhow!("{}: cannot read: {e}", path.display())))?;
-    serde_json::from_str(&text)
-        .map_err(|e| ExitError::bad_input(anyhow!("{}: bad lift settings: {e}", path.display())))
+    let params: LiftParams = serde_json::from_str(&text)
+        .map_err(|e| ExitError::bad_input(anyhow!("{}: bad lift settings: {e}", path.display())))?;
+    params
+        .validate()
+        .map_err(|e| ExitError::bad_input(anyhow!("{}: {e}", path.display())))?;
+    Ok(params)
 }
 
 /// A lift error naming the input it came from.

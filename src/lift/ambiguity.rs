@@ -16,6 +16,7 @@
 //! root. A user's choice for a bone on a frame
 //! ([`DepthOverrides`]) is a hard constraint.
 use super::backproject::{Root, bone_roots};
+use super::error::{LiftError, check_setting};
 use crate::skeleton::{
     BONE_COUNT, BodyPart, Bone, Joint, PerJoint, SubjectModel, segment_distance,
 };
@@ -110,6 +111,48 @@ impl Default for AmbiguityWeights {
             contact: 10.0,
             miss: 10.0,
         }
+    }
+}
+
+impl AmbiguityWeights {
+    /// Checks every weight is finite and not negative (a negative weight would reward the
+    /// posture its prior forbids).
+    pub fn validate(&self) -> Result<(), LiftError> {
+        // Destructured so that a new weight cannot be left unchecked.
+        let AmbiguityWeights {
+            trunk_up,
+            extension,
+            hips_collinear,
+            hips_parallel,
+            knee,
+            knee_side,
+            elbow,
+            hanging,
+            medial,
+            straight,
+            frontal,
+            arm_swing,
+            contact,
+            miss,
+        } = *self;
+        [
+            ("ambiguity.trunk_up", trunk_up),
+            ("ambiguity.extension", extension),
+            ("ambiguity.hips_collinear", hips_collinear),
+            ("ambiguity.hips_parallel", hips_parallel),
+            ("ambiguity.knee", knee),
+            ("ambiguity.knee_side", knee_side),
+            ("ambiguity.elbow", elbow),
+            ("ambiguity.hanging", hanging),
+            ("ambiguity.medial", medial),
+            ("ambiguity.straight", straight),
+            ("ambiguity.frontal", frontal),
+            ("ambiguity.arm_swing", arm_swing),
+            ("ambiguity.contact", contact),
+            ("ambiguity.miss", miss),
+        ]
+        .into_iter()
+        .try_for_each(|(name, value)| check_setting(name, value, false))
     }
 }
 

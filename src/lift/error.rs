@@ -23,10 +23,39 @@ pub enum LiftError {
         chest_shoulder_m: f64,
         shoulder_width_m: f64,
     },
+    #[error("lift setting \"{name}\" must be {want}, got {value}")]
+    BadSetting {
+        name: &'static str,
+        value: f64,
+        want: &'static str,
+    },
     #[error("camera calibration on the key triangle did not converge on frame {frame}")]
     CalibrationFailed { frame: usize },
     #[error(transparent)]
     Subject(#[from] ProportionsError),
     #[error("cancelled")]
     Cancelled,
+}
+
+/// Checks one lift setting: finite, and above 0 when `positive` (a tolerance or a deviation
+/// divides), else at least 0 (a weight or a width, where 0 turns the term off).
+pub(crate) fn check_setting(
+    name: &'static str,
+    value: f64,
+    positive: bool,
+) -> Result<(), LiftError> {
+    let ok = value.is_finite() && if positive { value > 0.0 } else { value >= 0.0 };
+    if ok {
+        Ok(())
+    } else {
+        Err(LiftError::BadSetting {
+            name,
+            value,
+            want: if positive {
+                "a finite number above 0"
+            } else {
+                "a finite number, 0 or more"
+            },
+        })
+    }
 }

@@ -17,7 +17,7 @@
 //! Solved by Levenberg–Marquardt; the normal equations are sparse (banded over frames plus
 //! the length columns) and factored with `nalgebra-sparse`'s Cholesky.
 
-use super::error::LiftError;
+use super::error::{LiftError, check_setting};
 use super::least_squares::{Residuals, Row, frame_interval_s, minimise};
 use crate::camera::PinholeCamera;
 use crate::formats::{PointSource, TrackedPoint};
@@ -86,6 +86,26 @@ impl Default for RefineParams {
             anchor_sigma_m: 0.03,
             adaptive: true,
         }
+    }
+}
+
+impl RefineParams {
+    /// Checks every deviation is finite and above 0 (each divides its residual), the anchor's
+    /// at least 0 (0 turns it off).
+    pub fn validate(&self) -> Result<(), LiftError> {
+        check_setting(
+            "refinement.reprojection_sigma_px",
+            self.reprojection_sigma_px,
+            true,
+        )?;
+        check_setting("refinement.length_sigma_m", self.length_sigma_m, true)?;
+        check_setting(
+            "refinement.acceleration_sigma_mps2",
+            self.acceleration_sigma_mps2,
+            true,
+        )?;
+        check_setting("refinement.length_prior", self.length_prior, true)?;
+        check_setting("refinement.anchor_sigma_m", self.anchor_sigma_m, false)
     }
 }
 

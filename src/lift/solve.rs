@@ -7,7 +7,7 @@ use super::calibrate::{
     KEY_JOINTS, KeyTriangle, Residuals, calibrate_all, calibrate_from, longest_side, shape,
     starting_poses,
 };
-use super::error::LiftError;
+use super::error::{LiftError, check_setting};
 use super::key_path::{centroid, chain_pitch_prior, smooth_key_path, tilt_m};
 use super::propagate::key_depths;
 use super::refine::{RefineParams, RefineSummary, refine, track_weight};
@@ -169,8 +169,30 @@ pub struct LiftOutput {
     pub refinement: Option<RefineSummary>,
 }
 
+impl LiftParams {
+    /// Checks every setting is in the range it means something in (a settings file can hold
+    /// anything): tolerances positive, the smoothing width not negative, and the ambiguity
+    /// weights and refinement deviations as their own `validate` says.
+    pub fn validate(&self) -> Result<(), LiftError> {
+        check_setting(
+            "calibration_tolerance_px",
+            self.calibration_tolerance_px,
+            true,
+        )?;
+        check_setting(
+            "propagation_tolerance_m",
+            self.propagation_tolerance_m,
+            true,
+        )?;
+        check_setting("smoothing_s", self.smoothing_s, false)?;
+        self.ambiguity.validate()?;
+        self.refinement.validate()
+    }
+}
+
 /// Checks the job's inputs.
 fn check(job: &LiftJob<'_>) -> Result<(), LiftError> {
+    job.params.validate()?;
     let f = job.camera.focal_px;
     if !(f.is_finite() && f > 0.0) {
         return Err(LiftError::BadFocal(f));
