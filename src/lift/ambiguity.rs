@@ -13,8 +13,7 @@
 //! candidates are chained over the frames by dynamic programming (Viterbi over pairs of
 //! consecutive choices) that minimises the joints' 3D acceleration relative to the group's root
 //! plus the priors. Groups are solved centre outwards, each on the trajectory chosen for its
-//! root. A user's choice for a bone on a frame
-//! ([`DepthOverrides`]) is a hard constraint.
+//! root. A user's choice for a bone on a frame ([`DepthOverrides`]) is a hard constraint.
 use super::backproject::{Root, bone_roots};
 use super::error::{LiftError, check_setting};
 use crate::skeleton::{
@@ -194,9 +193,9 @@ const HEAD_FORWARD: f64 = 0.2;
 const GAIT_SPLIT: f64 = 0.04;
 
 /// The radius of the trunk around the spine that [`AmbiguityWeights::contact`] keeps a wrist
-/// out of, as a share of the trunk's (frontal) breadth: the trunk is deeper than half its
-/// breadth only at the chest, and a round capsule stands for it (0.35 of the default 1.75 m
-/// subject's 0.35 m is 0.12 m).
+/// out of, as a share of the trunk's (frontal) breadth: a round capsule stands for a trunk
+/// less deep than broad, so its radius is nearer half the depth than half the breadth (0.35 of
+/// the default 1.75 m subject's 0.35 m is 0.12 m).
 const TRUNK_DEPTH: f64 = 0.35;
 
 /// The radius of a thigh around its bone that [`AmbiguityWeights::contact`] keeps a wrist out
