@@ -5,7 +5,7 @@
 //! combination of its bones' roots is a candidate, scored per frame by a prior built on the joints'
 //! ranges of motion (the neck and spine lie along the key triangle's up direction, the pelvis a
 //! little behind it and the head top a little forward of it, and bend forwards rather than
-//! backwards; the hips are collinear with the pelvis and parallel to the shoulders; knees bend
+//! backwards, the head rather than sideways; the hips are collinear with the pelvis and parallel to the shoulders; knees bend
 //! backwards, in the leg's own plane; hanging elbows bend forwards; upper arms and thighs do not
 //! cross the body's middle and weakly prefer to hang a little outwards; of two arms that fit
 //! equally, the straighter and the one nearer the trunk's frontal plane; in a stride each arm
@@ -186,6 +186,17 @@ const SPINE_BACK: f64 = 0.2;
 /// 103.9). At 0.2 the full `bench lift` also moved the real sample from the tracker's output
 /// 179.5 → 172.3 mm, and the suite's 2 px noise 48.1 → 48.5, from the tracker 94.3 → 95.1.
 const HEAD_FORWARD: f64 = 0.2;
+
+/// How much more a head tilted sideways pays in [`AmbiguityWeights::trunk_up`] than one
+/// tilted forwards (on top of the tilt both pay): the neck bends forwards far more than
+/// sideways. The references tilt the head sideways by a sine of 0.18 at most (0.13 at the
+/// median of the most tilted clip), forwards by up to 0.78 (dribbling looks down at the ball);
+/// a head leaning well forward in an oblique view has a mirror root less forward but tilted
+/// sideways, which the isotropic prior preferred on every frame of dribble_oblique. `bench
+/// lift`'s suite from exact 2D with true lengths at 0 / 1 / 2 / 3 / 10: wrong roots 5.0 / 4.7 /
+/// 4.7 / 4.9 / 5.1 % (dribble_oblique 9.4 / 4.6 / 4.2 / 4.2 / 4.2 %; from 3 walk_across_side's
+/// head, seen from the side, follows the key triangle's small errors sideways).
+const HEAD_SIDEWAYS: f64 = 2.0;
 
 /// How far the thighs must split for a stride to count fully in [`AmbiguityWeights::
 /// arm_swing`]: the product of their forward components, one forward and one back (0.2 each
@@ -371,9 +382,10 @@ fn posture_cost(
     match group.prior {
         Prior::Head => {
             let head = tilted(trunk.up, trunk.forward, HEAD_FORWARD);
+            let sideways = (p[HeadTop] - p[Neck]).dot(&trunk.left).powi(2);
             w.trunk_up
                 * (along(Bone::new(Chest, Neck), trunk.up)
-                    + 0.5 * along(Bone::new(Neck, HeadTop), head))
+                    + 0.5 * (along(Bone::new(Neck, HeadTop), head) + HEAD_SIDEWAYS * sideways))
                 + w.extension * behind(Bone::new(Neck, HeadTop))
         }
         Prior::Spine => {
@@ -802,6 +814,25 @@ mod tests {
         // Without the contact term nothing else tells the two apart; with it, the hand outside.
         assert!((cost(&outside, 0.0) - cost(&inside, 0.0)).abs() < 1e-12);
         assert!(cost(&outside, 10.0) < cost(&inside, 10.0));
+    }
+
+    #[test]
+    fn a_head_looking_down_leans_forwards_not_sideways() {
+        // Dribbling (frame 48 of the suite's dribble_oblique): the head top well forward of
+        // the neck, or its mirror root, less forward but tilted sideways. The isotropic
+        // pull towards HEAD_FORWARD alone preferred the mirror (0.35 against 0.44).
+        let subject = SubjectModel::default();
+        let down = -Vector3::y();
+        let body = standing(&subject, |_| [down; 4]);
+        let trunk = TrunkFrame::of(&body);
+        let head = |left: f64, up: f64, forward: f64| {
+            let mut p = body;
+            let dir = (trunk.left * left + trunk.up * up + trunk.forward * forward).normalize();
+            p.0[HeadTop.index()] = p[Neck] + dir * subject.bone_length(Bone::new(Neck, HeadTop));
+            group_prior(group_of(Bone::new(Neck, HeadTop)), &p, &subject)
+        };
+        let (forwards, sideways) = (head(-0.14, 0.64, 0.75), head(-0.42, 0.73, 0.53));
+        assert!(forwards < sideways, "{forwards} {sideways}");
     }
 
     /// The group holding `bone`.

@@ -27,11 +27,11 @@ pub struct LiftParams {
     /// Run the global refinement after the per-frame solve (default true), then set every bone
     /// back to exactly its refined length ([`super::refine::snap_to_lengths`]), so the BVH's
     /// fixed offsets give the skeleton back exactly. `bench lift` reports both; on the synthetic
-    /// suite with true lengths it lowers the error 49.4 → 48.0 mm with 2 px white noise (four
-    /// draws), 94.3 → 94.1 mm with the tracker's output, exact tracks 11.6 → 11.5 mm; on the
+    /// suite with true lengths it lowers the error 49.2 → 47.7 mm with 2 px white noise (four
+    /// draws), 94.2 → 93.9 mm with the tracker's output, exact tracks 11.5 → 11.3 mm; on the
     /// real sample 68.1 → 66.7 mm with its reference 2D and 174.0 → 172.3 mm with the
     /// tracker's output. It lowers every overall row but one: the real sample from the
-    /// tracker's output and the height (161.8 → 162.1 mm).
+    /// tracker's output and the height (162.0 → 162.2 mm).
     pub refine: bool,
     /// A key-triangle calibration fits when its residual is below this RMS, pixels (default 1).
     pub calibration_tolerance_px: f64,
