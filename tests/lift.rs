@@ -456,7 +456,8 @@ fn a_subject_fitted_to_the_tracks_beats_the_table_for_a_different_build() {
     built.bone_length_m[Bone::new(Joint::Chest, Joint::RightShoulder).index()] = side;
     let (gt, built) = truth_of(built);
     let tracks = tracks_from_truth(&gt, 0.0, 3);
-    let (fitted, fit) = subject_from_height(table.height_m, &tracks, gt.camera()).unwrap();
+    let (fitted, fit) =
+        subject_from_height(table.height_m, &tracks, gt.camera(), &LiftParams::default()).unwrap();
     let drop = fit.chest_drop.unwrap();
     assert!((drop.measured - 0.335).abs() < 0.01, "{drop:?}");
     let error = |subject: &SubjectModel| {

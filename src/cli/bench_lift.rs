@@ -58,7 +58,7 @@ fn lift_case(
         tracks,
         camera: gt.camera(),
         subject,
-        params: params.clone(),
+        params: *params,
         overrides: Default::default(),
     };
     let t0 = Instant::now();
@@ -98,7 +98,7 @@ fn run_clip(
         let i = *i;
         let subjects = [
             subject_from_truth(&gt),
-            subject_from_height(stature_from_truth(&gt), tracks, gt.camera())
+            subject_from_height(stature_from_truth(&gt), tracks, gt.camera(), params)
                 .map_err(ExitError::failed)?
                 .0,
         ];
@@ -220,7 +220,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             tracks: &tracks,
             camera: gt.camera(),
             subject,
-            params: params.clone(),
+            params,
             overrides: Default::default(),
         };
         let est = estimate_focal(&job).map_err(ExitError::failed)?;

@@ -12,8 +12,9 @@ use videomocap::lift::subject_fit::fit_in_perspective;
 use videomocap::lift::{FrameFlag, LiftError, LiftJob, LiftOutput, LiftParams, lift};
 use videomocap::skeleton::{DEFAULT_HEIGHT_M, Proportions, SubjectModel};
 
-/// Checks the camera and subject options before any work.
-pub fn check_options(o: &LiftOptions) -> Result<(), ExitError> {
+/// Checks the camera and subject options before any work, and reads the lift settings they
+/// name (the defaults without `--lift-settings`).
+pub fn check_options(o: &LiftOptions) -> Result<LiftParams, ExitError> {
     if let Some(f) = o.focal_px
         && !(f.is_finite() && f > 0.0)
     {
@@ -35,10 +36,10 @@ pub fn check_options(o: &LiftOptions) -> Result<(), ExitError> {
             "--height-m must be a person's height in metres (0.3 to 3), got {h}"
         )));
     }
-    if let Some(p) = &o.lift_settings {
-        load_settings(p)?;
+    match &o.lift_settings {
+        Some(p) => load_settings(p),
+        None => Ok(LiftParams::default()),
     }
-    Ok(())
 }
 
 /// Reads lift settings from a JSON file.
@@ -62,18 +63,16 @@ fn lift_error(source: &Path, e: LiftError) -> ExitError {
     }
 }
 
-/// Lifts tracks with the options' camera and subject, with progress; shared by `lift` and `run`.
-/// `source` names the tracks (or the video they came from) in errors.
+/// Lifts tracks with the options' camera and subject and the lift settings `params` (from
+/// [`check_options`]), with progress; shared by `lift` and `run`. `source` names the tracks (or
+/// the video they came from) in errors.
 pub fn lift_with_progress(
     tracks: &Tracks2d,
     source: &Path,
     o: &LiftOptions,
+    params: LiftParams,
     global: &GlobalArgs,
 ) -> Result<LiftOutput, ExitError> {
-    let params = match &o.lift_settings {
-        Some(p) => load_settings(p)?,
-        None => LiftParams::default(),
-    };
     let table = SubjectModel::from_height(
         o.height_m.unwrap_or(DEFAULT_HEIGHT_M),
         Proportions::default(),
@@ -92,7 +91,7 @@ pub fn lift_with_progress(
             tracks,
             camera,
             subject: table.clone(),
-            params: params.clone(),
+            params,
             overrides: Default::default(),
         };
         let est = estimate_focal(&table_job).map_err(|e| lift_error(source, e))?;
@@ -115,7 +114,7 @@ pub fn lift_with_progress(
             ),
         );
     }
-    let (subject, fit) = fit_in_perspective(&table, tracks, camera);
+    let (subject, fit) = fit_in_perspective(&table, tracks, camera, &params);
     say(global, &fit.to_string());
     let job = LiftJob {
         tracks,
@@ -177,9 +176,9 @@ pub fn report(out: &LiftOutput, global: &GlobalArgs) {
 
 /// `lift`.
 pub fn run(a: &LiftArgs, global: &GlobalArgs) -> Result<(), ExitError> {
-    check_options(&a.options)?;
+    let params = check_options(&a.options)?;
     let tracks = Tracks2d::load(&a.tracks).map_err(ExitError::bad_input)?;
-    let out = lift_with_progress(&tracks, &a.tracks, &a.options, global)?;
+    let out = lift_with_progress(&tracks, &a.tracks, &a.options, params, global)?;
     out.skeleton.save(&a.output).map_err(ExitError::failed)?;
     report(&out, global);
     say(global, &format!("wrote {}", a.output.display()));

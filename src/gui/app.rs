@@ -621,7 +621,14 @@ impl App {
             .unwrap_or_else(|| default_focal(info.width, info.height));
         let ctx = self.ctx.clone();
         self.running = Some(Running {
-            job: Job::lift(tracks, focal, p.settings.height_m, p.overrides.clone(), ctx),
+            job: Job::lift(
+                tracks,
+                focal,
+                p.settings.height_m,
+                p.settings.lift,
+                p.overrides.clone(),
+                ctx,
+            ),
             keys: p.keys.clone(),
             overrides: p.overrides.clone(),
         });
@@ -1321,6 +1328,9 @@ impl App {
                 if ui.button("Defaults").clicked() {
                     *t = d;
                 }
+            });
+            ui.collapsing("Lift", |ui| {
+                super::lift_settings::lift_settings_ui(ui, &mut settings.lift)
             });
             let dragging = ui.ctx().dragged_id().is_some();
             if settings != before {
@@ -2187,6 +2197,23 @@ mod tests {
         assert!(!h.state().project().unwrap().settings.tracker.hip_patch);
         h.state_mut().undo();
         assert!(h.state().project().unwrap().settings.tracker.hip_patch);
+    }
+
+    /// The lift's global refinement can be turned off from the Parameters panel: an undoable
+    /// project setting, which the next lift uses.
+    #[test]
+    fn the_global_refinement_is_switched_in_the_lift_settings() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut h = with_project(dir.path());
+        let refine = |h: &Harness<'_, App>| h.state().project().unwrap().settings.lift.refine;
+        assert!(refine(&h));
+        h.get_by_label("Lift").click();
+        h.run();
+        h.get_by_label("global refinement").click();
+        h.run();
+        assert!(!refine(&h));
+        h.state_mut().undo();
+        assert!(refine(&h));
     }
 
     /// The shoulder spring is part of the chain refinement: its slider is greyed out while the

@@ -75,11 +75,12 @@ impl Job {
         Job::new("Tracking", rx, cancel)
     }
 
-    /// Lifts `tracks` to 3D on a worker thread.
+    /// Lifts `tracks` to 3D on a worker thread with the project's lift settings `params`.
     pub fn lift(
         tracks: Arc<Tracks2d>,
         focal_px: f64,
         height_m: f64,
+        params: LiftParams,
         overrides: DepthOverrides,
         ctx: egui::Context,
     ) -> Job {
@@ -92,14 +93,14 @@ impl Job {
                 tracks.source.width,
                 tracks.source.height,
             );
-            let result = subject_from_height(height_m, &tracks, camera)
+            let result = subject_from_height(height_m, &tracks, camera, &params)
                 .map_err(|e| e.to_string())
                 .and_then(|(subject, fit)| {
                     let job = LiftJob {
                         tracks: &tracks,
                         camera,
                         subject,
-                        params: LiftParams::default(),
+                        params,
                         overrides,
                     };
                     let progress_tx = tx.clone();

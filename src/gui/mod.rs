@@ -8,6 +8,7 @@ mod dialogs;
 mod frame_loader;
 mod frame_view;
 mod jobs;
+mod lift_settings;
 mod timeline;
 mod view3d;
 mod volume_view;

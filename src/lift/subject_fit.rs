@@ -277,13 +277,14 @@ pub fn fit_to_tracks(subject: &SubjectModel, tracks: &Tracks2d) -> (SubjectModel
 }
 
 /// [`fit_to_tracks`], then the limbs read again with each image length scaled by the depth of
-/// its bone's parent over the trunk's in a first lift (default settings) with that fit through
-/// `camera`: in a side view the near limbs are nearer the camera than the trunk and look several
+/// its bone's parent over the trunk's in a first lift (per frame, with `params`) with that fit
+/// through `camera`: in a side view the near limbs are nearer the camera than the trunk and look several
 /// per cent longer. Falls back to the first fit when that lift fails.
 pub fn fit_in_perspective(
     subject: &SubjectModel,
     tracks: &Tracks2d,
     camera: PinholeCamera,
+    params: &LiftParams,
 ) -> (SubjectModel, SubjectFit) {
     let images = smoothed_images(tracks, &adaptive_sigmas(tracks));
     let first = fit(subject, &views(tracks, &images, None));
@@ -291,7 +292,7 @@ pub fn fit_in_perspective(
         tracks,
         camera,
         subject: first.0.clone(),
-        params: LiftParams::default(),
+        params: *params,
         overrides: Default::default(),
     };
     match lift_per_frame(&job) {
@@ -353,14 +354,16 @@ fn fit(subject: &SubjectModel, views: &[FrameView<'_>]) -> (SubjectModel, Subjec
 }
 
 /// What a user who knows only the subject's height gets: the proportions table scaled to the
-/// height and fitted to the tracks seen through `camera` ([`fit_in_perspective`]).
+/// height and fitted to the tracks seen through `camera` ([`fit_in_perspective`], its first lift
+/// with `params`).
 pub fn subject_from_height(
     height_m: f64,
     tracks: &Tracks2d,
     camera: PinholeCamera,
+    params: &LiftParams,
 ) -> Result<(SubjectModel, SubjectFit), ProportionsError> {
     let subject = SubjectModel::from_height(height_m, Proportions::default())?;
-    Ok(fit_in_perspective(&subject, tracks, camera))
+    Ok(fit_in_perspective(&subject, tracks, camera, params))
 }
 
 #[cfg(test)]
@@ -518,7 +521,7 @@ mod tests {
         };
         let upper = [Bone::new(Joint::LeftShoulder, Joint::LeftElbow)];
         let flat = fit_to_tracks(&table, &tracks).0;
-        let deep = fit_in_perspective(&table, &tracks, camera).0;
+        let deep = fit_in_perspective(&table, &tracks, camera, &LiftParams::default()).0;
         // Measured: upper arms 1.034 flat, 1.001 in perspective; the worst bone 3.4 % flat,
         // 2.2 % in perspective (the forearms: their parent, the elbow, sat 12° out of the image
         // plane in the first lift, where the arms were 2 % too long).

@@ -10,7 +10,7 @@ pub use history::History;
 use crate::formats::{
     FORMAT_VERSION, FormatError, Skeleton3d, Tracks2d, parse_json, read_text, write_atomically,
 };
-use crate::lift::{DepthOverrides, Root};
+use crate::lift::{DepthOverrides, LiftParams, Root};
 use crate::skeleton::{Bone, Joint};
 use crate::track::{KeyFrames, TrackerParams};
 use nalgebra::Point2;
@@ -35,6 +35,8 @@ pub struct Settings {
     pub focal_px: Option<f64>,
     /// The subject's stature, metres (scales the bone lengths).
     pub height_m: f64,
+    /// Lift settings, as in the command line's `--lift-settings` file.
+    pub lift: LiftParams,
 }
 
 impl Default for Settings {
@@ -43,6 +45,7 @@ impl Default for Settings {
             tracker: TrackerParams::default(),
             focal_px: None,
             height_m: DEFAULT_HEIGHT_M,
+            lift: LiftParams::default(),
         }
     }
 }
@@ -161,6 +164,10 @@ impl Project {
                 "settings.focal_px must be positive (got {f})"
             )));
         }
+        raw.settings
+            .lift
+            .validate()
+            .map_err(|e| invalid(format!("settings.lift: {e}")))?;
         let tracks = raw
             .tracks
             .map(|v| Tracks2d::from_json_value(v, path).map(Arc::new))
@@ -274,6 +281,8 @@ mod tests {
         );
         p.settings.height_m = 1.82;
         p.settings.focal_px = Some(900.0);
+        p.settings.lift.refine = false;
+        p.settings.lift.ambiguity.contact = 3.0;
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("p.json");
         p.save(&path).unwrap();
@@ -298,6 +307,11 @@ mod tests {
                 "nose",
             ),
             ("{".to_owned(), "bad.videomocap"),
+            // A weight below 0 would reward the posture its prior forbids.
+            (
+                base.replace("\"contact\": 10.0", "\"contact\": -1.0"),
+                "ambiguity.contact",
+            ),
         ];
         for (text, needle) in cases {
             let err = Project::parse(&text, path).unwrap_err().to_string();
