@@ -12,7 +12,9 @@ fn on_off(b: bool) -> &'static str {
 pub fn lift_settings_ui(ui: &mut egui::Ui, l: &mut LiftParams) {
     let d = LiftParams::default();
     ui.checkbox(&mut l.refine, "global refinement").on_hover_text(format!(
-        "After the per-frame solve, one least-squares pass over the whole clip (reprojection, bone lengths, smooth motion); on the benchmark ten times slower and 0.2 to 2 mm more accurate; default {}",
+        "After the per-frame solve, one least-squares pass over the whole clip (reprojection, bone \
+         lengths, smooth motion); on the benchmark ten times slower and 0.2 to 2 mm more \
+         accurate; default {}",
         on_off(d.refine)
     ));
     // The fixed smoothing replaces the adaptive one: greyed out while it is set.
@@ -22,28 +24,33 @@ pub fn lift_settings_ui(ui: &mut egui::Ui, l: &mut LiftParams) {
     );
     ui.add_enabled(l.smoothing_s == 0.0, adaptive)
         .on_hover_text(format!(
-            "Before the lift, each joint's track is smoothed by as much as its own jitter calls for (used when the fixed smoothing below is 0); default {}",
+            "Before the lift, each joint's track is smoothed by as much as its own jitter calls \
+             for (used when the fixed smoothing below is 0); default {}",
             on_off(d.adaptive_smoothing)
         ));
     ui.add(egui::Slider::new(&mut l.smoothing_s, 0.0..=0.3).text("fixed smoothing (s)"))
         .on_hover_text(format!(
-            "Above 0: every joint's track is smoothed by a Gaussian this many seconds wide instead; default {}",
+            "Above 0: every joint's track is smoothed by a Gaussian this many seconds wide \
+             instead; default {}",
             d.smoothing_s
         ));
     ui.checkbox(&mut l.key_path_smoothing, "refit the trunk's path")
         .on_hover_text(format!(
-            "The shoulders' and chest's 3D path is refitted over the whole clip (steadier depth and turn); default {}",
+            "The shoulders' and chest's 3D path is refitted over the whole clip (steadier depth \
+             and turn); default {}",
             on_off(d.key_path_smoothing)
         ));
     let a = &mut l.ambiguity;
     ui.add(egui::Slider::new(&mut a.arm_swing, 0.0..=3.0).text("arms swing against the legs"))
         .on_hover_text(format!(
-            "When walking or running, how strongly each arm is taken to swing against its own leg when its depth is in doubt (0 = off); default {}",
+            "When walking or running, how strongly each arm is taken to swing against its own leg \
+             when its depth is in doubt (0 = off); default {}",
             d.ambiguity.arm_swing
         ));
     ui.add(egui::Slider::new(&mut a.contact, 0.0..=30.0).text("hands stay out of the body"))
         .on_hover_text(format!(
-            "How strongly a hand is kept out of the trunk and the thighs when its depth is in doubt (0 = off); default {}",
+            "How strongly a hand is kept out of the trunk and the thighs when its depth is in \
+             doubt (0 = off); default {}",
             d.ambiguity.contact
         ));
     if ui.button("Defaults").clicked() {

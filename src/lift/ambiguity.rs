@@ -5,15 +5,15 @@
 //! combination of its bones' roots is a candidate, scored per frame by a prior built on the joints'
 //! ranges of motion (the neck and spine lie along the key triangle's up direction, the pelvis a
 //! little behind it and the head top a little forward of it, and bend forwards rather than
-//! backwards, the head rather than sideways; the hips are collinear with the pelvis and parallel to the shoulders; knees bend
-//! backwards, in the leg's own plane; hanging elbows bend forwards; upper arms and thighs do not
-//! cross the body's middle and weakly prefer to hang a little outwards; of two arms that fit
-//! equally, the straighter and the one nearer the trunk's frontal plane; in a stride each arm
-//! swings against its own thigh; a wrist stays out of the trunk and the thighs), and the
-//! candidates are chained over the frames by dynamic programming (Viterbi over pairs of
+//! backwards, the head rather than sideways; the hips are collinear with the pelvis and parallel to
+//! the shoulders; knees bend backwards, in the leg's own plane; hanging elbows bend forwards; upper
+//! arms and thighs do not cross the body's middle and weakly prefer to hang a little outwards; of
+//! two arms that fit equally, the straighter and the one nearer the trunk's frontal plane; in a
+//! stride each arm swings against its own thigh; a wrist stays out of the trunk and the thighs),
+//! and the candidates are chained over the frames by dynamic programming (Viterbi over pairs of
 //! consecutive choices) that minimises the joints' 3D acceleration relative to the group's root
-//! plus the priors. Groups are solved centre outwards, each on the trajectory chosen for its
-//! root. A user's choice for a bone on a frame ([`DepthOverrides`]) is a hard constraint.
+//! plus the priors. Groups are solved centre outwards, each on the trajectory chosen for its root.
+//! A user's choice for a bone on a frame ([`DepthOverrides`]) is a hard constraint.
 use super::backproject::{Root, bone_roots};
 use super::error::{LiftError, check_setting};
 use crate::skeleton::{

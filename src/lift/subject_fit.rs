@@ -276,9 +276,9 @@ pub fn fit_to_tracks(subject: &SubjectModel, tracks: &Tracks2d) -> (SubjectModel
     fit(subject, &views(tracks, &images, None))
 }
 
-/// [`fit_to_tracks`], then the limbs read again with each image length scaled by the depth of
-/// its bone's parent over the trunk's in a first lift (per frame, with `params`) with that fit
-/// through `camera`: in a side view the near limbs are nearer the camera than the trunk and look several
+/// [`fit_to_tracks`], then the limbs read again with each image length scaled by the depth of its
+/// bone's parent over the trunk's in a first lift (per frame, with `params`) with that fit through
+/// `camera`: in a side view the near limbs are nearer the camera than the trunk and look several
 /// per cent longer. Falls back to the first fit when that lift fails.
 pub fn fit_in_perspective(
     subject: &SubjectModel,
