@@ -2216,6 +2216,28 @@ mod tests {
         assert!(refine(&h));
     }
 
+    /// A fixed smoothing width replaces the adaptive smoothing: its checkbox is greyed out
+    /// while one is set.
+    #[test]
+    fn the_adaptive_smoothing_is_greyed_out_under_a_fixed_width() {
+        use egui_kittest::kittest::NodeT;
+        let dir = tempfile::tempdir().unwrap();
+        let mut h = with_project(dir.path());
+        h.get_by_label("Lift").click();
+        h.run();
+        let disabled = |h: &Harness<'_, App>| {
+            h.get_by_label("smooth each joint by its own noise")
+                .accesskit_node()
+                .is_disabled()
+        };
+        assert!(!disabled(&h));
+        if let Some(p) = &mut h.state_mut().project {
+            p.settings.lift.smoothing_s = 0.1;
+        }
+        h.run();
+        assert!(disabled(&h));
+    }
+
     /// The shoulder spring is part of the chain refinement: its slider is greyed out while the
     /// chain refinement is off.
     #[test]
