@@ -7,13 +7,14 @@
 //! little behind it and the head top a little forward of it, and bend forwards rather than
 //! backwards, the head rather than sideways; the hips are collinear with the pelvis and parallel to
 //! the shoulders; knees bend backwards, in the leg's own plane; hanging elbows bend forwards; upper
-//! arms and thighs do not cross the body's middle and weakly prefer to hang a little outwards; of
-//! two arms that fit equally, the straighter and the one nearer the trunk's frontal plane; in a
-//! stride each arm swings against its own thigh; a wrist stays out of the trunk and the thighs),
-//! and the candidates are chained over the frames by dynamic programming (Viterbi over pairs of
-//! consecutive choices) that minimises the joints' 3D acceleration relative to the group's root
-//! plus the priors. Groups are solved centre outwards, each on the trajectory chosen for its root.
-//! A user's choice for a bone on a frame ([`DepthOverrides`]) is a hard constraint.
+//! arms and thighs do not cross the body's middle and weakly prefer to hang a little outwards, an
+//! arm swung back less so; of two arms that fit equally, the straighter and the one nearer the
+//! trunk's frontal plane; in a stride each arm swings against its own thigh; a wrist stays out of
+//! the trunk and the thighs), and the candidates are chained over the frames by dynamic programming
+//! (Viterbi over pairs of consecutive choices) that minimises the joints' 3D acceleration relative
+//! to the group's root plus the priors. Groups are solved centre outwards, each on the trajectory
+//! chosen for its root. A user's choice for a bone on a frame ([`DepthOverrides`]) is a hard
+//! constraint.
 use super::backproject::{Root, bone_roots};
 use super::error::{LiftError, check_setting};
 use crate::skeleton::{
@@ -158,6 +159,25 @@ impl AmbiguityWeights {
 /// How far a resting arm and leg hang outwards from straight down, radians: arms clear the
 /// hips, legs stand a little apart.
 const REST_ABDUCTION: [f64; 2] = [0.15, 0.05];
+
+/// How much further outwards than [`REST_ABDUCTION`] a hanging upper arm rests per unit of its
+/// forward tilt (the sine of each angle): an arm swung back comes in towards the body, swung
+/// forward it moves out. The references' hanging arms (pointing more than 0.7 down), fitted
+/// per clip, give slopes of 0.11 to 0.53 on all six motion-capture clips (walk_across_side's
+/// arm hangs 0.14 inwards swung 0.41 back, where the fixed rest pose preferred its mirror root
+/// 0.21 outwards). The suite from exact 2D with true lengths at 0.3 / 0.5: wrong roots 4.7 →
+/// 4.6 % either way (walk_across_side 11.6 → 10.5 %). Counted only for an arm hanging within
+/// [`REST_SWING_HANG`] of straight down: applied to any arm, it turned jumping_jacks_frontal's
+/// raised arms forwards (2.0 → 23.1 %). At 0.3 `bench lift` (refined): exact 2D 11.3 → 11.3 mm
+/// (PA 10.6 → 10.5), wrong roots 4.8 → 4.6 %, from the height 36.9 → 36.8, 2 px noise 47.7 →
+/// 47.7 (from the height 62.6 → 62.7), from the tracker 93.9 → 93.9; the real sample
+/// unchanged.
+const REST_SWING: f64 = 0.3;
+
+/// How far down (the sine of the angle from horizontal) an upper arm must hang for
+/// [`REST_SWING`] to count at all; it counts fully straight down. At 0.3 (as for the elbow's
+/// prior) the real sample's wrong roots rose 5.4 → 6.1 %; at 0.8 they stay.
+const REST_SWING_HANG: f64 = 0.8;
 
 /// How far an upper arm or thigh may cross inwards of straight down before [`AmbiguityWeights::
 /// medial`] counts it (the sine of the angle).
@@ -421,7 +441,14 @@ fn posture_cost(
             // How the lower bone leaves the upper bone's line.
             let bend = lower - upper * upper.dot(&lower);
             let upper_len = (p[middle] - p[root]).norm();
-            let abduction = REST_ABDUCTION[usize::from(is_leg)];
+            let abduction = if is_leg {
+                REST_ABDUCTION[1]
+            } else {
+                // A hanging arm swung back rests further in, swung forward further out.
+                let hanging = ((-upper.dot(&trunk.up) - REST_SWING_HANG) / (1.0 - REST_SWING_HANG))
+                    .clamp(0.0, 1.0);
+                REST_ABDUCTION[0] + REST_SWING * upper.dot(&trunk.forward) * hanging
+            };
             let rest_dir = -trunk.up * abduction.cos() + outward * abduction.sin();
             let rest = w.hanging * ((upper - rest_dir) * upper_len).norm_squared();
             let medial =
@@ -835,6 +862,24 @@ mod tests {
         assert!(forwards < sideways, "{forwards} {sideways}");
     }
 
+    #[test]
+    fn a_hanging_arm_swung_back_rests_nearer_the_body() {
+        // The left arm straight, swung 0.4 back (the same forward tilt both times, so the
+        // frontal prior cannot tell them apart), 0.04 or 0.22 outwards. Without REST_SWING the
+        // nearest to the rest pose at this tilt lies 0.137 out, nearer the second; swung back
+        // the rest pose comes in (walk_across_side's arm hangs 0.14 inwards) and the first wins.
+        let arm = |out: f64| {
+            let forward: f64 = -0.4;
+            let down = (1.0 - out * out - forward * forward).sqrt();
+            prior_of(left_arm(), |s| {
+                let d = Vector3::new(out * s, -down, forward);
+                [d, d, -Vector3::y(), -Vector3::y()]
+            })
+        };
+        let (near, far) = (arm(0.04), arm(0.22));
+        assert!(near < far, "{near} {far}");
+    }
+
     /// The group holding `bone`.
     fn group_of(bone: Bone) -> usize {
         GROUPS
@@ -870,10 +915,24 @@ mod tests {
         // Left leg forwards: the left arm backwards.
         let (against, with) = (arm(-0.3, 0.4), arm(0.3, 0.4));
         assert!(against < with, "{against} {with}");
-        // Standing: forwards and backwards cost the same.
-        let (forwards, backwards) = (arm(0.3, 0.0), arm(-0.3, 0.0));
+        // Standing: the swing term costs forwards and backwards the same (nothing: the rest of
+        // the prior, REST_SWING, still tells them apart).
+        let swing = |z: f64| {
+            let subject = SubjectModel::default();
+            let p = standing(&subject, |s| {
+                [
+                    dir(0.2 * s, -1.0, z),
+                    dir(0.2 * s, -1.0, z),
+                    -Vector3::y(),
+                    -Vector3::y(),
+                ]
+            });
+            let w = AmbiguityWeights::default();
+            swing_cost(&GROUPS[left_arm()], &p, &TrunkFrame::of(&p), &w)
+        };
+        let (forwards, backwards) = (swing(0.3), swing(-0.3));
         assert!(
-            (forwards - backwards).abs() < 1e-12,
+            forwards.abs() < 1e-12 && backwards.abs() < 1e-12,
             "{forwards} {backwards}"
         );
     }
