@@ -176,8 +176,12 @@ const REST_SWING: f64 = 0.3;
 
 /// How far down (the sine of the angle from horizontal) an upper arm must hang for
 /// [`REST_SWING`] to count at all; it counts fully straight down. At 0.3 (as for the elbow's
-/// prior) the real sample's wrong roots rose 5.4 → 6.1 %; at 0.8 they stay.
+/// prior, [`ELBOW_HANG`]) the real sample's wrong roots rose 5.4 → 6.1 %; at 0.8 they stay.
 const REST_SWING_HANG: f64 = 0.8;
+
+/// How far down an upper arm must hang for [`AmbiguityWeights::elbow`] to count at all (the
+/// sine of the angle from horizontal); it counts fully straight down.
+const ELBOW_HANG: f64 = 0.3;
 
 /// How far an upper arm or thigh may cross inwards of straight down before [`AmbiguityWeights::
 /// medial`] counts it (the sine of the angle).
@@ -445,8 +449,7 @@ fn posture_cost(
                 REST_ABDUCTION[1]
             } else {
                 // A hanging arm swung back rests further in, swung forward further out.
-                let hanging = ((-upper.dot(&trunk.up) - REST_SWING_HANG) / (1.0 - REST_SWING_HANG))
-                    .clamp(0.0, 1.0);
+                let hanging = hanging_share(&upper, trunk, REST_SWING_HANG);
                 REST_ABDUCTION[0] + REST_SWING * upper.dot(&trunk.forward) * hanging
             };
             let rest_dir = -trunk.up * abduction.cos() + outward * abduction.sin();
@@ -467,7 +470,7 @@ fn posture_cost(
             } else {
                 // An elbow of an arm hanging down bends forwards; the weight fades as the arm
                 // rises (a raised arm can bend its elbow any way by turning the upper arm).
-                let hanging = ((-upper.dot(&trunk.up) - 0.3) / 0.7).clamp(0.0, 1.0);
+                let hanging = hanging_share(&upper, trunk, ELBOW_HANG);
                 common
                     + w.contact * inside_body(&p[end], p, subject)
                     + w.elbow * hanging * (-bend.dot(&trunk.forward)).max(0.0).powi(2)
@@ -476,6 +479,12 @@ fn posture_cost(
             }
         }
     }
+}
+
+/// How far the unit direction `upper` hangs down, from 0 when it points less than `from` down
+/// (the sine of its angle below the trunk's horizontal) to 1 straight down.
+fn hanging_share(upper: &Vector3<f64>, trunk: &TrunkFrame, from: f64) -> f64 {
+    ((-upper.dot(&trunk.up) - from) / (1.0 - from)).clamp(0.0, 1.0)
 }
 
 /// How deep a wrist lies inside the trunk or a thigh, squared (metres squared), for
@@ -847,7 +856,8 @@ mod tests {
     fn a_head_looking_down_leans_forwards_not_sideways() {
         // Dribbling (frame 48 of the suite's dribble_oblique): the head top well forward of
         // the neck, or its mirror root, less forward but tilted sideways. The isotropic
-        // pull towards HEAD_FORWARD alone preferred the mirror (0.35 against 0.44).
+        // pull towards HEAD_FORWARD alone preferred the mirror (squared distances 0.35 against
+        // 0.44).
         let subject = SubjectModel::default();
         let down = -Vector3::y();
         let body = standing(&subject, |_| [down; 4]);

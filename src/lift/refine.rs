@@ -93,19 +93,29 @@ impl RefineParams {
     /// Checks every deviation is finite and above 0 (each divides its residual), the anchor's
     /// at least 0 (0 turns it off).
     pub fn validate(&self) -> Result<(), LiftError> {
+        // Destructured so that a new setting cannot be left unchecked.
+        let RefineParams {
+            reprojection_sigma_px,
+            length_sigma_m,
+            acceleration_sigma_mps2,
+            length_prior,
+            max_iterations: _,
+            anchor_sigma_m,
+            adaptive: _,
+        } = *self;
         check_setting(
             "refinement.reprojection_sigma_px",
-            self.reprojection_sigma_px,
+            reprojection_sigma_px,
             true,
         )?;
-        check_setting("refinement.length_sigma_m", self.length_sigma_m, true)?;
+        check_setting("refinement.length_sigma_m", length_sigma_m, true)?;
         check_setting(
             "refinement.acceleration_sigma_mps2",
-            self.acceleration_sigma_mps2,
+            acceleration_sigma_mps2,
             true,
         )?;
-        check_setting("refinement.length_prior", self.length_prior, true)?;
-        check_setting("refinement.anchor_sigma_m", self.anchor_sigma_m, false)
+        check_setting("refinement.length_prior", length_prior, true)?;
+        check_setting("refinement.anchor_sigma_m", anchor_sigma_m, false)
     }
 }
 

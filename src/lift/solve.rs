@@ -174,19 +174,22 @@ impl LiftParams {
     /// anything): tolerances positive, the smoothing width not negative, and the ambiguity
     /// weights and refinement deviations as their own `validate` says.
     pub fn validate(&self) -> Result<(), LiftError> {
-        check_setting(
-            "calibration_tolerance_px",
-            self.calibration_tolerance_px,
-            true,
-        )?;
-        check_setting(
-            "propagation_tolerance_m",
-            self.propagation_tolerance_m,
-            true,
-        )?;
-        check_setting("smoothing_s", self.smoothing_s, false)?;
-        self.ambiguity.validate()?;
-        self.refinement.validate()
+        // Destructured so that a new setting cannot be left unchecked.
+        let LiftParams {
+            refine: _,
+            calibration_tolerance_px,
+            propagation_tolerance_m,
+            smoothing_s,
+            adaptive_smoothing: _,
+            key_path_smoothing: _,
+            ambiguity,
+            refinement,
+        } = *self;
+        check_setting("calibration_tolerance_px", calibration_tolerance_px, true)?;
+        check_setting("propagation_tolerance_m", propagation_tolerance_m, true)?;
+        check_setting("smoothing_s", smoothing_s, false)?;
+        ambiguity.validate()?;
+        refinement.validate()
     }
 }
 
