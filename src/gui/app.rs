@@ -1318,6 +1318,8 @@ impl App {
                     .on_hover_text(format!("How far a limb may turn between frames in the search; default {}°", d.limb_range_deg));
                 ui.add(egui::Slider::new(&mut t.short_penalty, 0.0..=20.0).text("keep limbs long"))
                     .on_hover_text(format!("How strongly a limb is pulled back to its full length when it looks shorter (legs crossing); lower it for limbs pointing at the camera, such as a seated person's thighs seen from the front; default {}", d.short_penalty));
+                ui.add(egui::Slider::new(&mut t.upper_arm_short_penalty, 0.0..=60.0).text("keep upper arms long"))
+                    .on_hover_text(format!("The same pull for the upper arms, stronger: a bare or plain-sleeved upper arm looks alike along its length and otherwise shrinks towards the shoulder; lower it for an arm pointing at the camera; default {}", d.upper_arm_short_penalty));
                 ui.checkbox(&mut t.hip_patch, "hold the hips when the back bends")
                     .on_hover_text(format!("A patch around the hips holds the pelvis when the spine bends (a bow, a reach), and the trunk is re-hung from the neck to it; default {}", if d.hip_patch { "on" } else { "off" }));
                 ui.checkbox(&mut t.chain_refine, "refine each limb as one chain")

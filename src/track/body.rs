@@ -65,6 +65,10 @@ struct Part {
     max_len: f64,
     /// How far along its bone the part is sampled.
     extent: Extent,
+    /// What the block pays per unit of ln(full length / length) when shorter than its full
+    /// length: [`TrackerParams::short_penalty`] for the limbs, the upper arms' own
+    /// [`TrackerParams::upper_arm_short_penalty`], 0 for the head, trunk and hip patch.
+    short_penalty: f32,
 }
 
 /// A limb's longest plausible image length over its full length from the proportions (people
@@ -198,6 +202,13 @@ impl BodyTracker {
                 reliability: 1.0,
                 max_len: (LENGTH_SLACK * fraction * stature).max(block.m * 1.05),
                 extent: extent(kind),
+                short_penalty: match kind {
+                    BodyPart::Head | BodyPart::Trunk => 0.0,
+                    BodyPart::LeftUpperArm | BodyPart::RightUpperArm => {
+                        params.upper_arm_short_penalty
+                    }
+                    _ => params.short_penalty,
+                },
             }
         };
         // The head block runs from the calvaria down to the neck (its anchor is head_top).
@@ -230,6 +241,7 @@ impl BodyTracker {
                 reliability: 1.0,
                 max_len: block.m,
                 extent: Extent::BLOCK,
+                short_penalty: 0.0,
             }
         };
         let trunk_points = TRUNK_JOINTS.map(|j| trunk_block.to_block(pose[j]));
@@ -417,7 +429,7 @@ impl BodyTracker {
                 m_count: 5,
                 scale_width: false,
             },
-            &prior(&self.trunk, &trunk_pred, &p, zoom, 0.0),
+            &prior(&self.trunk, &trunk_pred, &p, zoom),
         );
         accept(&mut self.trunk, found, frame, &p);
         if let Some(hips_found) = hips_found {
@@ -637,14 +649,14 @@ fn predict_anchored(
 
 /// The motion prior of an anchored part around its prediction; its length limits are the
 /// marked ones times the head's `zoom`, and a block shorter than the part's full length pays
-/// `short` per unit of log ratio (limbs; the trunk passes 0).
-fn prior(part: &Part, pred: &MorphBlock, p: &TrackerParams, zoom: f64, short: f32) -> Prior {
+/// the part's `short_penalty` per unit of log ratio.
+fn prior(part: &Part, pred: &MorphBlock, p: &TrackerParams, zoom: f64) -> Prior {
     Prior {
         theta: pred.theta,
         m: pred.m,
         per_degree: p.angle_penalty,
         per_log_length: p.length_penalty,
-        per_log_short: short,
+        per_log_short: part.short_penalty,
         m_full: part.max_len * zoom / LENGTH_SLACK,
         m_min: 0.2 * part.max_len * zoom,
         m_max: part.max_len * zoom,
@@ -728,7 +740,7 @@ fn track_limb(
             m_count: 5,
             scale_width: false,
         };
-        let free = prior(part, &pred, p, zoom, p.short_penalty);
+        let free = prior(part, &pred, p, zoom);
         let prior = match second_look {
             Some(bars) => Prior {
                 avoid: bars[k],
