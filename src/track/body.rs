@@ -803,7 +803,14 @@ fn track_limb(
                 ChainSegment {
                     template: &parts[0].template,
                     n: parts[0].block.n,
-                    prior: upper,
+                    // The upper arm's stronger pull towards full length stays out of the
+                    // chain's joint refinement, which also moves the shoulder: there it pulled
+                    // the suite's shoulders about a pixel off (the lift from the tracker's
+                    // output 93.9 → 112.4 mm), here the limbs' ordinary pull.
+                    prior: &Prior {
+                        per_log_short: upper.per_log_short.min(p.short_penalty),
+                        ..*upper
+                    },
                 },
                 ChainSegment {
                     template: &parts[1].template,
