@@ -526,12 +526,12 @@ impl BodyTracker {
     /// leg for most of each swing (PCK@0.2 0.82 and 0.77). The second look finds the swing leg
     /// on nearly every such frame, but matching it scores 0.1 to 0.3 lower (summed
     /// reliabilities) than the shared spot, so neither leg moves. Measured on `bench track`'s
-    /// suite and not kept (suite PCK@0.2 0.911 as it stands): moving a leg whenever both its
-    /// joints share the spot, whatever it loses, 0.885 (it often moves the stance leg's own
-    /// blocks); choosing which leg moves by how near the found swing leg lies to each leg's
-    /// ankle extrapolated from the last frames they were apart, 0.912; that and barring the
-    /// moved leg from the other for the next frames, 0.898; the angle prior three or ten times
-    /// as strong while the knees are close, 0.907 or 0.897.
+    /// suite and not kept (suite PCK@0.2 0.911 then, before the upper arms' own pull): moving a
+    /// leg whenever both its joints share the spot, whatever it loses, 0.885 (it often moves
+    /// the stance leg's own blocks); choosing which leg moves by how near the found swing leg
+    /// lies to each leg's ankle extrapolated from the last frames they were apart, 0.912; that
+    /// and barring the moved leg from the other for the next frames, 0.898; the angle prior
+    /// three or ten times as strong while the knees are close, 0.907 or 0.897.
     fn reacquire_legs(
         &mut self,
         before: &[[Part; 2]; 2],
