@@ -2165,8 +2165,8 @@ mod tests {
         h
     }
 
-    /// The pull of short limbs back to full length is set from the Parameters panel, and that
-    /// is an undoable project setting.
+    /// The pull of short limbs back to full length, and the upper arms' own, are set from the
+    /// Parameters panel, and each is an undoable project setting.
     #[test]
     fn the_short_limb_pull_is_set_in_the_tracker_settings() {
         let dir = tempfile::tempdir().unwrap();
@@ -2183,6 +2183,21 @@ mod tests {
         assert_eq!(pull(&h), 2.0);
         h.state_mut().undo();
         assert_eq!(pull(&h), default);
+        // The upper arms' own pull beside it, on its own.
+        let arms = |h: &Harness<'static, App>| {
+            h.state()
+                .project()
+                .unwrap()
+                .settings
+                .tracker
+                .upper_arm_short_penalty
+        };
+        h.get_by_role_and_label(egui::accesskit::Role::Slider, "keep upper arms long")
+            .set_value_accesskit(12.0);
+        h.run();
+        assert_eq!((arms(&h), pull(&h)), (12.0, default));
+        h.state_mut().undo();
+        assert_eq!(arms(&h), TrackerParams::default().upper_arm_short_penalty);
     }
 
     /// The tracker's hip patch can be turned off from the Parameters panel, and that is an
