@@ -1,24 +1,17 @@
 //! Tracking the bundled real sample (`sample_videos/pose2sim_balancing_cam01`, 1080×1920, 100
 //! frames) against its reference, where real video behaves unlike the synthetic suite.
 
+mod common;
+
 use std::path::Path;
-use std::sync::atomic::AtomicBool;
-use videomocap::eval::{ClipScore, score_tracks};
-use videomocap::formats::Marks;
+use videomocap::eval::ClipScore;
 use videomocap::skeleton::Joint;
-use videomocap::synth::GroundTruth;
-use videomocap::track::{TrackJob, TrackerParams, track_video};
-use videomocap::video::{OpenOptions, Video};
+use videomocap::track::TrackerParams;
 
 /// Tracks the real sample from its marks with `params` (two threads) and scores it.
 fn track_sample(params: TrackerParams) -> ClipScore {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("sample_videos/pose2sim_balancing_cam01");
-    let gt = GroundTruth::load(&dir.join("gt.json")).unwrap();
-    let marks = Marks::load(&dir.join("marks.json")).unwrap();
-    let mut video = Video::open(&dir.join("video.mp4"), &OpenOptions::default()).unwrap();
-    let job = TrackJob::from_marks(&marks, params, 2);
-    let out = track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false)).unwrap();
-    score_tracks(&gt, &out.tracks).unwrap()
+    common::track_and_score(&dir, &dir.join("video.mp4"), params)
 }
 
 /// The subject's bare left upper arm looks alike along its length: with the limbs' ordinary

@@ -1,6 +1,8 @@
 //! Tracking on rendered clips with known joints: accuracy floors, the CLI's output file, and
 //! bad input (too short a video, marks off the image).
 
+mod common;
+
 use assert_cmd::Command;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
@@ -76,12 +78,7 @@ fn assert_pck(s: &ClipScore, floor: f64) {
 /// Tracks the clip rendered into `dir` (PNG frames) from its marks with `params`, two threads,
 /// and scores it against the clip's truth.
 fn track_rendered(dir: &Path, params: TrackerParams) -> ClipScore {
-    let gt = GroundTruth::load(&dir.join("gt.json")).unwrap();
-    let marks = Marks::load(&dir.join("marks.json")).unwrap();
-    let mut video = Video::open(&dir.join("frames"), &OpenOptions::default()).unwrap();
-    let job = TrackJob::from_marks(&marks, params, 2);
-    let out = track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false)).unwrap();
-    score_tracks(&gt, &out.tracks).unwrap()
+    common::track_and_score(dir, &dir.join("frames"), params)
 }
 
 /// Tracks the clip rendered in `dir` with `params`; returns `joint`'s mean error (pixels) and
