@@ -144,6 +144,31 @@ fn bad_marks_are_named_with_the_joint() {
 }
 
 #[test]
+fn a_tracker_setting_out_of_its_range_is_named_with_its_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let video = sample_dir().join("video.mp4");
+    let marks = sample_dir().join("marks.json");
+    let settings = dir.path().join("tracker.json");
+    std::fs::write(&settings, r#"{"short_penalty": -3}"#).unwrap();
+    let ss = settings.to_str().unwrap();
+    let out = dir.path().join("t.json");
+    let args = [
+        "track",
+        video.to_str().unwrap(),
+        "--marks",
+        marks.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--tracker-settings",
+        ss,
+    ];
+    assert_bad(&args, &[ss, "short_penalty", "0 or more", "-3"]);
+    std::fs::write(&settings, r#"{"weights": {"key": 1.5}}"#).unwrap();
+    assert_bad(&args, &[ss, "weights.key", "between 0 and 1"]);
+    assert!(!out.exists());
+}
+
+#[test]
 fn malformed_json_is_named() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("broken.json");

@@ -107,7 +107,7 @@ pub struct TrackArgs {
     /// A ground-truth gt.json to score the tracks against (prints PCK and mean error).
     #[arg(long)]
     pub reference: Option<PathBuf>,
-    /// Tracker settings as JSON (keys of the GUI's tracker panel; missing keys keep defaults).
+    /// Tracker settings as JSON (see docs/formats.md; every field optional, defaults documented).
     #[arg(long)]
     pub tracker_settings: Option<PathBuf>,
 }

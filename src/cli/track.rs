@@ -67,8 +67,13 @@ pub fn track_with_progress(
 pub fn load_settings(path: &Path) -> Result<TrackerParams, ExitError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| ExitError::bad_input(anyhow!("{}: cannot read: {e}", path.display())))?;
-    serde_json::from_str(&text)
-        .map_err(|e| ExitError::bad_input(anyhow!("{}: bad tracker settings: {e}", path.display())))
+    let params: TrackerParams = serde_json::from_str(&text).map_err(|e| {
+        ExitError::bad_input(anyhow!("{}: bad tracker settings: {e}", path.display()))
+    })?;
+    params
+        .validate()
+        .map_err(|e| ExitError::bad_input(anyhow!("{}: {e}", path.display())))?;
+    Ok(params)
 }
 
 /// Prints the weak spans (the tracking report).

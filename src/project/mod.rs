@@ -165,6 +165,10 @@ impl Project {
             )));
         }
         raw.settings
+            .tracker
+            .validate()
+            .map_err(|e| invalid(format!("settings.tracker: {e}")))?;
+        raw.settings
             .lift
             .validate()
             .map_err(|e| invalid(format!("settings.lift: {e}")))?;
@@ -311,6 +315,12 @@ mod tests {
             (
                 base.replace("\"contact\": 10.0", "\"contact\": -1.0"),
                 "ambiguity.contact",
+            ),
+            // The tracker's settings are checked too (a length range of 1 or more would let a
+            // limb's block shrink to nothing).
+            (
+                base.replace("\"limb_range_m\": 0.3", "\"limb_range_m\": 1.5"),
+                "settings.tracker: tracker setting \"limb_range_m\"",
             ),
         ];
         for (text, needle) in cases {

@@ -1,6 +1,7 @@
 //! The tracker's settings, each with its default and what it does (the GUI shows these as
 //! tooltips).
 
+use super::run::TrackError;
 use super::similarity::SimilarityWeights;
 use serde::{Deserialize, Serialize};
 
@@ -163,6 +164,260 @@ impl Default for TrackerParams {
             upper_arm_short_penalty: 35.0,
             chain_refine: true,
             shoulder_spring: 0.05,
+        }
+    }
+}
+
+/// The range a setting must lie in to mean something.
+#[derive(Debug, Clone, Copy)]
+enum Range {
+    /// Finite and above 0.
+    Positive,
+    /// Finite, 0 or more.
+    NonNegative,
+    /// Finite, 0 or more, below 1 (a fraction taken off a length, which must stay positive).
+    Fraction,
+    /// Between 0 and 1, both included.
+    Unit,
+    /// Above 0 and at most 180 (an angle between two directions, degrees).
+    HalfTurn,
+}
+
+impl Range {
+    fn holds(self, v: f64) -> bool {
+        v.is_finite()
+            && match self {
+                Range::Positive => v > 0.0,
+                Range::NonNegative => v >= 0.0,
+                Range::Fraction => (0.0..1.0).contains(&v),
+                Range::Unit => (0.0..=1.0).contains(&v),
+                Range::HalfTurn => v > 0.0 && v <= 180.0,
+            }
+    }
+
+    fn want(self) -> &'static str {
+        match self {
+            Range::Positive => "a finite number above 0",
+            Range::NonNegative => "a finite number, 0 or more",
+            Range::Fraction => "0 or more and below 1",
+            Range::Unit => "between 0 and 1",
+            Range::HalfTurn => "above 0 and at most 180",
+        }
+    }
+}
+
+fn check(name: &'static str, value: f64, range: Range) -> Result<(), TrackError> {
+    if range.holds(value) {
+        Ok(())
+    } else {
+        Err(TrackError::BadSetting {
+            name,
+            value,
+            want: range.want(),
+        })
+    }
+}
+
+impl SimilarityWeights {
+    /// Checks the weights: none negative, the centre and margin not both 0 (eq. 4 would divide
+    /// by 0), the key-frame mix a share.
+    pub fn validate(&self) -> Result<(), TrackError> {
+        // Destructured so that a new weight cannot be left unchecked.
+        let SimilarityWeights {
+            rgb,
+            centre,
+            margin,
+            key,
+        } = *self;
+        for (name, w) in ["weights.rgb[0]", "weights.rgb[1]", "weights.rgb[2]"]
+            .into_iter()
+            .zip(rgb)
+        {
+            check(name, w.into(), Range::NonNegative)?;
+        }
+        check(
+            "weights.rgb (sum)",
+            rgb.iter().sum::<f32>().into(),
+            Range::Positive,
+        )?;
+        check("weights.centre", centre.into(), Range::NonNegative)?;
+        check("weights.margin", margin.into(), Range::NonNegative)?;
+        check(
+            "weights.centre + weights.margin",
+            (centre + margin).into(),
+            Range::Positive,
+        )?;
+        check("weights.key", key.into(), Range::Unit)
+    }
+}
+
+impl TrackerParams {
+    /// Checks every setting is in the range it means something in (a settings file or a
+    /// project can hold anything): steps and scales above 0, penalties, times and margins not
+    /// negative, shares between 0 and 1, length ranges below 1 (a length must stay positive).
+    pub fn validate(&self) -> Result<(), TrackError> {
+        use Range::{Fraction, HalfTurn, NonNegative, Positive, Unit};
+        // Destructured so that a new setting cannot be left unchecked.
+        let TrackerParams {
+            weights,
+            head_step_px,
+            head_d_theta_deg,
+            head_d_m,
+            head_max_rings: _,
+            trunk_range_deg,
+            trunk_range_m,
+            limb_range_deg,
+            limb_range_m,
+            wide_range_deg,
+            coarse_step_deg,
+            angle_penalty,
+            length_penalty,
+            velocity_damping,
+            update_rate,
+            reliability_c0,
+            weak_reliability,
+            max_gap_s,
+            twin_merge_s,
+            twin_guard_torso,
+            working_stature_px,
+            decoder_scaling: _,
+            block_width_scale,
+            parallel: _,
+            hip_patch: _,
+            hip_margin,
+            fold_limit_deg,
+            short_penalty,
+            upper_arm_short_penalty,
+            chain_refine: _,
+            shoulder_spring,
+        } = *self;
+        weights.validate()?;
+        let checks: [(&'static str, f64, Range); 25] = [
+            ("head_step_px", head_step_px, Positive),
+            ("head_d_theta_deg", head_d_theta_deg, NonNegative),
+            ("head_d_m", head_d_m, Fraction),
+            ("trunk_range_deg", trunk_range_deg, NonNegative),
+            ("trunk_range_m", trunk_range_m, Fraction),
+            ("limb_range_deg", limb_range_deg, NonNegative),
+            ("limb_range_m", limb_range_m, Fraction),
+            ("wide_range_deg", wide_range_deg, NonNegative),
+            ("coarse_step_deg", coarse_step_deg, Positive),
+            ("angle_penalty", angle_penalty.into(), NonNegative),
+            ("length_penalty", length_penalty.into(), NonNegative),
+            ("velocity_damping", velocity_damping, Unit),
+            ("update_rate", update_rate.into(), Unit),
+            ("reliability_c0", reliability_c0.into(), Positive),
+            ("weak_reliability", weak_reliability.into(), Unit),
+            ("max_gap_s", max_gap_s, NonNegative),
+            ("twin_merge_s", twin_merge_s, NonNegative),
+            ("twin_guard_torso", twin_guard_torso, NonNegative),
+            ("working_stature_px", working_stature_px, NonNegative),
+            ("block_width_scale", block_width_scale, Positive),
+            ("hip_margin", hip_margin.into(), NonNegative),
+            ("fold_limit_deg", fold_limit_deg, HalfTurn),
+            ("short_penalty", short_penalty.into(), NonNegative),
+            (
+                "upper_arm_short_penalty",
+                upper_arm_short_penalty.into(),
+                NonNegative,
+            ),
+            ("shoulder_spring", shoulder_spring.into(), NonNegative),
+        ];
+        checks
+            .into_iter()
+            .try_for_each(|(name, value, range)| check(name, value, range))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_defaults_are_valid() {
+        assert!(TrackerParams::default().validate().is_ok());
+    }
+
+    #[test]
+    fn the_documented_defaults_are_the_defaults() {
+        let doc = include_str!("../../docs/formats.md");
+        let section = doc
+            .split("## tracker settings")
+            .nth(1)
+            .expect("docs/formats.md has a tracker settings section");
+        let json = section
+            .split("```json")
+            .nth(1)
+            .and_then(|s| s.split("```").next())
+            .expect("the section has a JSON block");
+        let documented: TrackerParams = serde_json::from_str(json).unwrap();
+        // The document rounds the thirds.
+        assert!(documented.weights.rgb.iter().all(|w| (w - 1.0 / 3.0).abs() < 1e-3));
+        let rounded = TrackerParams {
+            weights: SimilarityWeights {
+                rgb: documented.weights.rgb,
+                ..SimilarityWeights::default()
+            },
+            ..TrackerParams::default()
+        };
+        assert_eq!(documented, rounded);
+    }
+
+    #[test]
+    fn a_setting_out_of_its_range_is_named() {
+        let cases: [(&str, TrackerParams); 6] = [
+            (
+                "short_penalty",
+                TrackerParams {
+                    short_penalty: -1.0,
+                    ..Default::default()
+                },
+            ),
+            (
+                "upper_arm_short_penalty",
+                TrackerParams {
+                    upper_arm_short_penalty: f32::NAN,
+                    ..Default::default()
+                },
+            ),
+            (
+                "limb_range_m",
+                TrackerParams {
+                    limb_range_m: 1.0,
+                    ..Default::default()
+                },
+            ),
+            (
+                "coarse_step_deg",
+                TrackerParams {
+                    coarse_step_deg: 0.0,
+                    ..Default::default()
+                },
+            ),
+            (
+                "fold_limit_deg",
+                TrackerParams {
+                    fold_limit_deg: 200.0,
+                    ..Default::default()
+                },
+            ),
+            (
+                "weights.centre + weights.margin",
+                TrackerParams {
+                    weights: SimilarityWeights {
+                        centre: 0.0,
+                        margin: 0.0,
+                        ..Default::default()
+                    },
+                    ..Default::default()
+                },
+            ),
+        ];
+        for (name, params) in cases {
+            match params.validate() {
+                Err(TrackError::BadSetting { name: got, .. }) => assert_eq!(got, name),
+                other => panic!("{name}: expected a bad setting, got {other:?}"),
+            }
         }
     }
 }

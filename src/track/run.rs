@@ -81,6 +81,12 @@ pub enum TrackError {
     NoEarlierResult { frame: usize },
     #[error("{path}: frame {frame}, where tracking starts, could not be decoded (damaged file?)")]
     StartFrameDamaged { path: PathBuf, frame: usize },
+    #[error("tracker setting \"{name}\" must be {want}, got {value}")]
+    BadSetting {
+        name: &'static str,
+        value: f64,
+        want: &'static str,
+    },
     #[error("cancelled")]
     Cancelled,
 }
@@ -187,6 +193,7 @@ pub fn track_video(
     progress: &mut (dyn FnMut(&TrackProgress) + Send),
     cancel: &AtomicBool,
 ) -> Result<TrackOutput, TrackError> {
+    job.params.validate()?;
     let info = video.info().clone();
     let out = track_at_working_scale(video, &info, job, progress, cancel);
     if (video.info().width, video.info().height) != (info.width, info.height) {
