@@ -113,6 +113,12 @@ pub struct TrackerParams {
     /// trunk for the whole clip (172 → 269 mm; a near tie between two calibrations); at 35 it
     /// is 156 mm. With the stronger pull in the chain refinement too, all limbs at 24 cost the
     /// suite's seated and raised-camera legs (0.878), the forearms too its swinging arms (0.900).
+    /// Also tried: the upper arm keeping only the ordinary pull while its forearm was shorter
+    /// than a share of its full length on the frame before (an arm pointing at the camera:
+    /// dribble_oblique's right arm is lost from frame 40). At shares 0.6 / 0.65 / 0.7 / 0.75 /
+    /// 0.9 the suite was 0.903 / 0.903 / 0.906 / 0.906 / 0.906 and the real sample 0.825 /
+    /// 0.828 / 0.791 / 0.791 / 0.763: dribble_oblique came right (0.939 → 0.99) only where the
+    /// real sample fell below 0.80.
     /// Default 35.
     pub upper_arm_short_penalty: f32,
     /// Refine each limb chain as one figure after its segments are found (beyond the paper):
@@ -127,6 +133,20 @@ pub struct TrackerParams {
     /// on the trunk. Where the shoulders truly stay put (the synthetic suite's bodies) it moves
     /// them by about a pixel, and the lift, which holds the shoulders and chest as a rigid
     /// triangle, feels that: there 0 gives the better 3D.
+    ///
+    /// What is left: in a side view the far shoulder is hidden in the trunk, and as the
+    /// walker crosses the image the shoulders' image separation turns from −20 to +15 px
+    /// (walk_across_side), which the rigid trunk cannot follow (its right shoulder PCK@0.2
+    /// 0.60, run_side 0.46). Tried and not kept (suite / real sample PCK@0.2, against 0.903 /
+    /// 0.805): the shoulders' shifts across the trunk made mirror images of each other, both
+    /// averaged 0.904 / 0.739, weighted by the upper arms' reliabilities 0.905 / 0.739 (to the
+    /// 4th power 0.906 / 0.748), or the less reliable arm's shoulder mirroring the other's
+    /// 0.910 / 0.750 (at a reliability margin of 0.05; 0.2: 0.904 / 0.805). The far shoulders
+    /// came right (run_side's 0.46 → 1.00), but on the real sample a raised arm's shoulder
+    /// rises and the mirror then pulled the hanging arm's shoulder inwards, off its arm (left
+    /// elbow PCK@0.2 0.78 → 0.12); gating it to side views by the shoulders' image separation
+    /// did not separate the clips (the real sample's ratio to the trunk 0.30–0.46, the side
+    /// views' 0.22–0.32).
     pub shoulder_spring: f32,
 }
 
@@ -352,7 +372,13 @@ mod tests {
             .expect("the section has a JSON block");
         let documented: TrackerParams = serde_json::from_str(json).unwrap();
         // The document rounds the thirds.
-        assert!(documented.weights.rgb.iter().all(|w| (w - 1.0 / 3.0).abs() < 1e-3));
+        assert!(
+            documented
+                .weights
+                .rgb
+                .iter()
+                .all(|w| (w - 1.0 / 3.0).abs() < 1e-3)
+        );
         let rounded = TrackerParams {
             weights: SimilarityWeights {
                 rgb: documented.weights.rgb,
