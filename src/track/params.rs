@@ -391,52 +391,23 @@ mod tests {
 
     #[test]
     fn a_setting_out_of_its_range_is_named() {
+        let with = |edit: fn(&mut TrackerParams)| {
+            let mut p = TrackerParams::default();
+            edit(&mut p);
+            p
+        };
         let cases: [(&str, TrackerParams); 6] = [
-            (
-                "short_penalty",
-                TrackerParams {
-                    short_penalty: -1.0,
-                    ..Default::default()
-                },
-            ),
+            ("short_penalty", with(|p| p.short_penalty = -1.0)),
             (
                 "upper_arm_short_penalty",
-                TrackerParams {
-                    upper_arm_short_penalty: f32::NAN,
-                    ..Default::default()
-                },
+                with(|p| p.upper_arm_short_penalty = f32::NAN),
             ),
-            (
-                "limb_range_m",
-                TrackerParams {
-                    limb_range_m: 1.0,
-                    ..Default::default()
-                },
-            ),
-            (
-                "coarse_step_deg",
-                TrackerParams {
-                    coarse_step_deg: 0.0,
-                    ..Default::default()
-                },
-            ),
-            (
-                "fold_limit_deg",
-                TrackerParams {
-                    fold_limit_deg: 200.0,
-                    ..Default::default()
-                },
-            ),
+            ("limb_range_m", with(|p| p.limb_range_m = 1.0)),
+            ("coarse_step_deg", with(|p| p.coarse_step_deg = 0.0)),
+            ("fold_limit_deg", with(|p| p.fold_limit_deg = 200.0)),
             (
                 "weights.centre + weights.margin",
-                TrackerParams {
-                    weights: SimilarityWeights {
-                        centre: 0.0,
-                        margin: 0.0,
-                        ..Default::default()
-                    },
-                    ..Default::default()
-                },
+                with(|p| (p.weights.centre, p.weights.margin) = (0.0, 0.0)),
             ),
         ];
         for (name, params) in cases {
