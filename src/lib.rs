@@ -17,5 +17,6 @@ pub mod video;
 pub mod export;
 pub mod lift;
 pub mod project;
+mod setting_range;
 pub mod track;
 pub mod volume;

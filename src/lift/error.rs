@@ -1,5 +1,6 @@
 //! Why a lift could not run.
 
+use crate::setting_range::Range;
 use crate::skeleton::{Joint, ProportionsError};
 
 /// Errors of the 3D reconstruction. Frames that are merely hard (Newton not converging, a bone
@@ -44,18 +45,18 @@ pub(crate) fn check_setting(
     value: f64,
     positive: bool,
 ) -> Result<(), LiftError> {
-    let ok = value.is_finite() && if positive { value > 0.0 } else { value >= 0.0 };
-    if ok {
+    let range = if positive {
+        Range::Positive
+    } else {
+        Range::NonNegative
+    };
+    if range.holds(value) {
         Ok(())
     } else {
         Err(LiftError::BadSetting {
             name,
             value,
-            want: if positive {
-                "a finite number above 0"
-            } else {
-                "a finite number, 0 or more"
-            },
+            want: range.want(),
         })
     }
 }

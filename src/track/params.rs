@@ -3,6 +3,7 @@
 
 use super::run::TrackError;
 use super::similarity::SimilarityWeights;
+use crate::setting_range::Range;
 use serde::{Deserialize, Serialize};
 
 /// Settings of the VBA tracker. Serialised as JSON (`--tracker-settings`); missing keys take
@@ -184,44 +185,6 @@ impl Default for TrackerParams {
             upper_arm_short_penalty: 35.0,
             chain_refine: true,
             shoulder_spring: 0.05,
-        }
-    }
-}
-
-/// The range a setting must lie in to mean something.
-#[derive(Debug, Clone, Copy)]
-enum Range {
-    /// Finite and above 0.
-    Positive,
-    /// Finite, 0 or more.
-    NonNegative,
-    /// Finite, 0 or more, below 1 (a fraction taken off a length, which must stay positive).
-    Fraction,
-    /// Between 0 and 1, both included.
-    Unit,
-    /// Above 0 and at most 180 (an angle between two directions, degrees).
-    HalfTurn,
-}
-
-impl Range {
-    fn holds(self, v: f64) -> bool {
-        v.is_finite()
-            && match self {
-                Range::Positive => v > 0.0,
-                Range::NonNegative => v >= 0.0,
-                Range::Fraction => (0.0..1.0).contains(&v),
-                Range::Unit => (0.0..=1.0).contains(&v),
-                Range::HalfTurn => v > 0.0 && v <= 180.0,
-            }
-    }
-
-    fn want(self) -> &'static str {
-        match self {
-            Range::Positive => "a finite number above 0",
-            Range::NonNegative => "a finite number, 0 or more",
-            Range::Fraction => "0 or more and below 1",
-            Range::Unit => "between 0 and 1",
-            Range::HalfTurn => "above 0 and at most 180",
         }
     }
 }
