@@ -61,7 +61,18 @@ pub struct AmbiguityWeights {
     /// that nothing else tells apart). `bench lift`'s suite, exact 2D and true lengths (before
     /// the spine's lean, `SPINE_BACK`), at 0.05 / 0.1 / 0.2 / 0.3: 19.3 / 18.1 / 18.0 / 19.1 mm
     /// (0 gives 20.3; at 0.3 the side view's bow, whose hanging arms point along the trunk's
-    /// forward direction, turns its arms backwards).
+    /// forward direction, turns its arms backwards). What it gets wrong: sit_down_frontal's arms
+    /// reach forwards as the body sits (0.6 rad at the seat), and the mirror root, tilted 0.3
+    /// back, pays less here (0.0009 against 0.0031 on the deepest frame) and in
+    /// [`AmbiguityWeights::hanging`] (0.0006 against 0.0017), so 45 of its 88 elbow-frames per arm are
+    /// wrong. Tried and not kept (the suite from exact 2D with true lengths, wrong roots
+    /// against 4.65 %):
+    /// - This prior for raised arms only (fading out as the arm hangs, from sines of 0.3 /
+    ///   0.5 / 0.7 / 0.9): 4.85 / 4.78 / 4.80 / 4.74 %, sit_down_frontal unchanged.
+    /// - An extra cost on upper arms swung behind the trunk's frontal plane, at 0.1 / 0.3 / 1:
+    ///   5.03 / 5.56 / 8.63 %. At 1 sit_down_frontal went 19.4 → 1.7 mm, but
+    ///   jumping_jacks_frontal went 7.8 → 32.8 and walk_toward_frontal 14.9 → 29.1. Counted only
+    ///   beyond a sine of 0.3, it gave 5.23 %, sit_down_frontal unchanged.
     pub frontal: f64,
     /// In a walking or running stride (the thighs split forwards and backwards), each arm
     /// swings against its own thigh (the left arm forward with the right leg): the arm

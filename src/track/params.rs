@@ -147,7 +147,11 @@ pub struct TrackerParams {
     /// rises and the mirror then pulled the hanging arm's shoulder inwards, off its arm (left
     /// elbow PCK@0.2 0.78 → 0.12); gating it to side views by the shoulders' image separation
     /// did not separate the clips (the real sample's ratio to the trunk 0.30–0.46, the side
-    /// views' 0.22–0.32).
+    /// views' 0.22–0.32). Mirroring only the shift across the trunk (not along it), and only
+    /// while both upper arms hang (within 37° of the trunk, or 60°), still lost the real
+    /// sample's left arm: 0.906 / 0.753 at a margin of 0.05, 0.906 / 0.747 at 0.1, 0.904 /
+    /// 0.805 at 0.2. Four mirrored frames, the largest moving the left shoulder about 11 px
+    /// outwards, were enough (left elbow 0.78 → 0.12).
     pub shoulder_spring: f32,
 }
 
