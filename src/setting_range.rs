@@ -18,7 +18,7 @@ pub(crate) enum Range {
 
 impl Range {
     /// Whether `v` lies in the range.
-    pub(crate) fn holds(self, v: f64) -> bool {
+    fn holds(self, v: f64) -> bool {
         v.is_finite()
             && match self {
                 Range::Positive => v > 0.0,
@@ -29,8 +29,18 @@ impl Range {
             }
     }
 
+    /// `Ok` when `v` lies in the range, else the range in words (for the caller's own typed
+    /// error).
+    pub(crate) fn check(self, v: f64) -> Result<(), &'static str> {
+        if self.holds(v) {
+            Ok(())
+        } else {
+            Err(self.want())
+        }
+    }
+
     /// The range in words, for an error message.
-    pub(crate) fn want(self) -> &'static str {
+    fn want(self) -> &'static str {
         match self {
             Range::Positive => "a finite number above 0",
             Range::NonNegative => "a finite number, 0 or more",

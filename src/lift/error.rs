@@ -50,13 +50,7 @@ pub(crate) fn check_setting(
     } else {
         Range::NonNegative
     };
-    if range.holds(value) {
-        Ok(())
-    } else {
-        Err(LiftError::BadSetting {
-            name,
-            value,
-            want: range.want(),
-        })
-    }
+    range
+        .check(value)
+        .map_err(|want| LiftError::BadSetting { name, value, want })
 }

@@ -194,15 +194,9 @@ impl Default for TrackerParams {
 }
 
 fn check(name: &'static str, value: f64, range: Range) -> Result<(), TrackError> {
-    if range.holds(value) {
-        Ok(())
-    } else {
-        Err(TrackError::BadSetting {
-            name,
-            value,
-            want: range.want(),
-        })
-    }
+    range
+        .check(value)
+        .map_err(|want| TrackError::BadSetting { name, value, want })
 }
 
 impl SimilarityWeights {
