@@ -258,9 +258,9 @@ fn joints_leaving_the_frame_are_tracked_and_exported_consistently() {
     assert_eq!(csv_flagged(&csv_path, "off_frame"), off_set, "tracks CSV");
     assert_eq!(csv_flagged(&csv_path, "lost"), lost_set, "tracks CSV");
     let text = std::fs::read_to_string(&csv_path).unwrap();
-    for row in text.lines().filter(|r| r.ends_with(",1,0")) {
+    for row in text.lines().filter(|r| r.ends_with(",1,0,0")) {
         // off the frame: confidence 0, not interpolated
-        assert!(row.ends_with(",0.000,0,1,0"), "{row}");
+        assert!(row.ends_with(",0.000,0,1,0,0"), "{row}");
     }
 
     // 4. The lift flags them; the 3D exports carry the flags.

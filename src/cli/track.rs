@@ -8,7 +8,9 @@ use std::sync::atomic::AtomicBool;
 use videomocap::eval::score_tracks;
 use videomocap::formats::Marks;
 use videomocap::synth::GroundTruth;
-use videomocap::track::{SpanKind, TrackError, TrackJob, TrackOutput, TrackerParams, track_video};
+use videomocap::track::{
+    LimbPair, SpanKind, TrackError, TrackJob, TrackOutput, TrackerParams, track_video,
+};
 use videomocap::video::{OpenOptions, Video};
 
 /// Opens the video and marks and checks that they fit together.
@@ -88,18 +90,36 @@ pub fn report(out: &TrackOutput, global: &GlobalArgs) {
         .iter()
         .filter(|s| s.kind != SpanKind::Interpolated)
         .collect();
-    let off_frame = weak.iter().filter(|s| s.kind == SpanKind::OffFrame).count();
+    let count = |kind| weak.iter().filter(|s| s.kind == kind).count();
     say(
         global,
         &format!(
-            "{} frames tracked (working scale 1/{:.2}); {} short weak runs interpolated, {} weak spans left for review ({} of them off the frame)",
+            "{} frames tracked (working scale 1/{:.2}); {} short weak runs interpolated, {} weak spans left for review ({} of them off the frame, {} completed from the gait)",
             out.tracks.frames.len(),
             out.shrink,
             interpolated,
             weak.len(),
-            off_frame
+            count(SpanKind::OffFrame),
+            count(SpanKind::Gait),
         ),
     );
+    for g in out.gait.iter().filter(|g| g.completed > 0) {
+        let far = if g.donor == "left" { "right" } else { "left" };
+        say(
+            global,
+            &format!(
+                "  gait: {} joint-frames of the {far} {} completed from the {} side's stride (period {:.2} s, median disagreement {:.2} torso)",
+                g.completed,
+                match g.limbs {
+                    LimbPair::Arms => "arm",
+                    LimbPair::Legs => "leg",
+                },
+                g.donor,
+                g.period_s.unwrap_or(0.0),
+                g.disagreement.unwrap_or(0.0),
+            ),
+        );
+    }
     if let (Some(first), Some(last)) = (out.damaged.first(), out.damaged.last()) {
         let place = if first == last {
             format!("frame {first}")
@@ -118,7 +138,7 @@ pub fn report(out: &TrackOutput, global: &GlobalArgs) {
         say(
             global,
             &format!(
-                "  {:<9}  {:<15} frames {}–{} (lowest reliability {:.2})",
+                "  {:<14}  {:<15} frames {}–{} (lowest reliability {:.2})",
                 format!("{}:", s.kind),
                 s.joint,
                 s.start,

@@ -1,5 +1,6 @@
 //! `tracks2d.json`: the tracker's output, every joint's image position per frame with its
-//! reliability and whether it was interpolated or off the frame.
+//! reliability and its state: tracked, interpolated, off the frame, lost or completed from the
+//! gait.
 
 use super::{
     FormatError, check_frame_order, check_header_up_to, joint_columns, joint_names, parse_json,
@@ -14,9 +15,10 @@ use std::path::{Path, PathBuf};
 /// The `format` tag of tracks2d files.
 pub const TRACKS2D_FORMAT: &str = "videomocap.tracks2d";
 
-/// The tracks2d version this build writes (it reads 1 and 2). Version 2 added `off_frame`:
-/// a version 1 reader would refuse its points outside the frame.
-pub const TRACKS2D_VERSION: u32 = 2;
+/// The tracks2d version this build writes (it reads 1 to 3). Version 2 added `off_frame` (a
+/// version 1 reader would refuse its points outside the frame) and `lost`; version 3 added
+/// `gait` (a version 2 reader would take those points for tracked ones).
+pub const TRACKS2D_VERSION: u32 = 3;
 
 /// The video the tracks belong to.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -46,6 +48,9 @@ pub enum PointSource {
     /// In a weak run too long to interpolate (or at an end of the video): the position is the
     /// tracker's guess, to be checked (a long occlusion, or a lost joint).
     Lost,
+    /// Completed from the gait (beyond the paper, [`crate::track::gait`]): a far limb hidden
+    /// in a side view, put where the other side's limb was half a stride earlier and later.
+    Gait,
 }
 
 /// One joint in one frame.
@@ -89,6 +94,9 @@ struct FrameFile {
     /// Version 2; omitted when no joint of the frame is lost.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     lost: Option<Vec<bool>>,
+    /// Version 3; omitted when no joint of the frame was completed from the gait.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    gait: Option<Vec<bool>>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -135,12 +143,14 @@ impl Tracks2d {
             let n = raw.joints.len();
             let off_frame = f.off_frame.unwrap_or_else(|| vec![false; n]);
             let lost = f.lost.unwrap_or_else(|| vec![false; n]);
+            let gait = f.gait.unwrap_or_else(|| vec![false; n]);
             for (field, found) in [
                 ("points", f.points.len()),
                 ("confidence", f.confidence.len()),
                 ("interpolated", f.interpolated.len()),
                 ("off_frame", off_frame.len()),
                 ("lost", lost.len()),
+                ("gait", gait.len()),
             ] {
                 if found != n {
                     return Err(FormatError::WrongLength {
@@ -195,6 +205,8 @@ impl Tracks2d {
                     Some("is marked off_frame with a confidence other than 0")
                 } else if lost[col] && (off_frame[col] || f.interpolated[col]) {
                     Some("is marked lost and also off_frame or interpolated")
+                } else if gait[col] && (off_frame[col] || f.interpolated[col] || lost[col]) {
+                    Some("is marked gait and also off_frame, interpolated or lost")
                 } else {
                     None
                 };
@@ -214,6 +226,8 @@ impl Tracks2d {
                         PointSource::OffFrame
                     } else if lost[col] {
                         PointSource::Lost
+                    } else if gait[col] {
+                        PointSource::Gait
                     } else if f.interpolated[col] {
                         PointSource::Interpolated
                     } else {
@@ -269,6 +283,7 @@ impl Tracks2d {
                         .collect(),
                     off_frame: flags(f, PointSource::OffFrame),
                     lost: flags(f, PointSource::Lost),
+                    gait: flags(f, PointSource::Gait),
                 })
                 .collect(),
         }
@@ -344,11 +359,12 @@ mod tests {
         assert_eq!(t, sample());
     }
 
-    /// The sample with the left wrist off the frame (left of the image) in frame 1 and the
-    /// right wrist lost in frame 0.
+    /// The sample with the left wrist off the frame (left of the image) in frame 1, the
+    /// right wrist lost in frame 0 and the right knee completed from the gait in frame 0.
     fn with_off_frame() -> Tracks2d {
         let mut t = sample();
         t.frames[0].points[Joint::RightWrist].source = PointSource::Lost;
+        t.frames[0].points[Joint::RightKnee].source = PointSource::Gait;
         t.frames[1].points[Joint::LeftWrist] = TrackedPoint {
             pos: Point2::new(-40.0, 200.0),
             confidence: 0.0,
@@ -358,15 +374,18 @@ mod tests {
     }
 
     #[test]
-    fn off_frame_points_round_trip_as_version_2() {
+    fn off_frame_lost_and_gait_points_round_trip_as_version_3() {
         let (_dir, path, v) = saved_json(&with_off_frame());
-        assert_eq!(v["version"], 2);
+        assert_eq!(v["version"], 3);
         // Only the frame with an off-frame (lost) joint carries the array.
         assert!(v["frames"][0].get("off_frame").is_none());
         assert_eq!(v["frames"][1]["off_frame"][6], true);
         assert_eq!(v["frames"][1]["off_frame"][5], false);
         assert!(v["frames"][1].get("lost").is_none());
         assert_eq!(v["frames"][0]["lost"][9], true);
+        assert!(v["frames"][1].get("gait").is_none());
+        assert_eq!(v["frames"][0]["gait"][14], true);
+        assert_eq!(v["frames"][0]["gait"][9], false);
         assert_eq!(Tracks2d::load(&path).unwrap(), with_off_frame());
     }
 
@@ -375,12 +394,12 @@ mod tests {
         let (_dir, path, mut v) = saved_json(&sample());
         v["version"] = serde_json::json!(1);
         assert_eq!(Tracks2d::parse(&v.to_string(), &path).unwrap(), sample());
-        v["version"] = serde_json::json!(3);
+        v["version"] = serde_json::json!(4);
         let err = Tracks2d::parse(&v.to_string(), &path)
             .unwrap_err()
             .to_string();
         assert!(
-            err.contains("t.json") && err.contains("version 3") && err.contains("up to version 2"),
+            err.contains("t.json") && err.contains("version 4") && err.contains("up to version 3"),
             "{err}"
         );
     }
@@ -392,7 +411,7 @@ mod tests {
         with_off_frame().save(&path).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         let base: serde_json::Value = serde_json::from_str(&text).unwrap();
-        let cases: [(&str, serde_json::Value, &str); 4] = [
+        let cases: [(&str, serde_json::Value, &str); 5] = [
             (
                 "points",
                 serde_json::json!([100.0, 200.0]),
@@ -409,11 +428,12 @@ mod tests {
                 "both off_frame and interpolated",
             ),
             ("lost", serde_json::json!(true), "lost and also off_frame"),
+            ("gait", serde_json::json!(true), "gait and also off_frame"),
         ];
         for (field, value, says) in cases {
             let mut v = base.clone();
-            if field == "lost" {
-                v["frames"][1]["lost"] = serde_json::json!(vec![false; 16]);
+            if field == "lost" || field == "gait" {
+                v["frames"][1][field] = serde_json::json!(vec![false; 16]);
             }
             v["frames"][1][field][6] = value;
             let err = Tracks2d::parse(&v.to_string(), &path)

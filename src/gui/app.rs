@@ -1327,6 +1327,8 @@ impl App {
                 // The spring is part of the chain refinement: greyed out without it.
                 ui.add_enabled(t.chain_refine, egui::Slider::new(&mut t.shoulder_spring, 0.0..=0.5).text("shoulder spring"))
                     .on_hover_text(format!("Cost per square pixel that a shoulder pays for leaving the place the rigid trunk gives it, so it can rise with a raised arm (part of the chain refinement); higher holds it closer; 0 holds it on the trunk; default {}", d.shoulder_spring));
+                ui.checkbox(&mut t.gait_completion, "complete hidden limbs from the gait")
+                    .on_hover_text(format!("In a walk or run seen from the side, the far arm's and leg's joints that are weak, or far from where the near limb was half a stride earlier and later, are put there (pink) for you to check; default {}", if d.gait_completion { "on" } else { "off" }));
                 if ui.button("Defaults").clicked() {
                     *t = d;
                 }
@@ -2198,6 +2200,31 @@ mod tests {
         assert_eq!((arms(&h), pull(&h)), (12.0, default));
         h.state_mut().undo();
         assert_eq!(arms(&h), TrackerParams::default().upper_arm_short_penalty);
+    }
+
+    /// Gait completion can be turned off from the Parameters panel, and that is an undoable
+    /// project setting.
+    #[test]
+    fn gait_completion_is_switched_in_the_tracker_settings() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut h = with_project(dir.path());
+        let on = |h: &Harness<'static, App>| {
+            h.state()
+                .project()
+                .unwrap()
+                .settings
+                .tracker
+                .gait_completion
+        };
+        assert!(on(&h));
+        h.get_by_label("Tracker").click();
+        h.run();
+        h.get_by_label("complete hidden limbs from the gait")
+            .click();
+        h.run();
+        assert!(!on(&h));
+        h.state_mut().undo();
+        assert!(on(&h));
     }
 
     /// The tracker's hip patch can be turned off from the Parameters panel, and that is an

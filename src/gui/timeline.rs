@@ -110,7 +110,7 @@ pub fn show(
         let k = ((pos.x - rail_left) / span * last).round();
         jump = Some((k.max(0.0) as usize).min(frames.saturating_sub(1)));
     }
-    response.on_hover_text("one strip per joint, top to bottom in model order: white key frame, green tracked, orange weak, blue interpolated, purple off the frame, red lost; click to jump");
+    response.on_hover_text("one strip per joint, top to bottom in model order: white key frame, green tracked, orange weak, blue interpolated, purple off the frame, red lost, pink from the gait; click to jump");
     jump
 }
 
@@ -123,13 +123,14 @@ mod tests {
 
     #[test]
     fn strips_colour_each_state() {
-        // Left wrist: tracked, weak, interpolated, off the frame, lost.
+        // Left wrist: tracked, weak, interpolated, off the frame, lost, from the gait.
         let states = [
             (0.9, PointSource::Tracked),
             (0.2, PointSource::Tracked),
             (0.2, PointSource::Interpolated),
             (0.0, PointSource::OffFrame),
             (0.1, PointSource::Lost),
+            (0.5, PointSource::Gait),
         ];
         let tracks = Tracks2d {
             source: SourceInfo {
@@ -173,6 +174,7 @@ mod tests {
                 PointState::Interpolated.colour(),
                 PointState::OffFrame.colour(),
                 PointState::Lost.colour(),
+                PointState::Gait.colour(),
             ]
         );
     }

@@ -165,10 +165,10 @@ pub struct Refined {
 }
 
 /// The weight of a track point in the reprojection term: its confidence (at least 0.05), halved
-/// when it was interpolated.
+/// when it was interpolated or completed from the gait (not seen there).
 pub fn track_weight(p: &TrackedPoint) -> f64 {
     let c = f64::from(p.confidence).clamp(0.05, 1.0);
-    if p.source == PointSource::Interpolated {
+    if matches!(p.source, PointSource::Interpolated | PointSource::Gait) {
         0.5 * c
     } else {
         c

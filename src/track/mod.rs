@@ -10,10 +10,12 @@
 //! - [`search`]: the spiral search path (Fig. 6) and the anchored angular search
 //! - [`body`]: the top-down tracker (head → trunk → limbs)
 //! - [`occlusion`]: interpolation over weak runs, the weak-span report
+//! - [`gait`]: the hidden far limbs of a walk or run completed from the other side
 //! - [`run`]: passes over a video, key frames, re-tracking
 
 pub mod block;
 pub mod body;
+pub mod gait;
 pub mod head;
 pub mod occlusion;
 pub mod params;
@@ -21,6 +23,7 @@ pub mod run;
 pub mod search;
 pub mod similarity;
 
+pub use gait::{GaitReport, LimbPair};
 pub use occlusion::{SpanKind, WeakSpan, weak_spans};
 pub use params::TrackerParams;
 pub use run::{KeyFrames, TrackError, TrackJob, TrackOutput, TrackProgress, track_video};

@@ -10,7 +10,8 @@
 //! thread while the tracker works, unless one thread is asked for.
 
 use super::body::{BodyTracker, JointResult, stature_px};
-use super::occlusion::{WeakSpan, fill_weak_runs, weaken_merged_twins};
+use super::gait::{GaitReport, complete_gaits};
+use super::occlusion::{WeakSpan, fill_weak_runs, weak_spans, weaken_merged_twins};
 use super::params::TrackerParams;
 use crate::camera::point_in_frame;
 use crate::formats::{FrameTracks, PointSource, SourceInfo, TrackedPoint, Tracks2d};
@@ -139,8 +140,10 @@ pub struct TrackProgress {
 pub struct TrackOutput {
     /// Tracks of every frame.
     pub tracks: Tracks2d,
-    /// Every run of weak frames per joint, interpolated or left weak.
+    /// Every run of weak frames per joint, interpolated, completed from the gait or left weak.
     pub spans: Vec<WeakSpan>,
+    /// What gait completion found for the arms and the legs (empty when it is off).
+    pub gait: Vec<GaitReport>,
     /// The shrink factor of the working scale: video pixels per tracker pixel (1 = full size).
     pub shrink: f64,
     /// Frames the decoder could not read (damaged or cut-short files), ascending. They are
@@ -425,28 +428,30 @@ fn track_at_working_scale(
             &|i, j| job.keys.is_key(i, j),
         );
     }
-    let spans = fill_weak_runs(
-        &mut frames,
-        job.params.weak_reliability,
-        max_gap,
-        &|i, j| job.keys.is_key(i, j),
-    );
+    let is_key = |i: usize, j: Joint| job.keys.is_key(i, j);
+    let mut spans = fill_weak_runs(&mut frames, job.params.weak_reliability, max_gap, &is_key);
+    let source = SourceInfo {
+        path: info.path.clone(),
+        width: info.width,
+        height: info.height,
+        fps: info.fps,
+        frame_count: n,
+    };
+    let gait = if job.params.gait_completion {
+        let reports = complete_gaits(&mut frames, &source, &is_key);
+        spans = weak_spans(&frames, job.params.weak_reliability, &is_key);
+        reports
+    } else {
+        Vec::new()
+    };
     let mut damaged = std::mem::take(&mut ctx.damaged);
     damaged.sort_unstable();
     damaged.dedup();
     Ok(TrackOutput {
         damaged,
-        tracks: Tracks2d {
-            source: SourceInfo {
-                path: info.path.clone(),
-                width: info.width,
-                height: info.height,
-                fps: info.fps,
-                frame_count: n,
-            },
-            frames,
-        },
+        tracks: Tracks2d { source, frames },
         spans,
+        gait,
         shrink,
     })
 }
