@@ -1736,6 +1736,8 @@ impl eframe::App for App {
                     if ui.button("Reset view").clicked() {
                         self.orbit = Orbit::default();
                     }
+                    ui.checkbox(&mut self.orbit.follow, "Follow")
+                        .on_hover_text("Keep the view on the subject as they move across the floor (panning turns it off)");
                 });
                 flip = self.orbit.show(ui, &scene);
             });

@@ -1,11 +1,13 @@
 //! The 3D viewport: the current frame's skeleton in the exports' Y-up world, a ground grid and
 //! the camera's frustum; orbit by dragging, zoom with the wheel, pan with the middle or right
-//! button; clicking a limb asks to flip its depth choice.
+//! button; clicking a limb asks to flip its depth choice. By default the view follows the
+//! subject across the floor (a walker leaves a fixed view within a few steps); panning stops
+//! that.
 
 use super::frame_view::side_colour;
 use egui::{Color32, Pos2, Rect, Sense, Stroke, Vec2};
 use nalgebra::{Point3, Vector3};
-use videomocap::skeleton::{Bone, PerJoint};
+use videomocap::skeleton::{Bone, Joint, PerJoint};
 
 /// What the viewport shows.
 pub struct Scene {
@@ -32,6 +34,8 @@ pub struct Orbit {
     pub distance: f32,
     /// The point looked at.
     pub target: Vector3<f32>,
+    /// Keep the target above the skeleton's pelvis on the floor (its height stays).
+    pub follow: bool,
 }
 
 impl Default for Orbit {
@@ -41,6 +45,7 @@ impl Default for Orbit {
             pitch: 0.25,
             distance: 4.5,
             target: Vector3::new(0.0, 0.9, 0.0),
+            follow: true,
         }
     }
 }
@@ -86,6 +91,14 @@ impl Orbit {
             let (_, right, up, _) = self.basis();
             let d = response.drag_delta() * self.distance / (rect.height() * 1.2);
             self.target += -right * d.x + up * d.y;
+            self.follow = false;
+        }
+        if let (true, Some(joints)) = (self.follow, &scene.joints) {
+            let pelvis = joints[Joint::Pelvis];
+            if pelvis.x.is_finite() && pelvis.z.is_finite() {
+                self.target.x = pelvis.x as f32;
+                self.target.z = pelvis.z as f32;
+            }
         }
         if response.hovered() {
             let scroll = ui.input(|i| i.smooth_scroll_delta.y);
@@ -98,11 +111,23 @@ impl Orbit {
                 painter.line_segment([p, q], stroke);
             }
         };
+        // 6 m of floor in half-metre squares around the target, fixed to the world (it slides
+        // by as a followed walker moves).
         let grid = Stroke::new(1.0, Color32::from_gray(70));
+        let snap = |v: f32| (f64::from(v) / 0.5).round() * 0.5;
+        let (gx, gz) = (snap(self.target.x), snap(self.target.z));
         for k in -6..=6 {
             let v = f64::from(k) * 0.5;
-            line(&Point3::new(v, 0.0, -3.0), &Point3::new(v, 0.0, 3.0), grid);
-            line(&Point3::new(-3.0, 0.0, v), &Point3::new(3.0, 0.0, v), grid);
+            line(
+                &Point3::new(gx + v, 0.0, gz - 3.0),
+                &Point3::new(gx + v, 0.0, gz + 3.0),
+                grid,
+            );
+            line(
+                &Point3::new(gx - 3.0, 0.0, gz + v),
+                &Point3::new(gx + 3.0, 0.0, gz + v),
+                grid,
+            );
         }
         if let Some((c, corners)) = &scene.camera {
             let s = Stroke::new(1.0, Color32::from_rgb(180, 180, 255));
@@ -174,4 +199,45 @@ fn distance_to_segment(p: Pos2, a: Pos2, b: Pos2) -> f32 {
     let ab = b - a;
     let t = ((p - a).dot(ab) / ab.length_sq().max(1e-6)).clamp(0.0, 1.0);
     p.distance(a + ab * t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use egui_kittest::Harness;
+
+    /// A skeleton with every joint at `(x, 1, z)` but the pelvis at `(x, 0.9, z)`.
+    fn scene_at(x: f64, z: f64) -> Scene {
+        let mut joints = PerJoint::from_fn(|_| Point3::new(x, 1.0, z));
+        joints[Joint::Pelvis] = Point3::new(x, 0.9, z);
+        Scene {
+            joints: Some(joints),
+            camera: None,
+            flippable: Vec::new(),
+            cloud: Vec::new(),
+            segments: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn the_view_follows_the_pelvis_across_the_floor_unless_told_not_to() {
+        let mut h = Harness::new_ui_state(
+            |ui, (orbit, x): &mut (Orbit, f64)| {
+                orbit.show(ui, &scene_at(*x, -2.0));
+            },
+            (Orbit::default(), 3.0),
+        );
+        h.run();
+        let target = h.state().0.target;
+        assert_eq!((target.x, target.y, target.z), (3.0, 0.9, -2.0));
+        // The walker moves on: the view goes with them.
+        h.state_mut().1 = 4.5;
+        h.run();
+        assert_eq!(h.state().0.target.x, 4.5);
+        // Not following: the view stays where it was.
+        h.state_mut().0.follow = false;
+        h.state_mut().1 = 7.0;
+        h.run();
+        assert_eq!(h.state().0.target.x, 4.5);
+    }
 }
