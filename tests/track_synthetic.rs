@@ -491,10 +491,14 @@ fn a_side_view_walk_has_its_hidden_far_limbs_completed_from_the_gait() {
             .count()
     };
     assert_eq!(from_gait(&off.tracks), 0);
-    let completed: usize = on.gait.iter().map(|g| g.completed).sum();
-    assert!(completed >= 40, "{:?}", on.gait);
+    let completed: usize = on.gait.limbs.iter().map(|g| g.completed).sum();
+    assert!(completed >= 40, "{:?}", on.gait.limbs);
     assert_eq!(from_gait(&on.tracks), completed);
-    assert!(on.gait.iter().all(|g| g.donor == "left"), "{:?}", on.gait);
+    assert!(
+        on.gait.limbs.iter().all(|g| g.donor == "left"),
+        "{:?}",
+        on.gait.limbs
+    );
     let (px_off, px_on) = (far_px(&off.tracks), far_px(&on.tracks));
     println!(
         "far limbs {px_on:.1} px completed ({completed} joint-frames), {px_off:.1} px as tracked"

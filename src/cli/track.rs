@@ -103,7 +103,16 @@ pub fn report(out: &TrackOutput, global: &GlobalArgs) {
             count(SpanKind::Gait),
         ),
     );
-    for g in out.gait.iter().filter(|g| g.completed > 0) {
+    if let Some(t) = out.gait.trunk.as_ref().filter(|t| t.frames > 0) {
+        say(
+            global,
+            &format!(
+                "  gait: shoulders and hips of {} frames set to the perspective of a side-on trunk (heading {:.0}°)",
+                t.frames, t.heading_deg
+            ),
+        );
+    }
+    for g in out.gait.limbs.iter().filter(|g| g.completed > 0) {
         let far = if g.donor == "left" { "right" } else { "left" };
         say(
             global,

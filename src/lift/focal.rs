@@ -11,16 +11,7 @@ use super::error::LiftError;
 use super::solve::{LiftJob, lift_per_frame, miss_m};
 use crate::camera::PinholeCamera;
 
-/// Field of view across the longer image side assumed when the focal length is neither given
-/// nor estimated: 60°, what phone main cameras and most webcams film at (the real sample's
-/// calibrated camera: 59.5°). Perspective cues of one person are weak, so on the synthetic suite
-/// this default was closer to the truth than [`estimate_focal`] (see the README's lift figures).
-pub const DEFAULT_FOV_LONG_SIDE_DEG: f64 = 60.0;
-
-/// The default focal length for an image: [`DEFAULT_FOV_LONG_SIDE_DEG`] across its longer side.
-pub fn default_focal(width: u32, height: u32) -> f64 {
-    PinholeCamera::focal_from_horizontal_fov(DEFAULT_FOV_LONG_SIDE_DEG, width.max(height))
-}
+pub use crate::camera::{DEFAULT_FOV_LONG_SIDE_DEG, default_focal};
 
 /// The estimate and the scan behind it.
 #[derive(Debug, Clone, PartialEq)]

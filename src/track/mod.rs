@@ -11,6 +11,7 @@
 //! - [`body`]: the top-down tracker (head → trunk → limbs)
 //! - [`occlusion`]: interpolation over weak runs, the weak-span report
 //! - [`gait`]: the hidden far limbs of a walk or run completed from the other side
+//! - [`side_trunk`]: a side-on walker's shoulders and hips in perspective
 //! - [`run`]: passes over a video, key frames, re-tracking
 
 pub mod block;
@@ -21,9 +22,10 @@ pub mod occlusion;
 pub mod params;
 pub mod run;
 pub mod search;
+pub mod side_trunk;
 pub mod similarity;
 
-pub use gait::{GaitReport, LimbPair};
+pub use gait::{GaitOutcome, GaitReport, LimbPair};
 pub use occlusion::{SpanKind, WeakSpan, weak_spans};
 pub use params::TrackerParams;
 pub use run::{KeyFrames, TrackError, TrackJob, TrackOutput, TrackProgress, track_video};

@@ -10,7 +10,7 @@
 //! thread while the tracker works, unless one thread is asked for.
 
 use super::body::{BodyTracker, JointResult, stature_px};
-use super::gait::{GaitReport, complete_gaits};
+use super::gait::{GaitOutcome, complete_gaits};
 use super::occlusion::{WeakSpan, fill_weak_runs, weak_spans, weaken_merged_twins};
 use super::params::TrackerParams;
 use crate::camera::point_in_frame;
@@ -142,8 +142,8 @@ pub struct TrackOutput {
     pub tracks: Tracks2d,
     /// Every run of weak frames per joint, interpolated, completed from the gait or left weak.
     pub spans: Vec<WeakSpan>,
-    /// What gait completion found for the arms and the legs (empty when it is off).
-    pub gait: Vec<GaitReport>,
+    /// What gait completion found and did (nothing when it is off).
+    pub gait: GaitOutcome,
     /// The shrink factor of the working scale: video pixels per tracker pixel (1 = full size).
     pub shrink: f64,
     /// Frames the decoder could not read (damaged or cut-short files), ascending. They are
@@ -438,11 +438,11 @@ fn track_at_working_scale(
         frame_count: n,
     };
     let gait = if job.params.gait_completion {
-        let reports = complete_gaits(&mut frames, &source, &is_key);
+        let outcome = complete_gaits(&mut frames, &source, &is_key);
         spans = weak_spans(&frames, job.params.weak_reliability, &is_key);
-        reports
+        outcome
     } else {
-        Vec::new()
+        GaitOutcome::default()
     };
     let mut damaged = std::mem::take(&mut ctx.damaged);
     damaged.sort_unstable();
