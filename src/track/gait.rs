@@ -198,7 +198,9 @@ fn examine(
             d.y.atan2(d.x)
         })
         .collect();
-    let Some(swing) = Swing::of(&unwrapped(&angles)) else {
+    // Lags up to the longest stride: the work grows with the video's length only linearly.
+    let max_lag = (PERIOD_S.1 * fps).ceil() as usize + 1;
+    let Some(swing) = Swing::of(&unwrapped(&angles), max_lag) else {
         return (report, None);
     };
     report.period_s = Some(swing.period as f64 / fps);
@@ -373,9 +375,10 @@ struct Swing {
 }
 
 impl Swing {
-    /// The highest peak of the normalised autocorrelation (lags up to half the series) after its
-    /// first negative lag; `None` for a constant series or one that never turns negative.
-    fn of(series: &[f64]) -> Option<Swing> {
+    /// The highest peak of the normalised autocorrelation (lags up to half the series and at
+    /// most `max_lag`) after its first negative lag; `None` for a constant series or one that
+    /// never turns negative there.
+    fn of(series: &[f64], max_lag: usize) -> Option<Swing> {
         let n = series.len();
         let mean = series.iter().sum::<f64>() / n.max(1) as f64;
         let s: Vec<f64> = series.iter().map(|x| x - mean).collect();
@@ -392,9 +395,10 @@ impl Swing {
                 / (n - lag) as f64
                 / var
         };
-        let lags = 1..n / 2;
+        let end = (n / 2).min(max_lag + 1);
+        let lags = 1..end;
         let first_negative = lags.clone().find(|&l| ac(l) < 0.0)?;
-        let (period, autocorr) = (first_negative..n / 2)
+        let (period, autocorr) = (first_negative..end)
             .map(|l| (l, ac(l)))
             .max_by(|x, y| x.1.total_cmp(&y.1))?;
         Some(Swing {
@@ -627,10 +631,12 @@ mod tests {
         let series: Vec<f64> = (0..150)
             .map(|t| (TAU * t as f64 / 37.0).sin() + 0.3 * (TAU * t as f64 / 12.0).cos())
             .collect();
-        let s = Swing::of(&series).unwrap();
+        let s = Swing::of(&series, 75).unwrap();
         assert!((36..=38).contains(&s.period), "{s:?}");
         assert!(s.autocorr > 0.8, "{s:?}");
-        assert!(Swing::of(&[1.0; 50]).is_none());
+        assert!(Swing::of(&[1.0; 50], 75).is_none());
+        // Lags capped below the period: no period found there.
+        assert!(Swing::of(&series, 20).is_none_or(|s| s.period <= 20));
         // Angles across ±180° unwrap to one smooth series.
         let u = unwrapped(&[3.1, -3.1, -3.0, 3.0]);
         assert!(u.windows(2).all(|w| (w[1] - w[0]).abs() < 0.3), "{u:?}");
