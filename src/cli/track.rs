@@ -113,12 +113,12 @@ pub fn report(out: &TrackOutput, global: &GlobalArgs) {
         );
     }
     for g in out.gait.limbs.iter().filter(|g| g.completed > 0) {
-        let far = if g.donor == "left" { "right" } else { "left" };
         say(
             global,
             &format!(
-                "  gait: {} joint-frames of the {far} {} completed from the {} side's stride (period {:.2} s, median disagreement {:.2} torso)",
+                "  gait: {} joint-frames of the {} {} completed from the {} side's stride (period {:.2} s, median disagreement {:.2} torso)",
                 g.completed,
+                g.far(),
                 match g.limbs {
                     LimbPair::Arms => "arm",
                     LimbPair::Legs => "leg",

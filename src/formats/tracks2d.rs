@@ -60,7 +60,7 @@ pub struct TrackedPoint {
     pub pos: Point2<f64>,
     /// Reliability in `[0, 1]` (the block similarity mapped to this range).
     pub confidence: f32,
-    /// Tracked, interpolated or off the frame.
+    /// Tracked, interpolated, off the frame, lost or completed from the gait.
     pub source: PointSource,
 }
 
@@ -71,6 +71,13 @@ pub struct FrameTracks {
     pub index: usize,
     /// The joints.
     pub points: PerJoint<TrackedPoint>,
+}
+
+impl FrameTracks {
+    /// The trunk's image length, neck to pelvis, pixels: the body's scale in this frame.
+    pub fn torso_px(&self) -> f64 {
+        (self.points[Joint::Neck].pos - self.points[Joint::Pelvis].pos).norm()
+    }
 }
 
 /// A whole tracking result.

@@ -101,6 +101,17 @@ pub struct GaitReport {
     pub completed: usize,
 }
 
+impl GaitReport {
+    /// The side copied onto: the other one than [`GaitReport::donor`].
+    pub fn far(&self) -> &'static str {
+        if self.donor == "left" {
+            "right"
+        } else {
+            "left"
+        }
+    }
+}
+
 /// Completes the far limbs of a gait in `frames` (consecutive frame indices, after the weak
 /// runs are filled) of `video` and reports what it did. Joints placed by hand
 /// (`is_key(frame position, joint)`) and joints off the frame are never moved, nor is a joint
@@ -160,6 +171,17 @@ struct PairGait {
     half: f64,
 }
 
+impl PairGait {
+    /// The donor's segments half a stride away in `frames`.
+    fn copy<'a>(&self, frames: &'a [FrameTracks]) -> HalfStride<'a> {
+        HalfStride {
+            frames,
+            donor: self.donor,
+            half: self.half,
+        }
+    }
+}
+
 /// Whether a pair of limbs is a gait whose copy agrees with the far limb (see
 /// [`complete_gaits`]), and the report so far (nothing completed yet).
 fn examine(
@@ -213,15 +235,11 @@ fn examine(
         far,
         half: swing.period as f64 / 2.0,
     };
-    let copy = HalfStride {
-        frames,
-        donor,
-        half: gait.half,
-    };
+    let copy = gait.copy(frames);
     // The copy's check against the clearly seen far limb (its own segments).
     let mut errors = Vec::new();
     for (t, f) in frames.iter().enumerate() {
-        let torso = torso_at(f);
+        let torso = f.torso_px().max(1.0);
         for (seg, &(a, b)) in far.iter().enumerate() {
             let p = f.points[b];
             let seen = is_key(t, b)
@@ -250,16 +268,12 @@ fn complete(
     is_key: &dyn Fn(usize, Joint) -> bool,
     gait: &PairGait,
 ) -> usize {
-    let copy = HalfStride {
-        frames,
-        donor: gait.donor,
-        half: gait.half,
-    };
+    let copy = gait.copy(frames);
     let far = gait.far;
     // Down the chain: the lower segment hangs from the middle joint, completed or not.
     let mut completed = Vec::new();
     for (t, f) in frames.iter().enumerate() {
-        let torso = torso_at(f);
+        let torso = f.torso_px().max(1.0);
         let mut parent = f.points[far[0].0].pos;
         for (seg, &(_, b)) in far.iter().enumerate() {
             let p = f.points[b];
@@ -342,13 +356,6 @@ impl HalfStride<'_> {
             .collect();
         cs.iter().sum::<f32>() / cs.len().max(1) as f32
     }
-}
-
-/// Neck to pelvis in the image, pixels (at least 1).
-fn torso_at(f: &FrameTracks) -> f64 {
-    (f.points[Joint::Neck].pos - f.points[Joint::Pelvis].pos)
-        .norm()
-        .max(1.0)
 }
 
 /// Angles without their jumps of a full turn.

@@ -93,7 +93,7 @@ const KEEP_FLOOR_TORSO: f64 = 0.02;
 fn median_torso(frames: &[FrameTracks]) -> f64 {
     let mut d: Vec<f64> = frames
         .iter()
-        .map(|f| (f.points[Joint::Neck].pos - f.points[Joint::Pelvis].pos).norm())
+        .map(FrameTracks::torso_px)
         .filter(|d| d.is_finite())
         .collect();
     d.sort_by(f64::total_cmp);

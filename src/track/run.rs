@@ -438,12 +438,14 @@ fn track_at_working_scale(
         frame_count: n,
     };
     let gait = if job.params.gait_completion {
-        let outcome = complete_gaits(&mut frames, &source, &is_key);
-        spans = weak_spans(&frames, job.params.weak_reliability, &is_key);
-        outcome
+        complete_gaits(&mut frames, &source, &is_key)
     } else {
         GaitOutcome::default()
     };
+    // Points completed from the gait change the weak runs they lay in.
+    if gait.limbs.iter().any(|g| g.completed > 0) {
+        spans = weak_spans(&frames, job.params.weak_reliability, &is_key);
+    }
     let mut damaged = std::mem::take(&mut ctx.damaged);
     damaged.sort_unstable();
     damaged.dedup();

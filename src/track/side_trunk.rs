@@ -90,9 +90,7 @@ pub fn correct_trunk(
     ];
     let f = default_focal(video.width, video.height);
     let cx = (f64::from(video.width) - 1.0) / 2.0;
-    let stature = |fr: &FrameTracks| {
-        (fr.points[Joint::Neck].pos - fr.points[Joint::Pelvis].pos).norm() / torso_h
-    };
+    let stature = |fr: &FrameTracks| fr.torso_px() / torso_h;
     let reference = (0..frames.len())
         .find(|&t| is_key(t, Joint::LeftShoulder) && is_key(t, Joint::RightShoulder))
         .unwrap_or(0);
