@@ -52,8 +52,12 @@ pub const SEEN_RELIABILITY: f32 = 0.6;
 pub const MAX_DISAGREEMENT_TORSO: f64 = 0.2;
 
 /// A clearly seen far joint further than this from the copy, torso lengths, is replaced too:
-/// a confident block riding on the near limb.
-pub const REPLACE_TORSO: f64 = 0.4;
+/// a confident block riding on the near limb. As far as a copy may disagree with the far limb
+/// at the median ([`MAX_DISAGREEMENT_TORSO`]). Measured on `bench track`'s suite with the
+/// side-on trunk centred and the stride searched over [`MAX_LAG_SHARE`]: PCK@0.2 0.931 at 0.4,
+/// 0.933 at 0.25, 0.934 at 0.2, 0.935 at 0.15; walk_across_side 0.935 → 0.952 from 0.4 to 0.2,
+/// dribble_oblique 0.926 → 0.921 (its strides are uneven) and 0.913 at 0.15.
+pub const REPLACE_TORSO: f64 = 0.2;
 
 /// A clearly seen far joint far from the copy ([`REPLACE_TORSO`]) is replaced only when the
 /// copy came from donor joints at most this much less reliable than it: treadmill_raised's
@@ -140,7 +144,14 @@ impl GaitReport {
 /// about 0.920. With the trunk's perspective first: 0.926, lost 1.87 % (walk_across_side 0.933,
 /// run_side 0.859; no other clip changed by more than 0.006 in PCK@0.1). Applied to every clip,
 /// not only to gaits, the perspective cost the turning dancers (dance_oblique 0.798 → 0.762) and
-/// the real sample (0.805 → 0.796).
+/// the real sample (0.805 → 0.796). Then with the trunk's pairs centred by the model, the
+/// stride searched over [`MAX_LAG_SHARE`] and seen joints replaced beyond [`REPLACE_TORSO`]
+/// (0.2, was 0.4): 0.934, lost 1.86 % (walk_across_side 0.952, run_side 0.907, dribble_oblique
+/// 0.921). Fitting the stride to the copy's agreement with the seen far limb (±10–30 % of the
+/// autocorrelation's, before the longer lags) gave 0.930–0.931 against 0.931: the seen far
+/// limb is itself often wrong, and run_side's arm stride went from 0.70 to 0.66 s. Replacing
+/// joints that sit on the donor's own joint whatever their reliability gave 0.934 (run_side
+/// +0.005 at 0.2 torso); not kept.
 pub fn complete_gaits(
     frames: &mut [FrameTracks],
     video: &SourceInfo,
@@ -381,10 +392,24 @@ struct Swing {
     std_deg: f64,
 }
 
+/// The longest lag searched for the stride, as a share of the series: a lag leaves the rest of
+/// the series to compare, so half a series (the usual bound) misses the period of a clip under
+/// two strides long. run_side (171 frames at 120 frames/s, stride about 92 frames) had its
+/// period cut to 84 frames at half, and copies half a stride off by 4 frames; at two thirds
+/// it is found at 91 (suite PCK@0.2 with the copies of [`REPLACE_TORSO`]: 0.931 → 0.934,
+/// run_side 0.882 → 0.907).
+pub const MAX_LAG_SHARE: f64 = 2.0 / 3.0;
+
+/// A later peak of the autocorrelation must beat the first by more than this to be taken for
+/// the period: with lags up to [`MAX_LAG_SHARE`] a clip of several strides shows peaks at two
+/// and three strides nearly as high as at one (treadmill_oblique: 1 s chosen over 3 s).
+pub const LATER_PEAK_MARGIN: f64 = 0.1;
+
 impl Swing {
-    /// The highest peak of the normalised autocorrelation (lags up to half the series and at
-    /// most `max_lag`) after its first negative lag; `None` for a constant series or one that
-    /// never turns negative there.
+    /// The period of a series: the first local peak of its normalised autocorrelation after
+    /// its first negative lag that is within [`LATER_PEAK_MARGIN`] of the highest there (lags
+    /// up to [`MAX_LAG_SHARE`] of the series and at most `max_lag`); `None` for a constant
+    /// series or one that never turns negative there.
     fn of(series: &[f64], max_lag: usize) -> Option<Swing> {
         let n = series.len();
         let mean = series.iter().sum::<f64>() / n.max(1) as f64;
@@ -402,12 +427,18 @@ impl Swing {
                 / (n - lag) as f64
                 / var
         };
-        let end = (n / 2).min(max_lag + 1);
-        let lags = 1..end;
-        let first_negative = lags.clone().find(|&l| ac(l) < 0.0)?;
-        let (period, autocorr) = (first_negative..end)
-            .map(|l| (l, ac(l)))
-            .max_by(|x, y| x.1.total_cmp(&y.1))?;
+        let end = ((n as f64 * MAX_LAG_SHARE) as usize).min(max_lag + 1);
+        let first_negative = (1..end).find(|&l| ac(l) < 0.0)?;
+        let ac: Vec<(usize, f64)> = (first_negative..end).map(|l| (l, ac(l))).collect();
+        let highest = ac.iter().map(|&(_, a)| a).fold(f64::NEG_INFINITY, f64::max);
+        // A local peak: no lower than its neighbours searched (the last lag has one).
+        let peak = |i: usize| {
+            let a = ac[i].1;
+            (i == 0 || a >= ac[i - 1].1) && ac.get(i + 1).is_none_or(|next| a >= next.1)
+        };
+        let (period, autocorr) = (0..ac.len())
+            .find(|&i| peak(i) && ac[i].1 >= highest - LATER_PEAK_MARGIN)
+            .map(|i| ac[i])?;
         Some(Swing {
             period,
             autocorr,
@@ -647,5 +678,20 @@ mod tests {
         // Angles across ±180° unwrap to one smooth series.
         let u = unwrapped(&[3.1, -3.1, -3.0, 3.0]);
         assert!(u.windows(2).all(|w| (w[1] - w[0]).abs() < 0.3), "{u:?}");
+    }
+
+    #[test]
+    fn a_clip_under_two_strides_long_still_gives_the_stride() {
+        // run_side's case: 171 frames, stride 92 frames (half the series would stop at 85).
+        let stride = |t: usize| (TAU * t as f64 / 92.0).sin();
+        let short: Vec<f64> = (0..171).map(stride).collect();
+        let s = Swing::of(&short, 300).unwrap();
+        assert!((90..=94).contains(&s.period), "{s:?}");
+        // Many strides: the first peak, not a later one nearly as high.
+        let long: Vec<f64> = (0..120)
+            .map(|t| (TAU * t as f64 / 30.0).sin() + 0.05 * ((t * 7919) % 13) as f64 / 13.0)
+            .collect();
+        let s = Swing::of(&long, 300).unwrap();
+        assert!((29..=31).contains(&s.period), "{s:?}");
     }
 }

@@ -156,8 +156,8 @@ pub struct TrackerParams {
     /// Beyond the paper: complete a walk's or run's hidden far arm and leg from the other
     /// side's stride half a period away ([`super::gait`]), marking those points as completed
     /// from the gait, after setting the side-on trunk's shoulders and hips to their perspective
-    /// ([`super::side_trunk`]). Default true. On `bench track`'s suite PCK@0.2 0.903 → 0.926,
-    /// lost 3.55 → 1.87 %; the real sample (no gait) unchanged.
+    /// ([`super::side_trunk`]). Default true. On `bench track`'s suite PCK@0.2 0.903 → 0.934,
+    /// lost 3.55 → 1.86 %; the real sample (no gait) unchanged.
     pub gait_completion: bool,
 }
 

@@ -12,8 +12,13 @@
 //! length). ψ is solved from the marked frame; of its two solutions, the one that puts the far
 //! side (the gait's less reliable side) behind. Then each frame's shoulders (about the neck)
 //! and hips (about the pelvis) are moved apart or together along the image's x axis to the
-//! model's separation. Heading and camera are taken as constant: this runs only on a gait
-//! ([`super::gait`]), where the body keeps its heading.
+//! model's separation, centred where the marked frame had them about the neck or pelvis (that
+//! offset scaled with the stature). Heading and camera are taken as constant: this runs only on
+//! a gait ([`super::gait`]), where the body keeps its heading.
+//!
+//! The centre is the model's too, not the block's: the rigid block tilts as the body runs and
+//! carried run_side's shoulders' centre 0.13 torso behind the neck by the last frame (the
+//! truth's stays within 0.04). Suite PCK@0.2 0.926 → 0.929 (run_side 0.859 → 0.879).
 //!
 //! On `bench track`'s suite, before the gait's limbs are completed: shoulders PCK@0.2 on
 //! walk_across_side 0.801 → 0.985, run_side 0.731 → 0.930 (the rigid trunk kept a separation
@@ -110,6 +115,10 @@ pub fn correct_trunk(
             .find(|p| (p.sin() > 0.0) == right_far)
             .unwrap_or(c.acos() - u0.atan());
         heading.get_or_insert(psi.to_degrees());
+        // The pair's centre about its middle joint on the reference frame, scaled with the
+        // stature: a side-on body carries it along (the neck a little before the shoulders).
+        let centre0 = (r.points[pair.left].pos.x + r.points[pair.right].pos.x) / 2.0
+            - r.points[pair.middle].pos.x;
         for (t, fr) in frames.iter_mut().enumerate() {
             let (l, rt) = (fr.points[pair.left], fr.points[pair.right]);
             let fixed = |j: Joint, p: &crate::formats::TrackedPoint| {
@@ -118,18 +127,19 @@ pub fn correct_trunk(
             if fixed(pair.left, &l) || fixed(pair.right, &rt) {
                 continue;
             }
-            let u = (fr.points[pair.middle].pos.x - cx) / f;
+            let middle = fr.points[pair.middle].pos.x;
+            let u = (middle - cx) / f;
             let sep = pair.width_h * stature(fr) * (psi.cos() - u * psi.sin());
-            let half = (sep - (rt.pos.x - l.pos.x)) / 2.0;
-            // Rounding: the reference frame's own separation comes back within 1e-12 px.
-            if half.abs() < 1e-6 {
+            let centre = middle + centre0 * stature(fr) / stature(&r);
+            let (mut nl, mut nr) = (l.pos, rt.pos);
+            nl.x = centre - sep / 2.0;
+            nr.x = centre + sep / 2.0;
+            // Rounding: the reference frame's own points come back within 1e-12 px.
+            if (nl.x - l.pos.x).abs().max((nr.x - rt.pos.x).abs()) < 1e-6 {
                 continue;
             }
-            let (mut nl, mut nr) = (l.pos, rt.pos);
-            nl.x -= half;
-            nr.x += half;
             let inside = |p| point_in_frame(&p, video.width, video.height);
-            if half.is_finite() && inside(nl) && inside(nr) {
+            if nl.x.is_finite() && nr.x.is_finite() && inside(nl) && inside(nr) {
                 fr.points[pair.left].pos = nl;
                 fr.points[pair.right].pos = nr;
                 moved[t] = true;
@@ -164,7 +174,8 @@ mod tests {
     /// A 1.7 m walker 5 m away crossing the view from X = −2 m to +2 m, the shoulder line at
     /// heading 80° (the right side behind), seen by a pinhole camera with the default focal
     /// length: the true image points, and the tracks of a rigid trunk that kept the first
-    /// frame's shoulder and hip offsets.
+    /// frame's shoulder and hip offsets and drifted 0.1 px a frame to the right of the neck and
+    /// pelvis.
     fn walker() -> (Vec<FrameTracks>, Vec<FrameTracks>) {
         let f = default_focal(640, 480);
         let project = |p: Point3<f64>| Point2::new(f * p.x / p.z + 319.5, f * p.y / p.z + 239.5);
@@ -198,7 +209,9 @@ mod tests {
             })
             .collect();
         let mut rigid = truth.clone();
-        for f in &mut rigid {
+        for (t, f) in rigid.iter_mut().enumerate() {
+            // The block tilts as it goes: the pairs' centres drift off their middle joints.
+            let drift = 0.1 * t as f64;
             for (j, middle) in [
                 (Joint::LeftShoulder, Joint::Neck),
                 (Joint::RightShoulder, Joint::Neck),
@@ -206,7 +219,7 @@ mod tests {
                 (Joint::RightHip, Joint::Pelvis),
             ] {
                 let offset = truth[0].points[j].pos - truth[0].points[middle].pos;
-                f.points[j].pos.x = f.points[middle].pos.x + offset.x;
+                f.points[j].pos.x = f.points[middle].pos.x + offset.x + drift;
             }
         }
         (truth, rigid)
@@ -241,14 +254,12 @@ mod tests {
     #[test]
     fn the_wrong_far_side_or_a_key_is_not_followed() {
         let (truth, rigid) = walker();
-        // Taking the left side for the far one turns the trend over: worse than rigid.
+        // Taking the left side for the far one turns the trend over: many pixels off, where
+        // the right side is brought within 1 px (the test above).
         let mut tracks = rigid.clone();
         correct_trunk(&mut tracks, &video(), false, &|t, _| t == 0);
-        let (wrong, kept) = (
-            worst_x(&tracks, &truth, Joint::RightShoulder),
-            worst_x(&rigid, &truth, Joint::RightShoulder),
-        );
-        assert!(wrong > kept, "{wrong:.1} vs {kept:.1}");
+        let wrong = worst_x(&tracks, &truth, Joint::RightShoulder);
+        assert!(wrong > 10.0, "{wrong:.1} px off");
         // A shoulder placed by hand on frame 50 stays where the hand put it, and so does its
         // twin (the pair moves together); the hips move.
         let mut tracks = rigid.clone();
