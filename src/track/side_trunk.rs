@@ -17,8 +17,9 @@
 //! a gait ([`super::gait`]), where the body keeps its heading.
 //!
 //! The centre is the model's too, not the block's: the rigid block tilts as the body runs and
-//! carried run_side's shoulders' centre 0.13 torso behind the neck by the last frame (the
-//! truth's stays within 0.04). Suite PCK@0.2 0.926 → 0.929 (run_side 0.859 → 0.879).
+//! carried run_side's shoulders' centre 0.12 torso ahead of the neck by the last frame, where
+//! the truth's went from 0.05 behind it to 0.01. Suite PCK@0.2 0.926 → 0.929 (run_side 0.859
+//! → 0.879).
 //!
 //! On `bench track`'s suite, before the gait's limbs are completed: shoulders PCK@0.2 on
 //! walk_across_side 0.801 → 0.985, run_side 0.731 → 0.930 (the rigid trunk kept a separation
