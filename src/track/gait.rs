@@ -13,7 +13,7 @@
 
 use super::side_trunk::{TrunkReport, correct_trunk};
 use crate::camera::point_in_frame;
-use crate::formats::{FrameTracks, PointSource, SourceInfo};
+use crate::formats::{FrameTracks, PointSource, SourceInfo, TrackedPoint};
 use crate::skeleton::Joint;
 use nalgebra::Vector2;
 use serde::Serialize;
@@ -123,13 +123,15 @@ impl GaitReport {
 ///
 /// Per pair: the donor is the side whose elbow and wrist (knee and ankle) have the higher summed
 /// reliability where tracked (so a second run on its own output keeps its donor); its stride
-/// period is the highest peak of the autocorrelation of its upper segment's image angle after
-/// the first negative lag. A gait needs an autocorrelation of at least [`MIN_AUTOCORR`], a
-/// swing of [`MIN_SWING_DEG`] and a period in [`PERIOD_S`]. The copy of a far joint at frame `t`
-/// is its own parent plus the donor's segment averaged over `t − T/2` and `t + T/2` (whichever
-/// lie in the video), down the chain. It is used only where it agrees with the clearly seen far
-/// limb ([`MAX_DISAGREEMENT_TORSO`]), and then replaces far joints that are weak (under
-/// [`SEEN_RELIABILITY`]) or far from it ([`REPLACE_TORSO`], [`REPLACE_MARGIN`]).
+/// period is the first peak of the autocorrelation of its upper segment's image angle after
+/// the first negative lag (lags up to [`MAX_LAG_SHARE`] of the clip) that comes within
+/// [`LATER_PEAK_MARGIN`] of the highest. A gait needs an autocorrelation of at least
+/// [`MIN_AUTOCORR`], a swing of [`MIN_SWING_DEG`] and a period in [`PERIOD_S`]. The copy of a
+/// far joint at frame `t` is its own parent plus the donor's segment averaged over `t − T/2`
+/// and `t + T/2` (whichever lie in the video), down the chain. It is used only where it agrees
+/// with the clearly seen far limb ([`MAX_DISAGREEMENT_TORSO`]), and then replaces far joints
+/// that are weak (under [`SEEN_RELIABILITY`]) or far from it ([`REPLACE_TORSO`],
+/// [`REPLACE_MARGIN`]).
 ///
 /// When the legs are such a gait, the body keeps its heading: first the shoulders and hips are
 /// set to the perspective of a side-on trunk ([`correct_trunk`]), so the copies hang from
@@ -253,8 +255,7 @@ fn examine(
         let torso = f.torso_px().max(1.0);
         for (seg, &(a, b)) in far.iter().enumerate() {
             let p = f.points[b];
-            let seen = is_key(t, b)
-                || (p.source == PointSource::Tracked && p.confidence >= SEEN_RELIABILITY);
+            let seen = is_key(t, b) || clearly_seen(&p);
             if let (true, Some(v)) = (seen, copy.segment(t, seg)) {
                 errors.push((v - (p.pos - f.points[a].pos)).norm() / torso);
             }
@@ -270,6 +271,11 @@ fn examine(
         return (report, None);
     }
     (report, Some(gait))
+}
+
+/// Whether a point was tracked at least [`SEEN_RELIABILITY`] (not filled in).
+fn clearly_seen(p: &TrackedPoint) -> bool {
+    p.source == PointSource::Tracked && p.confidence >= SEEN_RELIABILITY
 }
 
 /// Puts the far limb's joints where the copy says (see [`complete_gaits`]); returns how many.
@@ -293,7 +299,7 @@ fn complete(
                 continue;
             };
             let pred = parent + v;
-            let weak = p.source != PointSource::Tracked || p.confidence < SEEN_RELIABILITY;
+            let weak = !clearly_seen(&p);
             let movable = !is_key(t, b)
                 && p.source != PointSource::OffFrame
                 && point_in_frame(&pred, video.width, video.height);
@@ -429,16 +435,20 @@ impl Swing {
         };
         let end = ((n as f64 * MAX_LAG_SHARE) as usize).min(max_lag + 1);
         let first_negative = (1..end).find(|&l| ac(l) < 0.0)?;
-        let ac: Vec<(usize, f64)> = (first_negative..end).map(|l| (l, ac(l))).collect();
-        let highest = ac.iter().map(|&(_, a)| a).fold(f64::NEG_INFINITY, f64::max);
+        // (lag, autocorrelation) from the first negative lag on.
+        let curve: Vec<(usize, f64)> = (first_negative..end).map(|l| (l, ac(l))).collect();
+        let highest = curve
+            .iter()
+            .map(|&(_, a)| a)
+            .fold(f64::NEG_INFINITY, f64::max);
         // A local peak: no lower than its neighbours searched (the last lag has one).
         let peak = |i: usize| {
-            let a = ac[i].1;
-            (i == 0 || a >= ac[i - 1].1) && ac.get(i + 1).is_none_or(|next| a >= next.1)
+            let a = curve[i].1;
+            (i == 0 || a >= curve[i - 1].1) && curve.get(i + 1).is_none_or(|next| a >= next.1)
         };
-        let (period, autocorr) = (0..ac.len())
-            .find(|&i| peak(i) && ac[i].1 >= highest - LATER_PEAK_MARGIN)
-            .map(|i| ac[i])?;
+        let (period, autocorr) = (0..curve.len())
+            .find(|&i| peak(i) && curve[i].1 >= highest - LATER_PEAK_MARGIN)
+            .map(|i| curve[i])?;
         Some(Swing {
             period,
             autocorr,
