@@ -9,13 +9,13 @@
 //! the shoulders; knees bend backwards, in the leg's own plane; hanging elbows bend forwards; upper
 //! arms and thighs do not cross the body's middle, and weakly prefer to hang a little outwards
 //! (an arm swung back less so) or, thighs, a little inwards; the legs' priors are taken in the
-//! pelvis's frame, the arms' in the key triangle's; of two arms that fit equally, the straighter and the one nearer the
-//! trunk's frontal plane; in a stride each arm swings against its own thigh; a wrist stays out of
-//! the trunk and the thighs), and the candidates are chained over the frames by dynamic programming
-//! (Viterbi over pairs of consecutive choices) that minimises the joints' 3D acceleration relative
-//! to the group's root plus the priors. Groups are solved centre outwards, each on the trajectory
-//! chosen for its root. A user's choice for a bone on a frame ([`DepthOverrides`]) is a hard
-//! constraint.
+//! pelvis's frame, the arms' in the key triangle's; of two arms that fit equally, the
+//! straighter and the one nearer the trunk's frontal plane; in a stride each arm swings against
+//! its own thigh; a wrist stays out of the trunk and the thighs), and the candidates are chained
+//! over the frames by dynamic programming (Viterbi over pairs of consecutive choices) that
+//! minimises the joints' 3D acceleration relative to the group's root plus the priors. Groups
+//! are solved centre outwards, each on the trajectory chosen for its root. A user's choice for a
+//! bone on a frame ([`DepthOverrides`]) is a hard constraint.
 use super::backproject::{Root, bone_roots};
 use super::error::{LiftError, check_setting};
 use crate::skeleton::{
@@ -351,6 +351,7 @@ pub struct Resolved {
 }
 
 /// The key triangle's directions in one frame: left, up, forward (unit vectors).
+#[derive(Clone)]
 struct TrunkFrame {
     left: Vector3<f64>,
     up: Vector3<f64>,
@@ -386,11 +387,11 @@ impl TrunkFrame {
     /// 3.9 %), 2 px noise 47.7 → 46.7 (from the height 62.7 → 61.3), from the tracker 94.2 →
     /// 90.5 (walk_across_side 137.4 → 108.2, run_side 94.9 → 89.9), from the tracker and the
     /// height 104.2 → 100.1; worse: exact 2D from the height 36.8 → 39.0 (dribble_oblique 66.6
-    /// → 101.9: its fitted proportions' hips lean with a spine already wrong on 39 of its 100
-    /// frames, and its arms, which swing against the thighs, follow) and `--estimate-focal`'s
-    /// median error a factor of 1.22 → 1.48 (walk_across_side 716 → 1351 px against 600). The
-    /// real sample is unchanged. Where the hips coincide or their line
-    /// runs along the trunk, the key triangle's frame stands in.
+    /// → 101.9: its knees' roots changed, and its right arm, which swings against the thighs,
+    /// took the mirror root on 91 of its 100 frames, 9 before) and `--estimate-focal`'s median
+    /// error a factor of 1.22 → 1.48 (walk_across_side 716 → 1351 px against 600). The real
+    /// sample is unchanged. Where the hips coincide or their line runs along the trunk, the key
+    /// triangle's frame stands in.
     fn pelvis(&self, points: &PerJoint<Point3<f64>>) -> TrunkFrame {
         let hip_left = (points[LeftHip] - points[RightHip]).try_normalize(f64::EPSILON);
         let frame = hip_left.and_then(|left| {
@@ -401,11 +402,7 @@ impl TrunkFrame {
                 forward: left.cross(&up),
             })
         });
-        frame.unwrap_or(TrunkFrame {
-            left: self.left,
-            up: self.up,
-            forward: self.forward,
-        })
+        frame.unwrap_or_else(|| self.clone())
     }
 }
 
