@@ -387,11 +387,12 @@ impl TrunkFrame {
     /// 3.9 %), 2 px noise 47.7 → 46.7 (from the height 62.7 → 61.3), from the tracker 94.2 →
     /// 90.5 (walk_across_side 137.4 → 108.2, run_side 94.9 → 89.9), from the tracker and the
     /// height 104.2 → 100.1; worse: exact 2D from the height 36.8 → 39.0 (dribble_oblique 66.6
-    /// → 101.9: its knees' roots changed, and its right arm, which swings against the thighs,
-    /// took the mirror root on 91 of its 100 frames, 9 before) and `--estimate-focal`'s median
-    /// error a factor of 1.22 → 1.48 (walk_across_side 716 → 1351 px against 600). The real
-    /// sample is unchanged. Where the hips coincide or their line runs along the trunk, the key
-    /// triangle's frame stands in.
+    /// → 101.9: the proportions fitted to its tracks read these priors' costs, and its fitted
+    /// forearm came out 0.244 m, not 0.248, against a true 0.257; with them its right arm took the
+    /// mirror root on 91 of its 100 frames, 9 before, with or without the arm-swing prior) and
+    /// `--estimate-focal`'s median error a factor of 1.22 → 1.48 (walk_across_side 716 → 1351
+    /// px against 600). The real sample is unchanged. Where the hips coincide or their line
+    /// runs along the trunk, the key triangle's frame stands in.
     fn pelvis(&self, points: &PerJoint<Point3<f64>>) -> TrunkFrame {
         let hip_left = (points[LeftHip] - points[RightHip]).try_normalize(f64::EPSILON);
         let frame = hip_left.and_then(|left| {
