@@ -180,11 +180,16 @@ proptest! {
             let got = p[rig_index_of(j)] / 100.0;
             prop_assert!((got - ws.frames[39][j]).norm() < 1e-3);
         }
-        // No flips: bones move at most about 12° a frame here, so must every joint's rotation,
-        // and so must its Euler angles away from gimbal lock.
+        // No flips. An upper limb's swing turns at most 12° a frame here (0.2 rad/frame of
+        // phase times a swing of up to 0.6 rad per axis); a hand's or foot's bone adds its twist
+        // (up to 7°) and its flex (up to 10°), so a joint turns up to about 29° a frame, and an
+        // Euler channel under 30° of gimbal lock steps at most 1.73 times that, about 51°
+        // (3000 random cases turned a joint 26.9° once, over the 25° this bound used to be).
+        // A flip (a twist taken the other way, an Euler solution switched or wrapped) jumps by
+        // about 180° or 360°, far beyond both bounds.
         let (geodesic, euler) = steps(&motion);
-        prop_assert!(geodesic < 25.0, "a joint turned {geodesic}° in one frame");
-        prop_assert!(euler < 25.0, "an Euler angle stepped {euler}° in one frame");
+        prop_assert!(geodesic < 45.0, "a joint turned {geodesic}° in one frame");
+        prop_assert!(euler < 90.0, "an Euler angle stepped {euler}° in one frame");
     }
 }
 
