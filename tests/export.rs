@@ -133,8 +133,9 @@ fn frames_of(m: &Motion, n: usize) -> Vec<PerJoint<Point3<f64>>> {
 /// Largest step between neighbouring frames of any joint's rotation (geodesic angle, degrees),
 /// and of any Euler channel on frames away from gimbal lock (|x| < 30° on both frames). Near
 /// the lock the outer channels move up to (1 + |sin x|) / cos x times the joint's turn: at
-/// 60° that is 3.7 times, and a smooth 12.6° turn stepped a channel 25.3° (proptest's case
-/// 2c9fdb64 in `export.proptest-regressions`); under 30° it is at most 1.73 times.
+/// 60° that is 3.7 times, and proptest's case 2c9fdb64 (in `export.proptest-regressions`)
+/// stepped a channel 25.8° there while no joint turned more than 15.2° a frame; under 30° it
+/// is at most 1.73 times.
 fn steps(motion: &videomocap::export::kinematics::RigMotion) -> (f64, f64) {
     let (_, angles) = videomocap::export::bvh_text(motion);
     let rotating: Vec<usize> = (0..RIG.len()).filter(|&i| !RIG[i].is_end()).collect();
