@@ -12,14 +12,12 @@
 //! - [`occlusion`]: interpolation over weak runs, the weak-span report
 //! - [`gait`]: the hidden far limbs of a walk or run completed from the other side
 //! - [`side_trunk`]: a side-on walker's shoulders and hips in perspective
-//! - [`jitter`]: the finished tracks smoothed over a frame or two
 //! - [`run`]: passes over a video, key frames, re-tracking
 
 pub mod block;
 pub mod body;
 pub mod gait;
 pub mod head;
-pub mod jitter;
 pub mod occlusion;
 pub mod params;
 pub mod run;

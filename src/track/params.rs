@@ -159,16 +159,6 @@ pub struct TrackerParams {
     /// ([`super::side_trunk`]). Default true. On `bench track`'s suite PCK@0.2 0.903 → 0.934,
     /// lost 3.55 → 1.86 %; the real sample (no gait) unchanged.
     pub gait_completion: bool,
-    /// Beyond the paper: the tracks are smoothed over time by a Gaussian of this many frames
-    /// ([`crate::track::jitter`]) once weak runs are filled and before the gait completes the
-    /// hidden limbs, taking out the block search's frame-to-frame jitter; hand-placed points
-    /// stay. 0 leaves the tracks as found. Default 1. `bench track`'s suite at 0 / 0.7 / 1 /
-    /// 1.5 / 2 frames: 1546 / 1513 / 1511 / 1515 / 1515 misses at PCK@0.2 (of 24208
-    /// joint-frames; PCK@0.1 0.847 / 0.847 / 0.846 / 0.844 / 0.837). Smoothing after the gait
-    /// completion instead gave 1496, but the side-on trunk's correction, run again over the
-    /// kept frames of a re-track, then moved a shoulder the user had seen on the corrected
-    /// frame (by 0.0005 px).
-    pub jitter_sigma_frames: f64,
 }
 
 impl Default for TrackerParams {
@@ -206,7 +196,6 @@ impl Default for TrackerParams {
             chain_refine: true,
             shoulder_spring: 0.05,
             gait_completion: true,
-            jitter_sigma_frames: 1.0,
         }
     }
 }
@@ -290,10 +279,9 @@ impl TrackerParams {
             chain_refine: _,
             shoulder_spring,
             gait_completion: _,
-            jitter_sigma_frames,
         } = *self;
         weights.validate()?;
-        let checks: [(&'static str, f64, Range); 26] = [
+        let checks: [(&'static str, f64, Range); 25] = [
             ("head_step_px", head_step_px, Positive),
             ("head_d_theta_deg", head_d_theta_deg, NonNegative),
             ("head_d_m", head_d_m, Fraction),
@@ -323,7 +311,6 @@ impl TrackerParams {
                 NonNegative,
             ),
             ("shoulder_spring", shoulder_spring.into(), NonNegative),
-            ("jitter_sigma_frames", jitter_sigma_frames, NonNegative),
         ];
         checks
             .into_iter()

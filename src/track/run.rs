@@ -11,7 +11,6 @@
 
 use super::body::{BodyTracker, JointResult, stature_px};
 use super::gait::{GaitOutcome, complete_gaits};
-use super::jitter::smooth_jitter;
 use super::occlusion::{WeakSpan, fill_weak_runs, weak_spans, weaken_merged_twins};
 use super::params::TrackerParams;
 use crate::camera::point_in_frame;
@@ -431,9 +430,6 @@ fn track_at_working_scale(
     }
     let is_key = |i: usize, j: Joint| job.keys.is_key(i, j);
     let mut spans = fill_weak_runs(&mut frames, job.params.weak_reliability, max_gap, &is_key);
-    // A re-track keeps the frames up to the corrected one as they were (smoothed already).
-    let fresh = job.from.map_or(0, |f| f + 1);
-    smooth_jitter(&mut frames, job.params.jitter_sigma_frames, fresh, &is_key);
     let source = SourceInfo {
         path: info.path.clone(),
         width: info.width,
