@@ -167,11 +167,14 @@ const TWINS: [Joint; 4] = [
 /// twin whose velocity changed more when they met (by at least [`FOLLOW_FLOOR_TORSO`]) is the
 /// follower; its confidence is capped at half of `weak` over the merge, so that
 /// [`fill_weak_runs`] interpolates or reports it. Merges present from the first frame (the
-/// marks put the joints together) and frames with a key or an off-frame twin are left alone.
+/// marks put the joints together) and frames with a key or an off-frame twin are left alone,
+/// and so are frames before `fresh` (a re-track keeps them as the user saw them, though a
+/// merge that runs on past the corrected frame is found over all of it).
 pub fn weaken_merged_twins(
     frames: &mut [FrameTracks],
     weak: f32,
     min_frames: usize,
+    fresh: usize,
     is_key: &dyn Fn(usize, Joint) -> bool,
 ) {
     let torso = median_torso(frames);
@@ -204,7 +207,7 @@ pub fn weaken_merged_twins(
                 continue;
             }
             let follower = if ta >= tb { a } else { b };
-            for f in &mut frames[start..=end] {
+            for f in frames[..=end].iter_mut().skip(start.max(fresh)) {
                 let c = &mut f.points[follower].confidence;
                 *c = c.min(weak * 0.5);
             }
@@ -449,52 +452,54 @@ mod tests {
         f.iter().map(|f| f.points[j].confidence).collect()
     }
 
-    #[test]
-    fn a_joint_riding_on_its_twin_is_made_weak_and_a_crossing_is_not() {
-        // The left ankle walks on at 10 px a frame; the right one comes the other way, meets
-        // it at frame 4 and, lost, rides along with it for six frames.
+    /// The left ankle walks on at 10 px a frame; the right one comes the other way, meets it
+    /// at frame 4 and, lost, rides along with it, `beside` px off, for six frames.
+    fn riding(beside: f64) -> (Vec<f64>, Vec<f64>) {
         let left: Vec<f64> = (0..10).map(|i| 10.0 * i as f64).collect();
-        let right: Vec<f64> = (0..10)
+        let right = (0..10)
             .map(|i| {
                 if i < 4 {
                     80.0 - 10.0 * i as f64
                 } else {
-                    left[i]
+                    left[i] + beside
                 }
             })
             .collect();
+        (left, right)
+    }
+
+    #[test]
+    fn a_joint_riding_on_its_twin_is_made_weak_and_a_crossing_is_not() {
+        let (left, right) = riding(0.0);
         let mut f = ankles(&left, &right);
-        weaken_merged_twins(&mut f, 0.5, 4, &|_, _| false);
+        weaken_merged_twins(&mut f, 0.5, 4, 0, &|_, _| false);
         assert!(confidences(&f, Joint::LeftAnkle).iter().all(|&c| c == 0.9));
         let right_conf = confidences(&f, Joint::RightAnkle);
         assert!(right_conf[..4].iter().all(|&c| c == 0.9), "{right_conf:?}");
         assert!(right_conf[4..].iter().all(|&c| c == 0.25), "{right_conf:?}");
         // Shorter than four frames together: a crossing, left alone.
         let mut f = ankles(&left[..7], &right[..7]);
-        weaken_merged_twins(&mut f, 0.5, 4, &|_, _| false);
+        weaken_merged_twins(&mut f, 0.5, 4, 0, &|_, _| false);
         assert!(confidences(&f, Joint::RightAnkle).iter().all(|&c| c == 0.9));
         // A key frame inside the merge splits it into runs too short to count.
         let mut f = ankles(&left, &right);
-        weaken_merged_twins(&mut f, 0.5, 4, &|i, _| i == 6);
+        weaken_merged_twins(&mut f, 0.5, 4, 0, &|i, _| i == 6);
         assert!(confidences(&f, Joint::RightAnkle).iter().all(|&c| c == 0.9));
+        // A re-track from frame 5 keeps frames 0 to 5 as they were; the merge is still found.
+        let mut f = ankles(&left, &right);
+        weaken_merged_twins(&mut f, 0.5, 4, 6, &|_, _| false);
+        let right_conf = confidences(&f, Joint::RightAnkle);
+        assert!(right_conf[..6].iter().all(|&c| c == 0.9), "{right_conf:?}");
+        assert!(right_conf[6..].iter().all(|&c| c == 0.25), "{right_conf:?}");
     }
 
     #[test]
     fn a_joint_riding_beside_its_twin_is_made_weak() {
-        // As above, but the lost right ankle rides 10 px (a tenth of the torso) beside the
-        // left one: it still follows it, though never onto the same spot.
-        let left: Vec<f64> = (0..10).map(|i| 10.0 * i as f64).collect();
-        let right: Vec<f64> = (0..10)
-            .map(|i| {
-                if i < 4 {
-                    80.0 - 10.0 * i as f64
-                } else {
-                    left[i] + 10.0
-                }
-            })
-            .collect();
+        // The lost right ankle rides 10 px (a tenth of the torso) beside the left one: it
+        // follows it, though never onto the same spot.
+        let (left, right) = riding(10.0);
         let mut f = ankles(&left, &right);
-        weaken_merged_twins(&mut f, 0.5, 4, &|_, _| false);
+        weaken_merged_twins(&mut f, 0.5, 4, 0, &|_, _| false);
         let right_conf = confidences(&f, Joint::RightAnkle);
         assert!(right_conf[4..].iter().all(|&c| c == 0.25), "{right_conf:?}");
         assert!(confidences(&f, Joint::LeftAnkle).iter().all(|&c| c == 0.9));
@@ -505,12 +510,12 @@ mod tests {
         // Feet side by side from the marks on, or still when they meet: nothing followed.
         let still = [50.0; 10];
         let mut f = ankles(&still, &still);
-        weaken_merged_twins(&mut f, 0.5, 4, &|_, _| false);
+        weaken_merged_twins(&mut f, 0.5, 4, 0, &|_, _| false);
         let mut g = ankles(
             &still,
             &[52.0, 52.0, 60.0, 60.0, 51.0, 51.0, 51.0, 51.0, 51.0, 51.0],
         );
-        weaken_merged_twins(&mut g, 0.5, 4, &|_, _| false);
+        weaken_merged_twins(&mut g, 0.5, 4, 0, &|_, _| false);
         for f in [&f, &g] {
             for j in [Joint::LeftAnkle, Joint::RightAnkle] {
                 assert!(confidences(f, j).iter().all(|&c| c == 0.9));

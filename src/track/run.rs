@@ -425,6 +425,7 @@ fn track_at_working_scale(
             &mut frames,
             job.params.weak_reliability,
             (job.params.twin_merge_s * info.fps).round().max(2.0) as usize,
+            job.from.map_or(0, |f| f + 1),
             &|i, j| job.keys.is_key(i, j),
         );
     }
