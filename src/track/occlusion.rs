@@ -137,10 +137,11 @@ fn moves_with_its_anchors(
 /// Twin joints closer than this, in torso lengths (neck to pelvis, median over the clip), are
 /// on one spot for [`weaken_merged_twins`]. On treadmill_raised each knee is hidden behind the
 /// other leg for part of every stride, and its track rides on the other knee a median 0.10
-/// torso off it (0.08 at the lower quartile), which 0.05 did not catch. `bench track`'s suite at 0.05 / 0.1 / 0.12 / 0.13 / 0.15 /
-/// 0.17 / 0.2: 1609 / 1578 / 1546 / 1546 / 1556 / 1740 / 1770 misses at PCK@0.2 (of 24208
-/// joint-frames), treadmill_raised 0.893 → 0.920 at 0.12; from 0.17 run_side's swinging legs,
-/// which pass close by each other, lose their tracked crossings (0.908 → 0.846).
+/// torso off it (0.08 at the lower quartile), which 0.05 did not catch. The suite of `bench
+/// track` at 0.05 / 0.1 / 0.12 / 0.13 / 0.15 / 0.17 / 0.2 / 0.25: 1609 / 1578 / 1546 / 1546 /
+/// 1556 / 1740 / 1764 / 2041 misses at PCK@0.2 (of 24208 joint-frames), treadmill_raised
+/// 0.893 → 0.925 at 0.12; from 0.17 run_side's swinging legs, which pass close by each other,
+/// lose their tracked crossings (0.908 → 0.846).
 pub const MERGE_TORSO: f64 = 0.12;
 
 /// Frames before and after a merge begins over which each twin's velocity is measured.
