@@ -1327,6 +1327,8 @@ impl App {
                 // The spring is part of the chain refinement: greyed out without it.
                 ui.add_enabled(t.chain_refine, egui::Slider::new(&mut t.shoulder_spring, 0.0..=0.5).text("shoulder spring"))
                     .on_hover_text(format!("Cost per square pixel that a shoulder pays for leaving the place the rigid trunk gives it, so it can rise with a raised arm (part of the chain refinement); higher holds it closer; 0 holds it on the trunk; default {}", d.shoulder_spring));
+                ui.checkbox(&mut t.arm_rescue, "look again for lost arms")
+                    .on_hover_text(format!("When a forearm is lost, the whole arm is looked for again as one piece, so a sleeve the colour of the shirt no longer holds the arm on the body; default {}", if d.arm_rescue { "on" } else { "off" }));
                 ui.checkbox(&mut t.gait_completion, "complete hidden limbs from the gait")
                     .on_hover_text(format!("In a walk or run seen from the side, the far arm's and leg's joints that are weak, or far from where the near limb was half a stride earlier and later, are put there (pink) for you to check; default {}", if d.gait_completion { "on" } else { "off" }));
                 if ui.button("Defaults").clicked() {
@@ -2204,45 +2206,30 @@ mod tests {
         assert_eq!(arms(&h), TrackerParams::default().upper_arm_short_penalty);
     }
 
-    /// Gait completion can be turned off from the Parameters panel, and that is an undoable
-    /// project setting.
+    /// The tracker's switches (gait completion, the hip patch, the arms' second look) can each
+    /// be turned off from the Parameters panel, and each is an undoable project setting.
     #[test]
-    fn gait_completion_is_switched_in_the_tracker_settings() {
-        let dir = tempfile::tempdir().unwrap();
-        let mut h = with_project(dir.path());
-        let on = |h: &Harness<'static, App>| {
-            h.state()
-                .project()
-                .unwrap()
-                .settings
-                .tracker
-                .gait_completion
-        };
-        assert!(on(&h));
-        h.get_by_label("Tracker").click();
-        h.run();
-        h.get_by_label("complete hidden limbs from the gait")
-            .click();
-        h.run();
-        assert!(!on(&h));
-        h.state_mut().undo();
-        assert!(on(&h));
-    }
-
-    /// The tracker's hip patch can be turned off from the Parameters panel, and that is an
-    /// undoable project setting.
-    #[test]
-    fn the_hip_patch_is_switched_in_the_tracker_settings() {
-        let dir = tempfile::tempdir().unwrap();
-        let mut h = with_project(dir.path());
-        assert!(h.state().project().unwrap().settings.tracker.hip_patch);
-        h.get_by_label("Tracker").click();
-        h.run();
-        h.get_by_label("hold the hips when the back bends").click();
-        h.run();
-        assert!(!h.state().project().unwrap().settings.tracker.hip_patch);
-        h.state_mut().undo();
-        assert!(h.state().project().unwrap().settings.tracker.hip_patch);
+    fn each_tracker_switch_is_an_undoable_setting() {
+        type Get = fn(&TrackerParams) -> bool;
+        let switches: [(&str, Get); 3] = [
+            ("complete hidden limbs from the gait", |t| t.gait_completion),
+            ("hold the hips when the back bends", |t| t.hip_patch),
+            ("look again for lost arms", |t| t.arm_rescue),
+        ];
+        for (label, get) in switches {
+            let dir = tempfile::tempdir().unwrap();
+            let mut h = with_project(dir.path());
+            let on =
+                |h: &Harness<'static, App>| get(&h.state().project().unwrap().settings.tracker);
+            assert!(on(&h), "{label} starts on");
+            h.get_by_label("Tracker").click();
+            h.run();
+            h.get_by_label(label).click();
+            h.run();
+            assert!(!on(&h), "{label} turned off");
+            h.state_mut().undo();
+            assert!(on(&h), "{label} back on after undo");
+        }
     }
 
     /// The lift's global refinement can be turned off from the Parameters panel: an undoable
