@@ -1320,6 +1320,8 @@ impl App {
                     .on_hover_text(format!("How strongly a limb is pulled back to its full length when it looks shorter (legs crossing); lower it for limbs pointing at the camera, such as a seated person's thighs seen from the front; default {}", d.short_penalty));
                 ui.add(egui::Slider::new(&mut t.upper_arm_short_penalty, 0.0..=60.0).text("keep upper arms long"))
                     .on_hover_text(format!("The same pull for the upper arms, stronger: a bare or plain-sleeved upper arm looks alike along its length and otherwise shrinks towards the shoulder; lower it for an arm pointing at the camera; default {}", d.upper_arm_short_penalty));
+                ui.add(egui::Slider::new(&mut t.forearm_short_penalty, 0.0..=40.0).text("keep forearms long"))
+                    .on_hover_text(format!("The same pull for the forearms: raise it (12) when a forearm crossing the body, or a sleeve of its colour, shrinks towards the elbow and the wrist falls short; check the 3D view after; default {}", d.forearm_short_penalty));
                 ui.checkbox(&mut t.hip_patch, "hold the hips when the back bends")
                     .on_hover_text(format!("A patch around the hips holds the pelvis when the spine bends (a bow, a reach), and the trunk is re-hung from the neck to it; default {}", if d.hip_patch { "on" } else { "off" }));
                 ui.checkbox(&mut t.chain_refine, "refine each limb as one chain")
@@ -2171,39 +2173,37 @@ mod tests {
         h
     }
 
-    /// The pull of short limbs back to full length, and the upper arms' own, are set from the
-    /// Parameters panel, and each is an undoable project setting.
+    /// The pull of short limbs back to full length, and the upper arms' and the forearms' own,
+    /// are each set from the Parameters panel on its own (the others stay), and each is an
+    /// undoable project setting.
     #[test]
-    fn the_short_limb_pull_is_set_in_the_tracker_settings() {
+    fn the_short_limb_pulls_are_set_in_the_tracker_settings() {
+        type Get = fn(&TrackerParams) -> f32;
+        let pulls: [(&str, Get); 3] = [
+            ("keep limbs long", |t| t.short_penalty),
+            ("keep upper arms long", |t| t.upper_arm_short_penalty),
+            ("keep forearms long", |t| t.forearm_short_penalty),
+        ];
         let dir = tempfile::tempdir().unwrap();
         let mut h = with_project(dir.path());
-        let pull =
-            |h: &Harness<'static, App>| h.state().project().unwrap().settings.tracker.short_penalty;
-        let default = TrackerParams::default().short_penalty;
-        assert_eq!(pull(&h), default);
+        let now = |h: &Harness<'static, App>| {
+            let t = h.state().project().unwrap().settings.tracker;
+            pulls.map(|(_, get)| get(&t))
+        };
+        let defaults = pulls.map(|(_, get)| get(&TrackerParams::default()));
+        assert_eq!(now(&h), defaults);
         h.get_by_label("Tracker").click();
         h.run();
-        h.get_by_role_and_label(egui::accesskit::Role::Slider, "keep limbs long")
-            .set_value_accesskit(2.0);
-        h.run();
-        assert_eq!(pull(&h), 2.0);
-        h.state_mut().undo();
-        assert_eq!(pull(&h), default);
-        // The upper arms' own pull beside it, on its own.
-        let arms = |h: &Harness<'static, App>| {
-            h.state()
-                .project()
-                .unwrap()
-                .settings
-                .tracker
-                .upper_arm_short_penalty
-        };
-        h.get_by_role_and_label(egui::accesskit::Role::Slider, "keep upper arms long")
-            .set_value_accesskit(12.0);
-        h.run();
-        assert_eq!((arms(&h), pull(&h)), (12.0, default));
-        h.state_mut().undo();
-        assert_eq!(arms(&h), TrackerParams::default().upper_arm_short_penalty);
+        for (k, (label, _)) in pulls.iter().enumerate() {
+            h.get_by_role_and_label(egui::accesskit::Role::Slider, label)
+                .set_value_accesskit(2.0);
+            h.run();
+            let mut want = defaults;
+            want[k] = 2.0;
+            assert_eq!(now(&h), want, "{label} set on its own");
+            h.state_mut().undo();
+            assert_eq!(now(&h), defaults, "{label} undone");
+        }
     }
 
     /// The tracker's switches (gait completion, the hip patch, the arms' second look) can each

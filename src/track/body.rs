@@ -66,8 +66,9 @@ struct Part {
     /// How far along its bone the part is sampled.
     extent: Extent,
     /// What the block pays per unit of ln(full length / length) when shorter than its full
-    /// length: [`TrackerParams::short_penalty`] for the limbs, the upper arms' own
-    /// [`TrackerParams::upper_arm_short_penalty`], 0 for the head, trunk and hip patch.
+    /// length: [`TrackerParams::short_penalty`] for the legs, the upper arms' own
+    /// [`TrackerParams::upper_arm_short_penalty`], the forearms' own
+    /// [`TrackerParams::forearm_short_penalty`], 0 for the head, trunk and hip patch.
     short_penalty: f32,
 }
 
@@ -207,6 +208,7 @@ impl BodyTracker {
                     BodyPart::LeftUpperArm | BodyPart::RightUpperArm => {
                         params.upper_arm_short_penalty
                     }
+                    BodyPart::LeftForearm | BodyPart::RightForearm => params.forearm_short_penalty,
                     _ => params.short_penalty,
                 },
             }

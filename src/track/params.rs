@@ -122,6 +122,22 @@ pub struct TrackerParams {
     /// real sample fell below 0.80.
     /// Default 35.
     pub upper_arm_short_penalty: f32,
+    /// Beyond the paper: the forearms' own pull towards full length (as
+    /// [`TrackerParams::short_penalty`], for the forearms' blocks only). A forearm crossing the
+    /// trunk, or in a sleeve of its colour, shrinks towards the elbow with the ordinary pull and
+    /// leaves the wrist short; a stronger pull keeps it long, but also resists a hand pointing
+    /// at the camera. Measured with `bench track`'s suite (joint-frames missed at PCK@0.2, of
+    /// 24208) and the real sample (PCK@0.2) at 8 (the ordinary pull) / 10 / 11 / 12 / 13 / 14 /
+    /// 15 / 16 / 18 / 20 / 30: suite 1401 / 1337 / 1362 / 1340 / 1406 / 1387 / 1613 / 1363 /
+    /// 1511 / 1639 / 1623, real sample 0.805 / 0.811 / 0.833 / 0.834 / 0.822 / 0.839 / 0.843 /
+    /// 0.841 / 0.845 / 0.845 / 0.845 (at 12 its left wrist 66.3 → 51.4 px). It stays at the
+    /// ordinary 8 because the lift from those better tracks came out worse: at 10 to 14 the
+    /// real sample lifted with its true bone lengths takes the trunk's mirror image for the
+    /// whole clip (156 → 249–271 mm; a near tie between two calibrations, as
+    /// `upper_arm_short_penalty` found at 34), and at 12 the suite lifted from the height went
+    /// 94.9 → 101.0 mm (dance_turns_frontal 92.7 → 120.8). Raise it (12) for real video whose
+    /// wrists fall short, and check the 3D view. Default 8.
+    pub forearm_short_penalty: f32,
     /// Refine each limb chain as one figure after its segments are found (beyond the paper):
     /// the elbow or knee and the wrist or ankle move by sub-pixel steps while the sum of both
     /// segments' costs falls, so a middle joint the upper segment put a pixel off no longer
@@ -205,6 +221,7 @@ impl Default for TrackerParams {
             fold_limit_deg: 165.0,
             short_penalty: 8.0,
             upper_arm_short_penalty: 35.0,
+            forearm_short_penalty: 8.0,
             chain_refine: true,
             arm_rescue: true,
             shoulder_spring: 0.05,
@@ -289,13 +306,14 @@ impl TrackerParams {
             fold_limit_deg,
             short_penalty,
             upper_arm_short_penalty,
+            forearm_short_penalty,
             chain_refine: _,
             arm_rescue: _,
             shoulder_spring,
             gait_completion: _,
         } = *self;
         weights.validate()?;
-        let checks: [(&'static str, f64, Range); 25] = [
+        let checks: [(&'static str, f64, Range); 26] = [
             ("head_step_px", head_step_px, Positive),
             ("head_d_theta_deg", head_d_theta_deg, NonNegative),
             ("head_d_m", head_d_m, Fraction),
@@ -322,6 +340,11 @@ impl TrackerParams {
             (
                 "upper_arm_short_penalty",
                 upper_arm_short_penalty.into(),
+                NonNegative,
+            ),
+            (
+                "forearm_short_penalty",
+                forearm_short_penalty.into(),
                 NonNegative,
             ),
             ("shoulder_spring", shoulder_spring.into(), NonNegative),
@@ -379,8 +402,12 @@ mod tests {
             edit(&mut p);
             p
         };
-        let cases: [(&str, TrackerParams); 6] = [
+        let cases: [(&str, TrackerParams); 7] = [
             ("short_penalty", with(|p| p.short_penalty = -1.0)),
+            (
+                "forearm_short_penalty",
+                with(|p| p.forearm_short_penalty = -0.5),
+            ),
             (
                 "upper_arm_short_penalty",
                 with(|p| p.upper_arm_short_penalty = f32::NAN),
