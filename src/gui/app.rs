@@ -2173,6 +2173,14 @@ mod tests {
         h
     }
 
+    /// The app on a fresh project in `dir` with the Parameters panel's Tracker section open.
+    fn with_tracker_panel(dir: &Path) -> Harness<'static, App> {
+        let mut h = with_project(dir);
+        h.get_by_label("Tracker").click();
+        h.run();
+        h
+    }
+
     /// The pull of short limbs back to full length, and the upper arms' and the forearms' own,
     /// are each set from the Parameters panel on its own (the others stay), and each is an
     /// undoable project setting.
@@ -2185,15 +2193,13 @@ mod tests {
             ("keep forearms long", |t| t.forearm_short_penalty),
         ];
         let dir = tempfile::tempdir().unwrap();
-        let mut h = with_project(dir.path());
+        let mut h = with_tracker_panel(dir.path());
         let now = |h: &Harness<'static, App>| {
             let t = h.state().project().unwrap().settings.tracker;
             pulls.map(|(_, get)| get(&t))
         };
         let defaults = pulls.map(|(_, get)| get(&TrackerParams::default()));
         assert_eq!(now(&h), defaults);
-        h.get_by_label("Tracker").click();
-        h.run();
         for (k, (label, _)) in pulls.iter().enumerate() {
             h.get_by_role_and_label(egui::accesskit::Role::Slider, label)
                 .set_value_accesskit(2.0);
@@ -2218,12 +2224,10 @@ mod tests {
         ];
         for (label, get) in switches {
             let dir = tempfile::tempdir().unwrap();
-            let mut h = with_project(dir.path());
+            let mut h = with_tracker_panel(dir.path());
             let on =
                 |h: &Harness<'static, App>| get(&h.state().project().unwrap().settings.tracker);
             assert!(on(&h), "{label} starts on");
-            h.get_by_label("Tracker").click();
-            h.run();
             h.get_by_label(label).click();
             h.run();
             assert!(!on(&h), "{label} turned off");
@@ -2277,9 +2281,7 @@ mod tests {
     fn the_shoulder_spring_is_greyed_out_without_the_chain_refinement() {
         use egui_kittest::kittest::NodeT;
         let dir = tempfile::tempdir().unwrap();
-        let mut h = with_project(dir.path());
-        h.get_by_label("Tracker").click();
-        h.run();
+        let mut h = with_tracker_panel(dir.path());
         let disabled = |h: &Harness<'_, App>| {
             h.get_by_role_and_label(egui::accesskit::Role::Slider, "shoulder spring")
                 .accesskit_node()

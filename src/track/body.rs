@@ -730,12 +730,34 @@ const CHAIN_STEP_PX: f64 = 1.0;
 /// sample: a first step of 0.5 or 2 px, or four levels, did no better.
 const CHAIN_LEVELS: usize = 3;
 
+/// A limb segment's search around its prediction: `limb_range_deg` in coarse steps, the length
+/// within `limb_range_m`.
+fn limb_search(p: &TrackerParams) -> AngularParams {
+    AngularParams {
+        range_theta: p.limb_range_deg.to_radians(),
+        step_theta: p.coarse_step_deg.to_radians(),
+        range_m: p.limb_range_m,
+        m_count: 5,
+        scale_width: false,
+    }
+}
+
+/// `search` widened for fast limbs: `wide_range_deg` in steps twice the coarse step.
+fn widened(search: AngularParams, p: &TrackerParams) -> AngularParams {
+    AngularParams {
+        range_theta: p.wide_range_deg.to_radians(),
+        step_theta: 2.0 * p.coarse_step_deg.to_radians(),
+        ..search
+    }
+}
+
 /// How [`track_limb`] looks for a chain beyond its own search.
 #[derive(Clone, Copy)]
 struct Look {
     /// A leg's second look: its bars ([`BodyTracker::reacquire_legs`]).
     second: Option<Bars>,
-    /// Whether a lost forearm may call [`rescue_arm`] (arms, `arm_rescue`).
+    /// Whether a lost forearm may call [`rescue_arm`] (arms only, which never have a second
+    /// look: `arm_rescue`).
     rescue: bool,
 }
 
@@ -766,13 +788,7 @@ fn track_limb(
     for (k, part) in parts.iter_mut().enumerate() {
         let before = (part.block.theta, part.prev_theta);
         let pred = predict_anchored(part, anchor, Some(parent), p.velocity_damping);
-        let narrow = AngularParams {
-            range_theta: p.limb_range_deg.to_radians(),
-            step_theta: p.coarse_step_deg.to_radians(),
-            range_m: p.limb_range_m,
-            m_count: 5,
-            scale_width: false,
-        };
+        let narrow = limb_search(p);
         let free = prior(part, &pred, p, zoom);
         let prior = match second_look {
             Some(bars) => Prior {
@@ -806,11 +822,7 @@ fn track_limb(
             hold(part, anchor, parent);
         } else {
             if weak || second_look.is_some() || folded(&found.block) {
-                let wide = AngularParams {
-                    range_theta: p.wide_range_deg.to_radians(),
-                    step_theta: 2.0 * p.coarse_step_deg.to_radians(),
-                    ..narrow
-                };
+                let wide = widened(narrow, p);
                 let again = angular(&part.template, frame, &pred, &wide, &prior);
                 if again.cost < found.cost && !folded(&again.block) || folded(&found.block) {
                     found = again;
@@ -829,7 +841,6 @@ fn track_limb(
     }
     if let ([Some(upper), Some(lower)], [Some(up), Some(low)]) = (&moved, searched)
         && look.rescue
-        && second_look.is_none()
         && reliability(low.1, p.reliability_c0) < p.weak_reliability
         && let Some(rescued) = rescue_arm(parts, [up, low], [upper, lower], frame, p)
     {
@@ -911,14 +922,8 @@ fn rescue_arm(
     let found_upper = parts[0].block.theta;
     // The forearm's predicted angle to the upper arm the search found.
     let bend = lower.0.theta - found_upper;
-    let step = 2.0 * p.coarse_step_deg.to_radians();
-    let wide = AngularParams {
-        range_theta: p.wide_range_deg.to_radians(),
-        step_theta: step,
-        range_m: p.limb_range_m,
-        m_count: 5,
-        scale_width: false,
-    };
+    let wide = widened(limb_search(p), p);
+    let step = wide.step_theta;
     let steps = (wide.range_theta / step).ceil() as i64;
     let mut best: Option<(f32, Rescued)> = None;
     for k in -steps..=steps {
