@@ -12,8 +12,8 @@ use super::block::{MorphBlock, wrap_angle};
 use super::head::HeadPredictor;
 use super::params::TrackerParams;
 use super::search::{
-    AngularParams, ChainRoot, ChainSegment, Found, Prior, SpiralParams, angular, refine_chain,
-    spiral,
+    AngularParams, ChainRoot, ChainSegment, Found, Prior, SpiralParams, angular, angular_below,
+    refine_chain, spiral,
 };
 use super::similarity::{Extent, FloatFrame, FrameView, Template};
 use crate::camera::point_in_frame;
@@ -164,6 +164,16 @@ pub struct BodyTracker {
     prev: FloatFrame,
     /// A spare buffer the next frame is converted into (reused: no allocation per frame).
     spare: FloatFrame,
+}
+
+/// The highest cost a match may have and still be sound (its reliability at least
+/// `weak_reliability`): the inverse of [`reliability`].
+fn sound_cost(p: &TrackerParams) -> f32 {
+    if p.weak_reliability > 0.0 {
+        p.reliability_c0 * (1.0 / p.weak_reliability - 1.0)
+    } else {
+        f32::INFINITY
+    }
 }
 
 fn reliability(cost: f32, c0: f32) -> f32 {
@@ -955,7 +965,9 @@ fn rescue_arm(
             theta: pred.theta,
             ..*priors[1]
         };
-        let found = angular(&parts[1].template, frame, &pred, &wide, &lower_prior);
+        // Only a forearm both sound and making the pair cheaper is of use.
+        let cap = (bound - cost).min(sound_cost(p));
+        let found = angular_below(&parts[1].template, frame, &pred, &wide, &lower_prior, cap);
         let total = cost + found.cost;
         if total < bound
             && reliability(found.cost, p.reliability_c0) >= p.weak_reliability
