@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what videomocap needs on Debian/Ubuntu and is safe to run again: Debian packages
 # (build: pkg-config, clang for bindgen, FFmpeg's -dev libraries; GUI: X11/Wayland/GL; tests:
-# ffmpeg, xvfb) and the Rust toolchain pinned in rust-toolchain.toml.
+# ffmpeg, xvfb; screenshots: imagemagick, xdotool) and the Rust toolchain pinned in
+# rust-toolchain.toml.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -12,7 +13,7 @@ packages=(
   # the desktop app, loaded at run time
   libxcursor1 libxi6 libxkbcommon-x11-0 libx11-6 libwayland-client0 libgl1 libegl1 libegl-mesa0 libgl1-mesa-dri
   # tests, screenshots, benchmarks
-  ffmpeg xvfb xauth imagemagick
+  ffmpeg xvfb xauth imagemagick xdotool
   # fetching rustup when cargo is missing
   curl ca-certificates
 )
