@@ -235,7 +235,8 @@ fn examine(
         .collect();
     // Lags up to the longest stride: the work grows with the video's length only linearly.
     let max_lag = (PERIOD_S.1 * fps).ceil() as usize + 1;
-    let Some(swing) = Swing::of(&unwrapped(&angles), max_lag) else {
+    let min_lag = (PERIOD_S.0 * fps).ceil() as usize;
+    let Some(swing) = Swing::of(&unwrapped(&angles), min_lag, max_lag) else {
         return (report, None);
     };
     report.period_s = Some(swing.period as f64 / fps);
@@ -414,9 +415,12 @@ pub const LATER_PEAK_MARGIN: f64 = 0.1;
 impl Swing {
     /// The period of a series: the first local peak of its normalised autocorrelation after
     /// its first negative lag that is within [`LATER_PEAK_MARGIN`] of the highest there (lags
-    /// up to [`MAX_LAG_SHARE`] of the series and at most `max_lag`); `None` for a constant
-    /// series or one that never turns negative there.
-    fn of(series: &[f64], max_lag: usize) -> Option<Swing> {
+    /// from `min_lag`, up to [`MAX_LAG_SHARE`] of the series and at most `max_lag`); `None` for
+    /// a constant series or one that never turns negative there. Lags under `min_lag` (the
+    /// shortest stride taken) are never the period: a wobble in the tracked angle peaked there
+    /// first and cost the whole gait (run_side with `short_penalty` 10: the legs' period came
+    /// out 0.16 s, outside [`PERIOD_S`]).
+    fn of(series: &[f64], min_lag: usize, max_lag: usize) -> Option<Swing> {
         let n = series.len();
         let mean = series.iter().sum::<f64>() / n.max(1) as f64;
         let s: Vec<f64> = series.iter().map(|x| x - mean).collect();
@@ -436,7 +440,9 @@ impl Swing {
         let end = ((n as f64 * MAX_LAG_SHARE) as usize).min(max_lag + 1);
         let first_negative = (1..end).find(|&l| ac(l) < 0.0)?;
         // (lag, autocorrelation) from the first negative lag on.
-        let curve: Vec<(usize, f64)> = (first_negative..end).map(|l| (l, ac(l))).collect();
+        let curve: Vec<(usize, f64)> = (first_negative.max(min_lag)..end)
+            .map(|l| (l, ac(l)))
+            .collect();
         let highest = curve
             .iter()
             .map(|&(_, a)| a)
@@ -679,12 +685,20 @@ mod tests {
         let series: Vec<f64> = (0..150)
             .map(|t| (TAU * t as f64 / 37.0).sin() + 0.3 * (TAU * t as f64 / 12.0).cos())
             .collect();
-        let s = Swing::of(&series, 75).unwrap();
+        let s = Swing::of(&series, 0, 75).unwrap();
         assert!((36..=38).contains(&s.period), "{s:?}");
         assert!(s.autocorr > 0.8, "{s:?}");
-        assert!(Swing::of(&[1.0; 50], 75).is_none());
+        assert!(Swing::of(&[1.0; 50], 0, 75).is_none());
         // Lags capped below the period: no period found there.
-        assert!(Swing::of(&series, 20).is_none_or(|s| s.period <= 20));
+        assert!(Swing::of(&series, 0, 20).is_none_or(|s| s.period <= 20));
+        // A strong shorter swing (a wobbling track) peaks first; lags under the shortest
+        // stride are not searched, so the stride is still found.
+        let wobbly: Vec<f64> = (0..150)
+            .map(|t| (TAU * t as f64 / 37.0).sin() + 3.0 * (TAU * t as f64 / 9.0).cos())
+            .collect();
+        assert!(Swing::of(&wobbly, 0, 75).is_some_and(|s| s.period < 20));
+        let s = Swing::of(&wobbly, 20, 75).unwrap();
+        assert!((36..=38).contains(&s.period), "{s:?}");
         // Angles across ±180° unwrap to one smooth series.
         let u = unwrapped(&[3.1, -3.1, -3.0, 3.0]);
         assert!(u.windows(2).all(|w| (w[1] - w[0]).abs() < 0.3), "{u:?}");
@@ -695,13 +709,13 @@ mod tests {
         // run_side's case: 171 frames, stride 92 frames (half the series would stop at 85).
         let stride = |t: usize| (TAU * t as f64 / 92.0).sin();
         let short: Vec<f64> = (0..171).map(stride).collect();
-        let s = Swing::of(&short, 300).unwrap();
+        let s = Swing::of(&short, 0, 300).unwrap();
         assert!((90..=94).contains(&s.period), "{s:?}");
         // Many strides: the first peak, not a later one nearly as high.
         let long: Vec<f64> = (0..120)
             .map(|t| (TAU * t as f64 / 30.0).sin() + 0.05 * ((t * 7919) % 13) as f64 / 13.0)
             .collect();
-        let s = Swing::of(&long, 300).unwrap();
+        let s = Swing::of(&long, 0, 300).unwrap();
         assert!((29..=31).contains(&s.period), "{s:?}");
     }
 }
