@@ -270,7 +270,7 @@ fn track_at_working_scale(
     } else {
         (info.width, info.height)
     };
-    let mut params = job.params;
+    let mut params = job.params.at_frame_rate(info.fps);
     params.parallel = params.parallel && job.threads > 1;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(job.threads.max(1))
