@@ -348,7 +348,7 @@ pub fn angular(
 /// synthetic bar needs about 5. The arm rescue's cost on the real sample (instructions to
 /// decode and track it, counted by cachegrind; 10.4 G without the rescue): uncapped 16.9 G, 2
 /// 14.0 G, 1.5 11.3 G.
-const COARSE_SLACK: f32 = 1.5;
+pub const COARSE_SLACK: f32 = 1.5;
 
 /// [`angular`] for a caller that only wants a block costing under `cap`: coarse candidates
 /// costing more than [`COARSE_SLACK`] times `cap` are dropped as soon as their partial sum
