@@ -32,11 +32,16 @@ fn render(dir: &Path, motion: ProceduralMotion, frames: usize, view: View) {
 
 /// A motion-capture file of `tests/data`, from its start.
 fn bundled_bvh(file: &str) -> MotionSource {
+    bundled_bvh_from(file, 0.0)
+}
+
+/// A motion-capture file of `tests/data`, from `start_s` seconds in.
+fn bundled_bvh_from(file: &str, start_s: f64) -> MotionSource {
     MotionSource::Bvh {
         path: Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("tests/data")
             .join(file),
-        start_s: 0.0,
+        start_s,
     }
 }
 
@@ -114,6 +119,18 @@ fn track_rendered(dir: &Path, params: TrackerParams) -> ClipScore {
 fn joint_and_pck(dir: &Path, joint: Joint, params: TrackerParams) -> (f64, f64) {
     let s = track_rendered(dir, params);
     (s.per_joint[joint].mean_px(), s.overall.pck02())
+}
+
+/// Tracks the clip rendered into `dir` as H.264 with `params`; returns the mean error
+/// (pixels) of `joints`, averaged over them, and the clip's PCK@0.2.
+fn joints_and_pck_mp4(dir: &Path, joints: &[Joint], params: TrackerParams) -> (f64, f64) {
+    let s = common::track_and_score(dir, &dir.join("video.mp4"), params);
+    let px = joints
+        .iter()
+        .map(|&j| s.per_joint[j].mean_px())
+        .sum::<f64>()
+        / joints.len() as f64;
+    (px, s.overall.pck02())
 }
 
 #[test]
@@ -503,10 +520,7 @@ fn an_arm_whose_sleeve_matches_the_shirt_is_found_again_by_its_forearm() {
             arm_rescue,
             ..TrackerParams::default()
         };
-        let s = common::track_and_score(dir.path(), &dir.path().join("video.mp4"), params);
-        let arm = [Joint::RightElbow, Joint::RightWrist];
-        let arm_px = arm.iter().map(|&j| s.per_joint[j].mean_px()).sum::<f64>() / 2.0;
-        (arm_px, s.overall.pck02())
+        joints_and_pck_mp4(dir.path(), &[Joint::RightElbow, Joint::RightWrist], params)
     };
     let (arm_off, pck_off) = run(false);
     let (arm_on, pck_on) = run(true);
@@ -532,13 +546,9 @@ fn an_arm_whose_sleeve_matches_the_shirt_is_found_again_by_its_forearm() {
 #[test]
 fn a_forearm_weak_for_a_frame_turns_no_further_than_a_limb_can() {
     let dir = tempfile::tempdir().unwrap();
-    let motion = MotionSource::Bvh {
-        path: Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/cmu_02_01_walk.bvh"),
-        start_s: 1.0,
-    };
     render_suite_like(
         dir.path(),
-        motion,
+        bundled_bvh_from("cmu_02_01_walk.bvh", 1.0),
         View::Frontal,
         (111, 60),
         450.0,
@@ -550,8 +560,7 @@ fn a_forearm_weak_for_a_frame_turns_no_further_than_a_limb_can() {
             wide_speed_deg_s,
             ..TrackerParams::default()
         };
-        let s = common::track_and_score(dir.path(), &dir.path().join("video.mp4"), params);
-        (s.per_joint[Joint::LeftWrist].mean_px(), s.overall.pck02())
+        joints_and_pck_mp4(dir.path(), &[Joint::LeftWrist], params)
     };
     let (free_px, free_pck) = run(0.0);
     let (limited_px, limited_pck) = run(4000.0);
