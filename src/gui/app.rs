@@ -1308,6 +1308,8 @@ impl App {
                     .on_hover_text(format!("Reliability under which a joint counts as weak (orange) and may be interpolated; default {}", d.weak_reliability));
                 ui.add(egui::Slider::new(&mut t.max_gap_s, 0.0..=2.0).text("interpolate up to (s)"))
                     .on_hover_text(format!("Longest weak run filled by interpolation between reliable frames; default {} s", d.max_gap_s));
+                ui.add(egui::Slider::new(&mut t.smooth_s, 0.0..=0.1).fixed_decimals(3).text("smooth tracks (s)"))
+                    .on_hover_text(format!("The finished tracks are smoothed over time by a window this wide (standard deviation), each frame counting as much as it is reliable, so a weak frame between sound ones moves most; your own marks stay put. For 2D work: the lift smooths by the jitter it finds and gets less on smoothed tracks (0 = off); default {} s", d.smooth_s));
                 ui.add(egui::Slider::new(&mut t.twin_merge_s, 0.0..=1.0).text("twins merged after (s)"))
                     .on_hover_text(format!("Left and right elbows, wrists, knees or ankles tracked onto one spot this long: the one that followed the other is made weak (0 = off); default {} s", d.twin_merge_s));
                 ui.add(egui::Slider::new(&mut t.twin_guard_torso, 0.0..=0.5).text("legs second look (torso)"))
@@ -2210,6 +2212,23 @@ mod tests {
             h.state_mut().undo();
             assert_eq!(now(&h), defaults, "{label} undone");
         }
+    }
+
+    /// The tracks' smoothing window (off by default) is set from the Parameters panel, an
+    /// undoable project setting.
+    #[test]
+    fn the_track_smoothing_is_an_undoable_tracker_setting() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut h = with_tracker_panel(dir.path());
+        let now =
+            |h: &Harness<'static, App>| h.state().project().unwrap().settings.tracker.smooth_s;
+        assert_eq!(now(&h), TrackerParams::default().smooth_s);
+        h.get_by_role_and_label(egui::accesskit::Role::Slider, "smooth tracks (s)")
+            .set_value_accesskit(0.02);
+        h.run();
+        assert_eq!(now(&h), 0.02);
+        h.state_mut().undo();
+        assert_eq!(now(&h), TrackerParams::default().smooth_s);
     }
 
     /// The tracker's switches (gait completion, the hip patch, the arms' second look) can each

@@ -12,6 +12,7 @@
 //! - [`occlusion`]: interpolation over weak runs, the weak-span report
 //! - [`gait`]: the hidden far limbs of a walk or run completed from the other side
 //! - [`side_trunk`]: a side-on walker's shoulders and hips in perspective
+//! - [`smooth`]: the finished tracks smoothed over time, weighted by reliability
 //! - [`run`]: passes over a video, key frames, re-tracking
 
 pub mod block;
@@ -24,6 +25,7 @@ pub mod run;
 pub mod search;
 pub mod side_trunk;
 pub mod similarity;
+pub mod smooth;
 
 pub use gait::{GaitOutcome, GaitReport, LimbPair};
 pub use occlusion::{SpanKind, WeakSpan, weak_spans};

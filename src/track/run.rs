@@ -13,6 +13,7 @@ use super::body::{BodyTracker, JointResult, stature_px};
 use super::gait::{GaitOutcome, complete_gaits};
 use super::occlusion::{WeakSpan, fill_weak_runs, weak_spans, weaken_merged_twins};
 use super::params::TrackerParams;
+use super::smooth::smooth_tracks;
 use crate::camera::point_in_frame;
 use crate::formats::{FrameTracks, PointSource, SourceInfo, TrackedPoint, Tracks2d};
 use crate::skeleton::{JOINT_COUNT, Joint, PerJoint, Proportions};
@@ -446,6 +447,22 @@ fn track_at_working_scale(
     // Points completed from the gait change the weak runs they lay in.
     if gait.limbs.iter().any(|g| g.completed > 0) {
         spans = weak_spans(&frames, job.params.weak_reliability, &is_key);
+    }
+    // Smoothed last (when asked for): the filled runs and the gait's copies are smoothed with
+    // the rest. A re-track smooths what it tracked; the earlier result before it was smoothed
+    // already.
+    let first = job.from.map_or(0, |f| f + 1);
+    smooth_tracks(&mut frames, job.params.smooth_s * info.fps, first, &is_key);
+    // The corrected frame's reliable joints stay as the user saw them: the side-on trunk's
+    // shoulders and hips, set again above, would otherwise lose their smoothing there. (The
+    // earlier result covers every frame and `from` lies in it: checked before tracking.)
+    if let (Some(from), Some(prev)) = (job.from, job.previous.as_ref()) {
+        for j in Joint::ALL {
+            let was = prev.frames[from].points[j];
+            if !job.keys.is_key(from, j) && was.confidence >= job.params.weak_reliability {
+                frames[from].points[j] = was;
+            }
+        }
     }
     let mut damaged = std::mem::take(&mut ctx.damaged);
     damaged.sort_unstable();
