@@ -13,6 +13,7 @@
 
 use crate::formats::Tracks2d;
 use crate::skeleton::{JOINT_COUNT, Joint, PerJoint};
+use crate::track::smooth::gaussian_mean;
 use nalgebra::{Point2, Vector2};
 
 /// Widest Gaussian the adaptive choice takes, frames (beyond it motion is cut, not noise).
@@ -74,19 +75,10 @@ pub fn smoothed_images(tracks: &Tracks2d, sigma: &PerJoint<f64>) -> Vec<PerJoint
                 if s < UNTOUCHED_BELOW {
                     return raw[t][j];
                 }
-                let reach = (3.0 * s).ceil() as usize;
-                let mut sum = Vector2::zeros();
-                let mut total = 0.0;
-                let first = t.saturating_sub(reach);
-                let window = raw.iter().zip(&tracks.frames).enumerate();
-                for (u, (point, frame)) in window.skip(first).take(t + reach + 1 - first) {
-                    let d = u as f64 - t as f64;
-                    let w = (-0.5 * d * d / (s * s)).exp()
-                        * super::refine::track_weight(&frame.points[j]);
-                    sum += point[j].coords * w;
-                    total += w;
-                }
-                Point2::from(sum * (1.0 / total))
+                Point2::from(gaussian_mean(t, n, s, |u| {
+                    let w = super::refine::track_weight(&tracks.frames[u].points[j]);
+                    Some((raw[u][j].coords, w))
+                }))
             })
         })
         .collect()

@@ -30,6 +30,30 @@ pub const MIN_WEIGHT: f64 = 0.05;
 /// How far the window reaches, in standard deviations.
 pub const REACH_SIGMAS: f64 = 3.0;
 
+/// The Gaussian-weighted mean at position `t` of a series of `len` points: every position `u`
+/// within [`REACH_SIGMAS`] standard deviations (`sigma`, in positions) gives `sample(u)`, its
+/// point and weight (`None` leaves it out), weighed by `exp(−(u − t)² / 2σ²)` on top. The
+/// weights that count must not all be 0. One window for the tracker's smoothing here and the
+/// lift's (`lift::smoothing`), which differ only in what they weigh and leave out.
+pub fn gaussian_mean(
+    t: usize,
+    len: usize,
+    sigma: f64,
+    mut sample: impl FnMut(usize) -> Option<(Vector2<f64>, f64)>,
+) -> Vector2<f64> {
+    let reach = (REACH_SIGMAS * sigma).ceil() as usize;
+    let (mut sum, mut total) = (Vector2::zeros(), 0.0);
+    for u in t.saturating_sub(reach)..(t + reach + 1).min(len) {
+        if let Some((point, weight)) = sample(u) {
+            let d = u as f64 - t as f64;
+            let w = (-0.5 * d * d / (sigma * sigma)).exp() * weight;
+            sum += point * w;
+            total += w;
+        }
+    }
+    sum * (1.0 / total)
+}
+
 /// Smooths every joint's track from position `first` of `frames` on (the frames before it
 /// are neighbours only) with a Gaussian window of standard deviation `sigma_frames` (frames),
 /// each neighbour weighted by its reliability (at least [`MIN_WEIGHT`]). Joints for which
@@ -46,10 +70,6 @@ pub fn smooth_tracks(
     if sigma_frames.is_nan() || sigma_frames <= 0.0 || frames.len() < 2 {
         return;
     }
-    let reach = (REACH_SIGMAS * sigma_frames).ceil() as usize;
-    let kernel: Vec<f64> = (0..=reach)
-        .map(|d| (-0.5 * (d as f64 / sigma_frames).powi(2)).exp())
-        .collect();
     for joint in Joint::ALL {
         let smoothed: Vec<Option<Vector2<f64>>> = (0..frames.len())
             .map(|t| {
@@ -57,24 +77,17 @@ pub fn smooth_tracks(
                 if t < first || is_key(t, joint) || p.source == PointSource::OffFrame {
                     return None;
                 }
-                let (from, to) = (t.saturating_sub(reach), (t + reach).min(frames.len() - 1));
-                let (mut sum, mut total) = (Vector2::zeros(), 0.0);
-                for (s, frame) in frames.iter().enumerate().take(to + 1).skip(from) {
-                    let q = frame.points[joint];
-                    if q.source == PointSource::OffFrame {
-                        continue;
-                    }
-                    let reliability = if is_key(s, joint) {
+                // The weights are not all 0: the frame itself is on the frame and weighs at
+                // least MIN_WEIGHT.
+                Some(gaussian_mean(t, frames.len(), sigma_frames, |u| {
+                    let q = frames[u].points[joint];
+                    let reliability = if is_key(u, joint) {
                         1.0
                     } else {
                         f64::from(q.confidence).max(MIN_WEIGHT)
                     };
-                    let w = kernel[s.abs_diff(t)] * reliability;
-                    sum += q.pos.coords * w;
-                    total += w;
-                }
-                // `total` > 0: the frame itself is on the frame and weighs at least MIN_WEIGHT.
-                Some(sum / total)
+                    (q.source != PointSource::OffFrame).then_some((q.pos.coords, reliability))
+                }))
             })
             .collect();
         for (frame, pos) in frames.iter_mut().zip(smoothed) {
