@@ -7,8 +7,9 @@
 //! proportions from the subject's height alone, the true focal length given. Scores from
 //! [`videomocap::eval::pose3d`], per-frame solve (eqs. 6–11 and the root choices) and after the
 //! global refinement; (a) with true lengths once more on the reference's own key triangle in
-//! every frame, which leaves the root choices alone. Then the focal-length estimate against the
-//! truth, and speed.
+//! every frame, which leaves the root choices alone; and its wrong roots taken apart (coin
+//! flips against choices that matter, the arms' and legs' bones alone). Then the focal-length
+//! estimate against the truth, and speed.
 
 use super::args::{BenchArgs, GlobalArgs};
 use super::bench_track::{ensure_suite, track_opened};
@@ -17,8 +18,8 @@ use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 use videomocap::eval::pose3d::{
-    Pose3dScore, key_triangle_flex_m, lift_on_reference_key, score_skeleton, stature_from_truth,
-    subject_from_truth, tracks_from_truth,
+    COIN_FLIP_LENGTHS, Pose3dScore, key_triangle_flex_m, lift_on_reference_key, score_skeleton,
+    stature_from_truth, subject_from_truth, tracks_from_truth,
 };
 use videomocap::formats::{Marks, Tracks2d};
 use videomocap::lift::focal::estimate_focal;
@@ -160,6 +161,26 @@ fn isolation_line(score: &Pose3dScore, flex_m: f64) -> String {
     )
 }
 
+/// The line that takes (a) with true lengths' wrong roots apart: the coin flips (both roots
+/// about equally far from the truth, the parent joint being off) against the choices that
+/// matter, and the arms' and legs' bones alone.
+fn roots_line(score: &Pose3dScore) -> String {
+    format!(
+        "(a) true lengths, wrong roots taken apart: {} of {} bone-frames ({:.1}%); {} of them coin flips, both roots about equally far from the truth (within {} of the bone's length: its parent joint is off), so {} of the {} choices that matter ({:.1}%); the arms' and legs' bones alone {} of {} ({:.1}%)",
+        score.wrong,
+        score.choices,
+        100.0 * score.wrong_share(),
+        score.coin_flips_wrong,
+        COIN_FLIP_LENGTHS,
+        score.wrong - score.coin_flips_wrong,
+        score.choices - score.coin_flips,
+        100.0 * score.decided_wrong_share(),
+        score.limb_wrong,
+        score.limb_choices,
+        100.0 * score.limb_wrong_share(),
+    )
+}
+
 /// Runs the lift benchmark and prints its tables.
 pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let threads = std::thread::available_parallelism()
@@ -244,6 +265,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         &isolated,
         flex_sum / clips.len().max(1) as f64,
     ));
+    out.push(roots_line(&suite[0][0].per_frame));
     out.push("per clip:".to_owned());
     out.extend(lines);
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -264,6 +286,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     );
     let (iso, flex_m) = on_reference_key(&real_gt, &params)?;
     out.push(isolation_line(&iso, flex_m));
+    out.push(roots_line(&real[0][0].per_frame));
     out.push(String::new());
     out.push(
         "focal length estimated from (a) with height-based proportions; default 60° across the longer side = 554 px here"

@@ -32,6 +32,75 @@ pub struct Pose3dScore {
     pub choices: usize,
     /// Of those, the ones where the other root is nearer the truth.
     pub wrong: usize,
+    /// Of the choices, the coin flips: both roots about equally far from the truth (their
+    /// distances within [`COIN_FLIP_LENGTHS`] of the bone's length). The parent joint is off
+    /// (the rigid key triangle against a flexing reference, an earlier choice), so neither
+    /// root is right and the choice hardly changes the error.
+    pub coin_flips: usize,
+    /// Of the coin flips, the ones counted wrong.
+    pub coin_flips_wrong: usize,
+    /// Choices on the arms' and legs' bones (upper arms, forearms, thighs, shanks).
+    pub limb_choices: usize,
+    /// Of those, the wrong ones.
+    pub limb_wrong: usize,
+}
+
+/// How close, as a share of the bone's length, the two roots' distances from the truth must be
+/// for a depth choice to be a coin flip ([`Pose3dScore::coin_flips`]); the same share as the
+/// roots' least separation for the choice to count at all.
+pub const COIN_FLIP_LENGTHS: f64 = 0.1;
+
+/// One bone's depth choice against the truth ([`root_choice`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RootChoice {
+    /// The other root is nearer the truth.
+    pub wrong: bool,
+    /// Both roots are about equally far from it ([`Pose3dScore::coin_flips`]).
+    pub coin_flip: bool,
+}
+
+/// How a bone's depth root was chosen: `known` its solved parent, `solved` the joint on its
+/// viewing ray (camera space), `want` the true bone vector. `None` when the two roots on the
+/// ray lie within [`COIN_FLIP_LENGTHS`] of the bone's length of each other (the choice does
+/// not matter).
+pub fn root_choice(
+    known: Point3<f64>,
+    solved: Point3<f64>,
+    want: Vector3<f64>,
+) -> Option<RootChoice> {
+    let len = (solved - known).norm();
+    // The other root on the same ray: s' = 2(r·K) − s.
+    let r = solved.coords.try_normalize(f64::EPSILON)?;
+    let along = r.dot(&solved.coords);
+    let other = 2.0 * r.dot(&known.coords) - along;
+    if (other - along).abs() < COIN_FLIP_LENGTHS * len {
+        return None;
+    }
+    let alt = Point3::from(r * other);
+    let (d_taken, d_other) = (
+        ((solved - known) - want).norm(),
+        ((alt - known) - want).norm(),
+    );
+    Some(RootChoice {
+        wrong: d_other < d_taken,
+        coin_flip: (d_taken - d_other).abs() < COIN_FLIP_LENGTHS * len,
+    })
+}
+
+/// Whether a bone solved towards `solved` is a limb's (an elbow, wrist, knee or ankle at its
+/// end).
+fn is_limb(solved: Joint) -> bool {
+    matches!(
+        solved,
+        Joint::LeftElbow
+            | Joint::LeftWrist
+            | Joint::RightElbow
+            | Joint::RightWrist
+            | Joint::LeftKnee
+            | Joint::LeftAnkle
+            | Joint::RightKnee
+            | Joint::RightAnkle
+    )
 }
 
 impl Pose3dScore {
@@ -44,6 +113,10 @@ impl Pose3dScore {
         self.bones += o.bones;
         self.choices += o.choices;
         self.wrong += o.wrong;
+        self.coin_flips += o.coin_flips;
+        self.coin_flips_wrong += o.coin_flips_wrong;
+        self.limb_choices += o.limb_choices;
+        self.limb_wrong += o.limb_wrong;
     }
     /// MPJPE after pelvis alignment, mm.
     pub fn mpjpe_mm(&self) -> f64 {
@@ -60,6 +133,16 @@ impl Pose3dScore {
     /// Share of depth choices that are wrong.
     pub fn wrong_share(&self) -> f64 {
         self.wrong as f64 / self.choices.max(1) as f64
+    }
+    /// Share of the depth choices that are not coin flips ([`Pose3dScore::coin_flips`]) that
+    /// are wrong: the choices that matter, decided the wrong way.
+    pub fn decided_wrong_share(&self) -> f64 {
+        (self.wrong - self.coin_flips_wrong) as f64
+            / self.choices.saturating_sub(self.coin_flips).max(1) as f64
+    }
+    /// Share of the arms' and legs' depth choices that are wrong.
+    pub fn limb_wrong_share(&self) -> f64 {
+        self.limb_wrong as f64 / self.limb_choices.max(1) as f64
     }
 }
 
@@ -129,21 +212,17 @@ pub fn score_skeleton(gt: &GroundTruth, skeleton: &Skeleton3d) -> Result<Pose3dS
                 continue;
             }
             let (k, c) = (p[known], p[solved]);
-            let len = (c - k).norm();
-            lengths.entry(bone).or_default().push(len);
-            // The other root on the same ray: s' = 2(r·K) − s.
-            let r = c.coords.normalize();
-            let along = r.dot(&c.coords);
-            let other = 2.0 * r.dot(&k.coords) - along;
-            if (other - along).abs() < 0.1 * len {
+            lengths.entry(bone).or_default().push((c - k).norm());
+            let Some(choice) = root_choice(k, c, truth[solved] - truth[known]) else {
                 continue;
-            }
-            let alt = Point3::from(r * other);
-            let want = truth[solved] - truth[known];
+            };
+            let limb = is_limb(solved);
             s.choices += 1;
-            if ((alt - k) - want).norm() < ((c - k) - want).norm() {
-                s.wrong += 1;
-            }
+            s.wrong += usize::from(choice.wrong);
+            s.coin_flips += usize::from(choice.coin_flip);
+            s.coin_flips_wrong += usize::from(choice.coin_flip && choice.wrong);
+            s.limb_choices += usize::from(limb);
+            s.limb_wrong += usize::from(limb && choice.wrong);
         }
     }
     for values in lengths.values() {
@@ -304,6 +383,57 @@ pub fn lift_on_reference_key(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_root_choice_is_wrong_right_or_a_coin_flip() {
+        // A 0.3 m bone from a parent 3 m ahead, tilted 30° towards the camera.
+        let known = Point3::new(0.0, 0.0, 3.0);
+        let tilt = 30f64.to_radians();
+        let want = Vector3::new(0.3 * tilt.cos(), 0.0, -0.3 * tilt.sin());
+        let truth = known + want;
+        // The mirror root on the same ray.
+        let r = truth.coords.normalize();
+        let mirror = Point3::from(r * (2.0 * r.dot(&known.coords) - r.dot(&truth.coords)));
+        let right = root_choice(known, truth, want);
+        assert_eq!(
+            right,
+            Some(RootChoice {
+                wrong: false,
+                coin_flip: false
+            })
+        );
+        let wrong = root_choice(known, mirror, want);
+        assert_eq!(
+            wrong,
+            Some(RootChoice {
+                wrong: true,
+                coin_flip: false
+            })
+        );
+        // The parent solved off its true place: the true bone hung from it ends on the plane
+        // halfway between the two roots on the ray (here beyond the ray's nearest point to
+        // the parent), so either root is as far from it.
+        let foot = Point3::from(r * r.dot(&known.coords));
+        let to_foot = foot - known;
+        let half = (0.09 - to_foot.norm_squared()).sqrt();
+        let sideways = to_foot * (0.3 / to_foot.norm());
+        let flip = root_choice(known, foot - r * half, sideways);
+        assert_eq!(
+            flip,
+            Some(RootChoice {
+                wrong: false,
+                coin_flip: true
+            })
+        );
+        assert_eq!(
+            root_choice(known, foot + r * half, sideways).map(|c| c.coin_flip),
+            Some(true)
+        );
+        // A bone square to its end's viewing ray: both roots together, no choice.
+        let end = Point3::new(0.0, 0.3, 3.0);
+        let square = Vector3::new(0.3, 0.0, 0.0);
+        assert_eq!(root_choice(end - square, end, square), None);
+    }
 
     #[test]
     fn procrustes_undoes_a_similarity() {
