@@ -134,11 +134,19 @@ impl Pose3dScore {
     pub fn wrong_share(&self) -> f64 {
         self.wrong as f64 / self.choices.max(1) as f64
     }
-    /// Share of the depth choices that are not coin flips ([`Pose3dScore::coin_flips`]) that
-    /// are wrong: the choices that matter, decided the wrong way.
+    /// The depth choices that matter: those that are not coin flips
+    /// ([`Pose3dScore::coin_flips`]).
+    pub fn decided(&self) -> usize {
+        self.choices.saturating_sub(self.coin_flips)
+    }
+    /// Of the choices that matter, the ones decided the wrong way.
+    pub fn decided_wrong(&self) -> usize {
+        self.wrong.saturating_sub(self.coin_flips_wrong)
+    }
+    /// Share of the choices that matter that are wrong ([`Pose3dScore::decided_wrong`] of
+    /// [`Pose3dScore::decided`]).
     pub fn decided_wrong_share(&self) -> f64 {
-        (self.wrong - self.coin_flips_wrong) as f64
-            / self.choices.saturating_sub(self.coin_flips).max(1) as f64
+        self.decided_wrong() as f64 / self.decided().max(1) as f64
     }
     /// Share of the arms' and legs' depth choices that are wrong.
     pub fn limb_wrong_share(&self) -> f64 {
