@@ -1333,6 +1333,10 @@ impl App {
                     .on_hover_text(format!("Cost per square pixel that a shoulder pays for leaving the place the rigid trunk gives it, so it can rise with a raised arm (part of the chain refinement); higher holds it closer; 0 holds it on the trunk; default {}", d.shoulder_spring));
                 ui.checkbox(&mut t.arm_rescue, "look again for lost arms")
                     .on_hover_text(format!("When a forearm is lost, the whole arm is looked for again as one piece, so a sleeve the colour of the shirt no longer holds the arm on the body; default {}", if d.arm_rescue { "on" } else { "off" }));
+                ui.add(egui::Slider::new(&mut t.arm_foreground, 0.0..=1.0).text("arms stand out from the background"))
+                    .on_hover_text(format!("With a camera that stands still, the background is the median of 25 frames, and an arm's blocks must stand out from it where they did on the marked frame, so a forearm no longer settles on a wall of its colour; ignored when the camera moves (0 = off); default {}", d.arm_foreground));
+                ui.add(egui::Slider::new(&mut t.head_min_share, 0.0..=1.0).text("shortest head"))
+                    .on_hover_text(format!("The head's length may not fall below this share of its marked length (less when the whole body has shrunk), so a head turning away keeps the neck in its place (0 = no floor); default {}", d.head_min_share));
                 ui.checkbox(&mut t.gait_completion, "complete hidden limbs from the gait")
                     .on_hover_text(format!("In a walk or run seen from the side, the far arm's and leg's joints that are weak, or far from where the near limb was half a stride earlier and later, are put there (pink) for you to check; default {}", if d.gait_completion { "on" } else { "off" }));
                 if ui.button("Defaults").clicked() {
@@ -2229,6 +2233,34 @@ mod tests {
         assert_eq!(now(&h), 0.02);
         h.state_mut().undo();
         assert_eq!(now(&h), TrackerParams::default().smooth_s);
+    }
+
+    /// The arms' foreground weight and the head's shortest share are set from the Parameters
+    /// panel, each on its own and undoable.
+    #[test]
+    fn the_background_and_head_floor_are_undoable_tracker_settings() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut h = with_tracker_panel(dir.path());
+        let now = |h: &Harness<'static, App>| {
+            let t = h.state().project().unwrap().settings.tracker;
+            (t.arm_foreground, t.head_min_share)
+        };
+        let d = TrackerParams::default();
+        assert_eq!(now(&h), (d.arm_foreground, d.head_min_share));
+        h.get_by_role_and_label(
+            egui::accesskit::Role::Slider,
+            "arms stand out from the background",
+        )
+        .set_value_accesskit(0.0);
+        h.run();
+        assert_eq!(now(&h), (0.0, d.head_min_share), "the weight on its own");
+        h.get_by_role_and_label(egui::accesskit::Role::Slider, "shortest head")
+            .set_value_accesskit(0.5);
+        h.run();
+        assert_eq!(now(&h), (0.0, 0.5));
+        h.state_mut().undo();
+        h.state_mut().undo();
+        assert_eq!(now(&h), (d.arm_foreground, d.head_min_share), "both undone");
     }
 
     /// The tracker's switches (gait completion, the hip patch, the arms' second look) can each

@@ -8,6 +8,7 @@
 //!
 //! Works in one image scale (the caller converts to and from video pixels).
 
+use super::background::Background;
 use super::block::{MorphBlock, wrap_angle};
 use super::head::HeadPredictor;
 use super::params::TrackerParams;
@@ -21,6 +22,7 @@ use crate::skeleton::{BodyPart, Joint, PerJoint, Proportions};
 use image::RgbImage;
 use nalgebra::Point2;
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// The four limb chains: root joint, middle joint, end joint.
 pub const CHAINS: [[Joint; 3]; 4] = [
@@ -79,6 +81,18 @@ const LENGTH_SLACK: f64 = 1.2;
 /// The sampled extent of each part along its bone (see [`Extent`]): the head block reaches a
 /// little above the calvaria, limb blocks past their far joint (into the forearm, the hand,
 /// the shank, the foot).
+/// Whether a part is an upper arm or a forearm: the parts whose blocks weigh the foreground
+/// lane ([`TrackerParams::arm_foreground`]).
+fn is_arm(part: BodyPart) -> bool {
+    matches!(
+        part,
+        BodyPart::LeftUpperArm
+            | BodyPart::RightUpperArm
+            | BodyPart::LeftForearm
+            | BodyPart::RightForearm
+    )
+}
+
 fn extent(part: BodyPart) -> Extent {
     let (start, end) = match part {
         BodyPart::Head => (0.0, 1.0),
@@ -155,6 +169,10 @@ pub struct BodyTracker {
     predictor: HeadPredictor,
     /// The head block's length on the marked frame, pixels.
     marked_head_m: f64,
+    /// The trunk block's length on the marked frame, pixels.
+    marked_trunk_m: f64,
+    /// The static camera's background, when there is one: the fourth lane of every frame.
+    background: Option<Arc<Background>>,
     /// The head's zoom since the marking (never below 1): every length limit is multiplied by
     /// it.
     zoom: f64,
@@ -192,10 +210,12 @@ impl BodyTracker {
         pose: &PerJoint<Point2<f64>>,
         proportions: &Proportions,
         params: TrackerParams,
+        background: Option<Arc<Background>>,
     ) -> BodyTracker {
         let width = widths(pose, proportions, params.block_width_scale);
         let stature = stature_px(pose, proportions);
-        let floats = FloatFrame::new(image);
+        let mut floats = FloatFrame::default();
+        floats.fill_with(image, background.as_deref());
         let frame = floats.view();
         let w = params.weights;
         let part = |block: MorphBlock, kind: BodyPart| {
@@ -206,10 +226,14 @@ impl BodyTracker {
             } else {
                 proportions.fraction_between(a, b)
             };
+            let mut template = Template::sample(frame, &block, extent(kind), w);
+            if is_arm(kind) {
+                template.set_foreground(params.arm_foreground);
+            }
             Part {
                 block,
                 prev_theta: block.theta,
-                template: Template::sample(frame, &block, extent(kind), w),
+                template,
                 reliability: 1.0,
                 max_len: (LENGTH_SLACK * fraction * stature).max(block.m * 1.05),
                 extent: extent(kind),
@@ -286,6 +310,8 @@ impl BodyTracker {
             root_shift: [(0.0, 0.0); 4],
             predictor: HeadPredictor::default(),
             marked_head_m: pose_head_m,
+            marked_trunk_m: trunk_block.m,
+            background,
             zoom: 1.0,
             head_velocity: nalgebra::Vector2::zeros(),
             prev: floats,
@@ -356,7 +382,7 @@ impl BodyTracker {
         // Both frames are taken out of `self` while the parts are updated, and put back at the
         // end with their roles swapped.
         let mut floats = std::mem::take(&mut self.spare);
-        floats.fill(image);
+        floats.fill_with(image, self.background.as_deref());
         let previous = std::mem::take(&mut self.prev);
         let frame = floats.view();
         let prev = previous.view();
@@ -374,6 +400,7 @@ impl BodyTracker {
             d_theta: p.head_d_theta_deg.to_radians(),
             d_m: p.head_d_m,
             max_rings: p.head_max_rings,
+            m_bounds: (self.shortest_head(), f64::INFINITY),
         };
         let starts = [
             motion.displacement,
@@ -595,6 +622,18 @@ impl BodyTracker {
     }
 
     /// The hip patch searched by the head's spiral from where it was (for [`Self::hips_hold`]).
+    /// The shortest the head block may become, pixels: [`TrackerParams::head_min_share`] of
+    /// its marked length, times the trunk's shrink since the marking when it has shrunk (a
+    /// person walking away, or bowing). A head turning away from the camera loses the
+    /// contrast between face and hair that held its length, and the spiral's zoom then
+    /// shrank it frame by frame: on dance_turns_frontal to 8 px from the marked 61 as the
+    /// body turned side-on, the neck 0.2–0.3 torso above its place and the trunk and legs
+    /// hanging from it.
+    fn shortest_head(&self) -> f64 {
+        let shrink = (self.trunk.block.m / self.marked_trunk_m.max(f64::EPSILON)).min(1.0);
+        self.params.head_min_share * self.marked_head_m * shrink
+    }
+
     fn hips_spiral(&self, frame: FrameView, p: &TrackerParams) -> Found {
         spiral(
             &self.hips.template,
@@ -605,6 +644,7 @@ impl BodyTracker {
                 d_theta: p.head_d_theta_deg.to_radians(),
                 d_m: 0.0,
                 max_rings: p.head_max_rings,
+                m_bounds: (0.0, f64::INFINITY),
             },
         )
     }
@@ -710,8 +750,9 @@ fn move_to(part: &mut Part, block: MorphBlock) {
 /// The part learns from its block in the new frame: its reliability is the mapped similarity,
 /// and the adaptive colour model learns the new appearance when reliable.
 fn learn(part: &mut Part, frame: FrameView, p: &TrackerParams) {
-    // The reliability comes from the appearance alone, without the prior's penalty.
-    let cost = part.template.cost(frame, &part.block, false, f32::INFINITY);
+    // The reliability comes from the colours alone, without the prior's penalty or the
+    // foreground lane.
+    let cost = part.template.appearance_cost(frame, &part.block);
     part.reliability = reliability(cost, p.reliability_c0);
     if part.reliability >= p.weak_reliability {
         part.template.update(frame, &part.block, p.update_rate);

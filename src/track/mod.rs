@@ -6,6 +6,7 @@
 //!
 //! - [`block`]: the morph-block `A = {(x, y), m, n, θ}` (Fig. 7)
 //! - [`similarity`]: the sub-pixel morph-block similarity (eqs. 3–5), the hot loop
+//! - [`background`]: a static camera's background, foreground evidence for the arms
 //! - [`head`]: image-difference head prediction (eqs. 1–5)
 //! - [`search`]: the spiral search path (Fig. 6) and the anchored angular search
 //! - [`body`]: the top-down tracker (head → trunk → limbs)
@@ -15,6 +16,7 @@
 //! - [`smooth`]: the finished tracks smoothed over time, weighted by reliability
 //! - [`run`]: passes over a video, key frames, re-tracking
 
+pub mod background;
 pub mod block;
 pub mod body;
 pub mod gait;

@@ -21,6 +21,14 @@ pub struct TrackerParams {
     pub head_d_m: f64,
     /// Most rings of the spiral path. Default 12.
     pub head_max_rings: usize,
+    /// Beyond the paper: the shortest the head block may become, as a share of its marked
+    /// length (times the trunk's shrink since the marking, when the trunk has shrunk: a person
+    /// walking away or bowing). 0 = no floor. Default 0.7: on dance_turns_frontal the head
+    /// turning side-on otherwise shrank to 8 px of its marked 61. `bench track`'s suite misses
+    /// at PCK@0.2 (of 24208) with 0 / 0.5 / 0.7 / 0.8 / 0.9: 1318 / 1315 / 1301 / 1317 / 1325
+    /// (dance_turns_frontal 319 / 316 / 302 / 307 / 305), the real sample 0.805 / 0.805 / 0.805
+    /// / 0.794 / 0.819 (before the arms' foreground lane).
+    pub head_min_share: f64,
     /// Half-range of the trunk's angle search around its prediction, degrees. Default 20.
     pub trunk_range_deg: f64,
     /// Half-range of the trunk's length search, fraction. Default 0.15.
@@ -197,6 +205,27 @@ pub struct TrackerParams {
     /// ([`super::side_trunk`]). Default true. On `bench track`'s suite PCK@0.2 0.903 → 0.934,
     /// lost 3.55 → 1.86 %; the real sample (no gait) unchanged.
     pub gait_completion: bool,
+    /// Beyond the paper: weight of the foreground lane in the arms' blocks (upper arms and
+    /// forearms), against the colours' (each 8-bit level of foreground difference counts this
+    /// much against a level of colour difference). The lane is each pixel's difference from the
+    /// static camera's background ([`super::background`]), 0 to 255 from no difference to
+    /// `foreground_tau` and beyond; without a background (a moving camera) it is 0 everywhere.
+    /// An arm's block must then stand out from the background where it did on the key frame:
+    /// a forearm no longer settles on a wall of its own colour. The reliability still reads the
+    /// colours alone. 0 = off. Default 0.2. `bench track`'s suite misses at PCK@0.2 (of 24208;
+    /// with `head_min_share` 0) at 0 / 0.1 / 0.15 / 0.2 / 0.3: 1318 / 1222 / 1219 / 1217 /
+    /// 1280 (treadmill_raised 144 → 112, dance_oblique 384 → 317 at 0.2), the real sample
+    /// 0.805 / 0.796 / 0.787 / 0.810 / 0.787. On the legs as well it was chaotic: 1235 to
+    /// 1700, walk_across_side 114 to 516 misses (two legs that both stand out from the
+    /// background are told apart by their colours alone), and on the head and trunk the
+    /// median's ghost of a person who stands still, then bows, held bend_side's trunk where
+    /// it had stood (36 → 513 misses).
+    pub arm_foreground: f32,
+    /// The colour difference from the background (largest channel, 8-bit levels) at which a
+    /// pixel counts fully as foreground; also how near its median a steady background pixel
+    /// stays. Default 20. With `arm_foreground` 0.2: 15 / 20 / 25 gave 1206 / 1217 / 1253
+    /// misses, the real sample 0.784 / 0.810 / 0.796.
+    pub foreground_tau: f32,
     /// Beyond the paper: the finished tracks smoothed over time ([`super::smooth`]), a
     /// Gaussian window of this standard deviation, seconds, each neighbour weighted by its
     /// reliability; key frames and joints off the frame stay put. 0 (the default) turns it
@@ -218,6 +247,7 @@ impl Default for TrackerParams {
             head_d_theta_deg: 6.0,
             head_d_m: 0.06,
             head_max_rings: 12,
+            head_min_share: 0.7,
             trunk_range_deg: 20.0,
             trunk_range_m: 0.15,
             limb_range_deg: 30.0,
@@ -248,6 +278,8 @@ impl Default for TrackerParams {
             arm_rescue: true,
             shoulder_spring: 0.05,
             gait_completion: true,
+            arm_foreground: 0.2,
+            foreground_tau: 20.0,
             smooth_s: 0.0,
         }
     }
@@ -318,6 +350,7 @@ impl TrackerParams {
             head_d_theta_deg,
             head_d_m,
             head_max_rings: _,
+            head_min_share,
             trunk_range_deg,
             trunk_range_m,
             limb_range_deg,
@@ -348,10 +381,12 @@ impl TrackerParams {
             arm_rescue: _,
             shoulder_spring,
             gait_completion: _,
+            arm_foreground,
+            foreground_tau,
             smooth_s,
         } = *self;
         weights.validate()?;
-        let checks: [(&'static str, f64, Range); 28] = [
+        let checks: [(&'static str, f64, Range); 31] = [
             ("head_step_px", head_step_px, Positive),
             ("head_d_theta_deg", head_d_theta_deg, NonNegative),
             ("head_d_m", head_d_m, Fraction),
@@ -388,6 +423,9 @@ impl TrackerParams {
                 NonNegative,
             ),
             ("shoulder_spring", shoulder_spring.into(), NonNegative),
+            ("head_min_share", head_min_share, Unit),
+            ("arm_foreground", arm_foreground.into(), NonNegative),
+            ("foreground_tau", foreground_tau.into(), Positive),
         ];
         checks
             .into_iter()

@@ -9,6 +9,7 @@
 //! anchors ([`super::occlusion`]), never runs that leave the frame. Frames are decoded (and shrunk to the working scale) on a separate
 //! thread while the tracker works, unless one thread is asked for.
 
+use super::background::{self, Background};
 use super::body::{BodyTracker, JointResult, stature_px};
 use super::gait::{GaitOutcome, complete_gaits};
 use super::occlusion::{WeakSpan, fill_weak_runs, weak_spans, weaken_merged_twins};
@@ -313,6 +314,13 @@ fn track_at_working_scale(
         total: (n - start) + if job.from.is_none() { first_key } else { 0 },
         progress,
         cancel,
+        background: None,
+    };
+    ctx.background = if job.params.arm_foreground > 0.0 {
+        ctx.estimate_background(n, job.params.foreground_tau)?
+            .map(Arc::new)
+    } else {
+        None
     };
     let start_pose = |raw: &[Option<PerJoint<JointResult>>], f: usize| -> PerJoint<Point2<f64>> {
         let base = raw[f].map(|r| r.map(|_, j| j.pos)).unwrap_or(first_pose);
@@ -500,9 +508,45 @@ struct PassContext<'a, 'p> {
     total: usize,
     progress: &'p mut (dyn FnMut(&TrackProgress) + Send),
     cancel: &'a AtomicBool,
+    /// The static camera's background at the working size, when there is one.
+    background: Option<Arc<Background>>,
 }
 
 impl PassContext<'_, '_> {
+    /// The static camera's background from [`background::SAMPLES`] frames spread over the
+    /// clip's `n` frames, at the working size ([`Background::estimate`]; `None` for a moving
+    /// camera). When the whole clip fits in the video's frame cache every frame is read, so
+    /// that the passes find them there and the clip is decoded once (reading only the samples
+    /// forwards decodes the frames between them all the same, and the first pass would then
+    /// decode them again).
+    fn estimate_background(
+        &mut self,
+        n: usize,
+        tau: f32,
+    ) -> Result<Option<Background>, TrackError> {
+        let samples = background::sample_indices(n, background::SAMPLES);
+        let read: Vec<usize> = if n <= self.video.cache_capacity_frames() {
+            (0..n).collect()
+        } else {
+            samples.clone()
+        };
+        let mut images = Vec::with_capacity(samples.len());
+        for index in read {
+            if self.cancel.load(Ordering::Relaxed) {
+                return Err(TrackError::Cancelled);
+            }
+            let Some(frame) = undamaged(self.video.frame(index))? else {
+                continue;
+            };
+            if samples.binary_search(&index).is_ok()
+                && (frame.image.width(), frame.image.height()) == (self.width, self.height)
+            {
+                images.push(self.scale.shrink(frame.image));
+            }
+        }
+        let refs: Vec<&RgbImage> = images.iter().map(|i| i.as_ref()).collect();
+        Ok(Background::estimate(&refs, tau))
+    }
     /// Tracks over `order` (consecutive frames, forwards or backwards), starting from `pose` on
     /// its first frame; returns the results in video pixels, one per frame of `order` (the
     /// first is the starting pose). Forward passes re-key at key frames on the way.
@@ -514,6 +558,7 @@ impl PassContext<'_, '_> {
     ) -> Result<Vec<PerJoint<JointResult>>, TrackError> {
         let scale = self.scale;
         let params = self.params;
+        let background = self.background.clone();
         let keys = self.keys;
         let cancel = self.cancel;
         let (path, width, height) = (self.path.clone(), self.width, self.height);
@@ -564,7 +609,8 @@ impl PassContext<'_, '_> {
             let result = match tracker.as_mut() {
                 None => {
                     let work = pose.map(|_, p| scale.to_work(*p));
-                    let t = BodyTracker::new(&image, &work, &proportions, params);
+                    let t =
+                        BodyTracker::new(&image, &work, &proportions, params, background.clone());
                     let mut r = t.pose();
                     for j in Joint::ALL {
                         r[j].reliability = 1.0;
@@ -578,7 +624,13 @@ impl PassContext<'_, '_> {
                         let tracked = r.map(|_, j| j.pos);
                         let work_keys = keys.frames[&index].map(|_, k| k.map(|p| scale.to_work(p)));
                         let fixed = tracked.map(|j, p| work_keys[j].unwrap_or(*p));
-                        *t = BodyTracker::new(&image, &fixed, &proportions, params);
+                        *t = BodyTracker::new(
+                            &image,
+                            &fixed,
+                            &proportions,
+                            params,
+                            background.clone(),
+                        );
                         for j in Joint::ALL {
                             if work_keys[j].is_some() {
                                 r[j] = JointResult {

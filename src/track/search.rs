@@ -110,6 +110,8 @@ pub struct SpiralParams {
     pub d_m: f64,
     /// Most rings walked (a bound on the time spent on a lost head).
     pub max_rings: usize,
+    /// Shortest and longest length a block may take, pixels.
+    pub m_bounds: (f64, f64),
 }
 
 /// The morph variants tried at each point of the spiral: {θ−Δθ, θ, θ+Δθ} × {m−Δm, m, m+Δm},
@@ -146,6 +148,20 @@ pub fn spiral(
     predicted: &MorphBlock,
     p: &SpiralParams,
 ) -> Found {
+    // The start brought within the length bounds, its width in proportion.
+    let m = predicted
+        .m
+        .clamp(p.m_bounds.0, p.m_bounds.1.max(p.m_bounds.0));
+    let start = MorphBlock {
+        m,
+        n: if predicted.m > 0.0 {
+            predicted.n * m / predicted.m
+        } else {
+            predicted.n
+        },
+        ..*predicted
+    };
+    let predicted = &start;
     let mut best = Found {
         block: *predicted,
         cost: f32::INFINITY,
@@ -202,7 +218,9 @@ fn try_point(
             ..*predicted
         },
         p,
-    ) {
+    )
+    .filter(|v| v.m >= p.m_bounds.0 && v.m <= p.m_bounds.1)
+    {
         let c = template.cost(frame, &v, false, best.cost);
         if c < best.cost {
             *best = Found { block: v, cost: c };
@@ -227,7 +245,11 @@ fn spiral_refine(template: &Template, frame: FrameView, best: Found, p: &SpiralP
             move_origin: true,
             levels: 3,
         },
-        &Prior::NONE,
+        &Prior {
+            m_min: p.m_bounds.0,
+            m_max: p.m_bounds.1,
+            ..Prior::NONE
+        },
     )
 }
 
@@ -799,10 +821,58 @@ mod tests {
                 d_theta: 0.05,
                 d_m: 0.05,
                 max_rings: 10,
+                m_bounds: (0.0, f64::INFINITY),
             },
         );
         let err = (found.block.origin - Point2::new(66.0, 46.0)).norm();
         assert!(err < 1.0, "origin off by {err} px");
+    }
+
+    #[test]
+    fn the_spiral_keeps_the_length_within_its_bounds() {
+        // The bar shrinks to half its length: unbounded, the spiral's zoom follows it; with a
+        // floor, the block stops there, and a start below the floor is lifted to it.
+        let (top, bottom) = (Point2::new(60.0, 30.0), Point2::new(70.0, 110.0));
+        let a = bar(top, bottom, 20.0);
+        let b = bar(top, nalgebra::center(&top, &bottom), 10.0);
+        let block = MorphBlock::along(top, bottom, 20.0);
+        let t = Template::sample(
+            FloatFrame::new(&a).view(),
+            &block,
+            Extent::BLOCK,
+            SimilarityWeights::default(),
+        );
+        let search = |m_bounds: (f64, f64), start: &MorphBlock| {
+            spiral(
+                &t,
+                FloatFrame::new(&b).view(),
+                start,
+                &SpiralParams {
+                    step_px: 2.0,
+                    d_theta: 0.05,
+                    d_m: 0.06,
+                    max_rings: 10,
+                    m_bounds,
+                },
+            )
+        };
+        let free = search((0.0, f64::INFINITY), &block);
+        assert!(free.block.m < 0.8 * block.m, "unbounded: {}", free.block.m);
+        let floor = 0.9 * block.m;
+        let held = search((floor, f64::INFINITY), &block);
+        assert!(held.block.m >= floor - 1e-9, "bounded: {}", held.block.m);
+        let short = MorphBlock {
+            m: 0.5 * block.m,
+            n: 10.0,
+            ..block
+        };
+        let lifted = search((floor, f64::INFINITY), &short);
+        assert!(
+            lifted.block.m >= floor - 1e-9,
+            "from below: {}",
+            lifted.block.m
+        );
+        assert!(lifted.cost.is_finite());
     }
 
     /// The spiral's rings walked one point at a time, as Fig. 6 draws them (no threads), then
@@ -846,6 +916,7 @@ mod tests {
             d_theta: 0.05,
             d_m: 0.05,
             max_rings: 10,
+            m_bounds: (0.0, f64::INFINITY),
         };
         for (k, shift) in [(3.0, -2.0), (9.0, 7.0), (-13.0, 4.0), (0.5, 0.5)]
             .into_iter()

@@ -28,6 +28,7 @@
 //! Fixed point took `bench track`'s 640×480 one-thread figure from 85.4 to 104.4 frames/s and
 //! the 1080×1920 tracking-to-decoding ratio from 2.04 to 1.57.
 
+use super::background::Background;
 use super::block::MorphBlock;
 use image::RgbImage;
 
@@ -64,7 +65,8 @@ impl Default for SimilarityWeights {
     }
 }
 
-/// A frame as four `f32` lanes per pixel (R, G, B and 0), converted once per frame (0.3 ms at
+/// A frame as four `f32` lanes per pixel (R, G, B and the foreground level, 0 without a
+/// background: [`FloatFrame::fill_with`]), converted once per frame (0.3 ms at
 /// 640×480): the hot loop then loads a pixel as one vector instead of widening its bytes at
 /// every sample.
 #[derive(Clone, Default)]
@@ -95,15 +97,25 @@ impl FloatFrame {
     /// Converts an RGB8 image into this frame's buffer, reusing its memory (a fresh buffer per
     /// frame would cost its page faults every frame).
     pub fn fill(&mut self, image: &RgbImage) {
+        self.fill_with(image, None);
+    }
+
+    /// [`FloatFrame::fill`] with the fourth lane set to each pixel's foreground level against
+    /// `background` ([`Background::levels`]); 0 without one, or when its size differs.
+    pub fn fill_with(&mut self, image: &RgbImage, background: Option<&Background>) {
         self.width = image.width() as usize;
         self.height = image.height() as usize;
         self.px.clear();
-        self.px.extend(
-            image
-                .as_raw()
-                .chunks_exact(3)
-                .map(|c| [f32::from(c[0]), f32::from(c[1]), f32::from(c[2]), 0.0]),
-        );
+        let rgb = image.as_raw().as_chunks::<3>().0.iter();
+        match background.and_then(|b| b.levels(image)) {
+            Some(levels) => self.px.extend(
+                rgb.zip(levels)
+                    .map(|(c, f)| [f32::from(c[0]), f32::from(c[1]), f32::from(c[2]), f]),
+            ),
+            None => self
+                .px
+                .extend(rgb.map(|c| [f32::from(c[0]), f32::from(c[1]), f32::from(c[2]), 0.0])),
+        }
     }
 
     /// A view for sampling.
@@ -174,7 +186,7 @@ impl FrameView<'_> {
     }
 
     /// The colour at a point known to lie inside `[0, width − 1) × [0, height − 1)`, given in
-    /// fixed point ([`FRAC_BITS`] fraction bits), as four lanes (R, G, B, 0) so the compiler
+    /// fixed point ([`FRAC_BITS`] fraction bits), as four lanes (R, G, B, foreground) so the compiler
     /// keeps a pixel in one vector register: no clamping, no float-to-integer conversion (a
     /// saturating one per coordinate in Rust), and each pair of neighbouring pixels is one
     /// slice. `None` when the point is not inside after all.
@@ -197,11 +209,25 @@ impl FrameView<'_> {
         Some(out)
     }
 
-    /// [`FrameView::bilinear`] as four lanes (R, G, B, 0).
+    /// [`FrameView::bilinear`] as four lanes (R, G, B and the foreground level).
     #[cold]
     fn bilinear4(&self, x: f32, y: f32) -> [f32; 4] {
         let [r, g, b] = self.bilinear(x, y);
-        [r, g, b, 0.0]
+        [r, g, b, self.bilinear_lane(x, y, 3)]
+    }
+
+    /// One lane at a sub-pixel position, as [`FrameView::bilinear`] interpolates the colour.
+    fn bilinear_lane(&self, x: f32, y: f32, lane: usize) -> f32 {
+        let x = x.clamp(0.0, (self.width - 1) as f32);
+        let y = y.clamp(0.0, (self.height - 1) as f32);
+        let (x0, y0) = (x as usize, y as usize);
+        let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+        let x1 = (x0 + 1).min(self.width - 1);
+        let y1 = (y0 + 1).min(self.height - 1);
+        let v = |xx: usize, yy: usize| self.at(yy * self.width + xx)[lane];
+        let top = v(x0, y0) + fx * (v(x1, y0) - v(x0, y0));
+        let bottom = v(x0, y1) + fx * (v(x1, y1) - v(x0, y1));
+        top + fy * (bottom - top)
     }
 
     /// Colour at an integer pixel (caller keeps `x < width`, `y < height`).
@@ -333,7 +359,7 @@ impl Extent {
 pub struct Template {
     rows: usize,
     cols: usize,
-    /// Per cell: the key model's R, G, B, 0 and the adaptive model's R, G, B, 0 (four lanes,
+    /// Per cell: the key model's R, G, B, foreground and the adaptive model's (four lanes,
     /// like [`FloatFrame`]).
     cells: Vec<[[f32; 4]; 2]>,
     /// Per cell: `W1` in the centre region, `W2` in the margin (eq. 5).
@@ -346,6 +372,8 @@ pub struct Template {
     total: [f32; 2],
     weights: SimilarityWeights,
     extent: Extent,
+    /// Weight of the foreground lane against the colour ([`Template::set_foreground`]).
+    foreground: f32,
 }
 
 /// Grid size for a block of `m × n` pixels: one cell per pixel, capped.
@@ -387,6 +415,7 @@ impl Template {
             }
         }
         let mut t = Template {
+            foreground: 0.0,
             rows,
             cols,
             cells: vec![[[0.0; 4]; 2]; rows * cols],
@@ -538,6 +567,31 @@ impl Template {
     /// samples, for the wide first search). Returns `f32::INFINITY` as soon as the partial sum
     /// proves the cost exceeds `bound` (early exit: the candidate already loses).
     pub fn cost(&self, frame: FrameView, block: &MorphBlock, coarse: bool, bound: f32) -> f32 {
+        self.cost_lanes(frame, block, coarse, bound, self.foreground)
+    }
+
+    /// [`Template::cost`] on the colour alone, the foreground lane left out: what the
+    /// reliability is read from, so that it means the same with and without a background.
+    pub fn appearance_cost(&self, frame: FrameView, block: &MorphBlock) -> f32 {
+        self.cost_lanes(frame, block, false, f32::INFINITY, 0.0)
+    }
+
+    /// Makes [`Template::cost`] weigh the foreground lane by `weight` (levels of foreground
+    /// difference against levels of colour difference): the part must stand out from the
+    /// background where it stood out on the key frame. 0 (the default) leaves it out.
+    pub fn set_foreground(&mut self, weight: f32) {
+        self.foreground = weight;
+    }
+
+    /// [`Template::cost`] with the foreground lane weighed by `foreground`.
+    fn cost_lanes(
+        &self,
+        frame: FrameView,
+        block: &MorphBlock,
+        coarse: bool,
+        bound: f32,
+        foreground: f32,
+    ) -> f32 {
         let total = self.total[usize::from(coarse)];
         let limit = if bound.is_finite() {
             bound * total
@@ -545,12 +599,13 @@ impl Template {
             f32::INFINITY
         };
         let g = GridGeometry::new(block, self.extent, self.rows, self.cols);
-        // eq. 3's channel weights times the two models' mix, per lane (the fourth weighs 0).
+        // eq. 3's channel weights times the two models' mix, per lane (the fourth is the
+        // foreground level's).
         let [wr, wg, wb] = self.weights.rgb;
         let wk = self.weights.key;
         let wa = 1.0 - wk;
-        let w_key = [wk * wr, wk * wg, wk * wb, 0.0];
-        let w_ada = [wa * wr, wa * wg, wa * wb, 0.0];
+        let w_key = [wk * wr, wk * wg, wk * wb, wk * foreground];
+        let w_ada = [wa * wr, wa * wg, wa * wb, wa * foreground];
         let sum = if coarse {
             self.sum_over::<2>(frame, &g, [w_key, w_ada], limit)
         } else {
@@ -560,7 +615,7 @@ impl Template {
     }
 }
 
-/// Every cell's colour (R, G, B, 0) in row-major order, sampled exactly as [`Template::cost`]
+/// Every cell's colour and foreground level in row-major order, sampled exactly as [`Template::cost`]
 /// samples it (in fixed point when the grid lies inside the frame), so that a block compared
 /// with itself costs nothing.
 fn sample_grid(
@@ -698,6 +753,64 @@ mod tests {
             ..block
         };
         assert!(t.cost(f, &moved, false, f32::INFINITY) > 5.0);
+    }
+
+    #[test]
+    fn the_foreground_lane_tells_an_arm_from_a_wall_of_its_colour() {
+        // A plain scene with a red stripe painted on the wall at x 70–79; the person's red arm
+        // stands at x 20–29 on the key frame and at x 40–49 on the next.
+        let red = image::Rgb([200, 40, 40]);
+        let scene = RgbImage::from_fn(100, 60, |x, _| {
+            if (70..80).contains(&x) {
+                red
+            } else {
+                image::Rgb([90, 110, 100])
+            }
+        });
+        let with_arm = |x0: u32| {
+            let mut im = scene.clone();
+            for y in 10..50 {
+                for x in x0..x0 + 10 {
+                    im.put_pixel(x, y, red);
+                }
+            }
+            im
+        };
+        let background =
+            Background::estimate(&[&scene, &scene, &scene], 20.0).expect("a static camera");
+        let frame = |im: &RgbImage| {
+            let mut f = FloatFrame::default();
+            f.fill_with(im, Some(&background));
+            f
+        };
+        let (key, next) = (frame(&with_arm(20)), frame(&with_arm(40)));
+        let at = |x: f64| MorphBlock::along(Point2::new(x, 15.0), Point2::new(x, 45.0), 6.0);
+        let mut t = Template::sample(key.view(), &at(24.5), Extent::BLOCK, Default::default());
+        let (arm, wall) = (at(44.5), at(74.5));
+        let cost = |t: &Template, b: &MorphBlock| t.cost(next.view(), b, false, f32::INFINITY);
+        // By colour alone the wall is as good a match as the arm.
+        assert!((cost(&t, &arm) - cost(&t, &wall)).abs() < 1e-3);
+        t.set_foreground(0.2);
+        assert!(
+            cost(&t, &arm) + 10.0 < cost(&t, &wall),
+            "the wall stands out no more"
+        );
+        // The reliability's cost reads the colours alone.
+        assert_eq!(
+            t.appearance_cost(next.view(), &arm),
+            t.appearance_cost(next.view(), &wall)
+        );
+        // Without a background the lane is 0 everywhere and changes nothing.
+        let plain = FloatFrame::new(&with_arm(40));
+        let mut u = Template::sample(
+            FloatFrame::new(&with_arm(20)).view(),
+            &at(24.5),
+            Extent::BLOCK,
+            Default::default(),
+        );
+        u.set_foreground(0.2);
+        let c = |b: &MorphBlock| u.cost(plain.view(), b, false, f32::INFINITY);
+        assert!((c(&arm) - c(&wall)).abs() < 1e-3);
     }
 
     #[test]

@@ -187,6 +187,11 @@ impl Video {
         Ok(Video::from_source(Box::new(span), cache_bytes))
     }
 
+    /// How many frames of the current size the cache holds at most.
+    pub fn cache_capacity_frames(&self) -> usize {
+        self.cache.capacity_frames()
+    }
+
     /// Bytes currently held by the frame cache.
     pub fn cached_bytes(&self) -> usize {
         self.cache.used_bytes()
