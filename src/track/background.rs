@@ -103,7 +103,12 @@ impl Background {
 /// How much a pixel `c` stands out from its background `b`: 255 times its largest channel
 /// difference over `tau`, at most 255.
 pub fn foreground_level(c: &[u8; 3], b: &[u8; 3], tau: f32) -> f32 {
-    255.0 * (f32::from(max_abs_diff(c, b)) / tau).min(1.0)
+    level(max_abs_diff(c, b), tau)
+}
+
+/// The foreground level of a largest channel difference `diff`.
+fn level(diff: u8, tau: f32) -> f32 {
+    255.0 * (f32::from(diff) / tau).min(1.0)
 }
 
 /// The largest channel difference between two pixels.
@@ -116,7 +121,7 @@ fn max_abs_diff(c: &[u8; 3], b: &[u8; 3]) -> u8 {
 
 /// [`foreground_level`] of every difference 0 to 255 (read per pixel and frame).
 fn level_table(tau: f32) -> [f32; 256] {
-    std::array::from_fn(|d| 255.0 * (d as f32 / tau).min(1.0))
+    std::array::from_fn(|d| level(u8::try_from(d).unwrap_or(u8::MAX), tau))
 }
 
 /// Indices of `count` frames spread evenly over `0..n`, first and last included (all of them
