@@ -57,18 +57,17 @@ impl Background {
         }
         // A steady pixel: enough samples within `tau` of the median in every channel.
         let need = (STABLE_SHARE * raws.len() as f32).ceil() as usize;
-        let mut near = vec![0u8; w as usize * h as usize];
-        let lut = level_table(tau);
+        let mut near = vec![0usize; w as usize * h as usize];
         for raw in &raws {
             for ((n, px), m) in near
                 .iter_mut()
                 .zip(raw.as_chunks::<3>().0)
                 .zip(median.as_chunks::<3>().0)
             {
-                *n += u8::from(lut[usize::from(max_abs_diff(px, m))] < 255.0);
+                *n += usize::from(f32::from(max_abs_diff(px, m)) < tau);
             }
         }
-        let steady = near.iter().filter(|&&n| usize::from(n) >= need).count();
+        let steady = near.iter().filter(|&&n| n >= need).count();
         let pixels = near.len().max(1);
         if (steady as f32) < MIN_STATIC_SHARE * pixels as f32 {
             return None;
@@ -76,7 +75,7 @@ impl Background {
         let pixels = RgbImage::from_raw(w, h, median)?;
         Some(Background {
             pixels,
-            levels: lut,
+            levels: level_table(tau),
         })
     }
 

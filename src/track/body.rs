@@ -78,9 +78,6 @@ struct Part {
 /// differ from the table, and marks are not exact).
 const LENGTH_SLACK: f64 = 1.2;
 
-/// The sampled extent of each part along its bone (see [`Extent`]): the head block reaches a
-/// little above the calvaria, limb blocks past their far joint (into the forearm, the hand,
-/// the shank, the foot).
 /// Whether a part is an upper arm or a forearm: the parts whose blocks weigh the foreground
 /// lane ([`TrackerParams::arm_foreground`]).
 fn is_arm(part: BodyPart) -> bool {
@@ -93,6 +90,9 @@ fn is_arm(part: BodyPart) -> bool {
     )
 }
 
+/// The sampled extent of each part along its bone (see [`Extent`]): the head block reaches a
+/// little above the calvaria, limb blocks past their far joint (into the forearm, the hand,
+/// the shank, the foot).
 fn extent(part: BodyPart) -> Extent {
     let (start, end) = match part {
         BodyPart::Head => (0.0, 1.0),
@@ -621,7 +621,6 @@ impl BodyTracker {
         }
     }
 
-    /// The hip patch searched by the head's spiral from where it was (for [`Self::hips_hold`]).
     /// The shortest the head block may become, pixels: [`TrackerParams::head_min_share`] of
     /// its marked length, times the trunk's shrink since the marking when it has shrunk (a
     /// person walking away, or bowing). A head turning away from the camera loses the
@@ -634,6 +633,7 @@ impl BodyTracker {
         self.params.head_min_share * self.marked_head_m * shrink
     }
 
+    /// The hip patch searched by the head's spiral from where it was (for [`Self::hips_hold`]).
     fn hips_spiral(&self, frame: FrameView, p: &TrackerParams) -> Found {
         spiral(
             &self.hips.template,

@@ -158,6 +158,13 @@ impl FrameView<'_> {
     /// the nearest edge pixel's colour.
     #[inline]
     pub fn bilinear(&self, x: f32, y: f32) -> [f32; 3] {
+        let [r, g, b, _] = self.interpolate(x, y);
+        [r, g, b]
+    }
+
+    /// All four lanes at a sub-pixel position (see [`FrameView::bilinear`]).
+    #[inline]
+    fn interpolate(&self, x: f32, y: f32) -> [f32; 4] {
         let xmax = (self.width - 1) as f32;
         let ymax = (self.height - 1) as f32;
         let x = x.clamp(0.0, xmax);
@@ -176,7 +183,7 @@ impl FrameView<'_> {
             self.at(row1 + x0),
             self.at(row1 + x1),
         );
-        let mut out = [0.0f32; 3];
+        let mut out = [0.0f32; 4];
         for (k, o) in out.iter_mut().enumerate() {
             let top = a[k] + fx * (b[k] - a[k]);
             let bottom = c[k] + fx * (e[k] - c[k]);
@@ -186,10 +193,10 @@ impl FrameView<'_> {
     }
 
     /// The colour at a point known to lie inside `[0, width − 1) × [0, height − 1)`, given in
-    /// fixed point ([`FRAC_BITS`] fraction bits), as four lanes (R, G, B, foreground) so the compiler
-    /// keeps a pixel in one vector register: no clamping, no float-to-integer conversion (a
-    /// saturating one per coordinate in Rust), and each pair of neighbouring pixels is one
-    /// slice. `None` when the point is not inside after all.
+    /// fixed point ([`FRAC_BITS`] fraction bits), as four lanes (R, G, B, foreground) so the
+    /// compiler keeps a pixel in one vector register: no clamping, no float-to-integer
+    /// conversion (a saturating one per coordinate in Rust), and each pair of neighbouring
+    /// pixels is one slice. `None` when the point is not inside after all.
     #[inline]
     fn bilinear_fixed(&self, [x, y]: [i32; 2]) -> Option<[f32; 4]> {
         // A negative coordinate (not inside after all) becomes an index `get` refuses.
@@ -212,22 +219,7 @@ impl FrameView<'_> {
     /// [`FrameView::bilinear`] as four lanes (R, G, B and the foreground level).
     #[cold]
     fn bilinear4(&self, x: f32, y: f32) -> [f32; 4] {
-        let [r, g, b] = self.bilinear(x, y);
-        [r, g, b, self.bilinear_lane(x, y, 3)]
-    }
-
-    /// One lane at a sub-pixel position, as [`FrameView::bilinear`] interpolates the colour.
-    fn bilinear_lane(&self, x: f32, y: f32, lane: usize) -> f32 {
-        let x = x.clamp(0.0, (self.width - 1) as f32);
-        let y = y.clamp(0.0, (self.height - 1) as f32);
-        let (x0, y0) = (x as usize, y as usize);
-        let (fx, fy) = (x - x0 as f32, y - y0 as f32);
-        let x1 = (x0 + 1).min(self.width - 1);
-        let y1 = (y0 + 1).min(self.height - 1);
-        let v = |xx: usize, yy: usize| self.at(yy * self.width + xx)[lane];
-        let top = v(x0, y0) + fx * (v(x1, y0) - v(x0, y0));
-        let bottom = v(x0, y1) + fx * (v(x1, y1) - v(x0, y1));
-        top + fy * (bottom - top)
+        self.interpolate(x, y)
     }
 
     /// Colour at an integer pixel (caller keeps `x < width`, `y < height`).
@@ -615,9 +607,9 @@ impl Template {
     }
 }
 
-/// Every cell's colour and foreground level in row-major order, sampled exactly as [`Template::cost`]
-/// samples it (in fixed point when the grid lies inside the frame), so that a block compared
-/// with itself costs nothing.
+/// Every cell's colour and foreground level in row-major order, sampled exactly as
+/// [`Template::cost`] samples it (in fixed point when the grid lies inside the frame), so that
+/// a block compared with itself costs nothing.
 fn sample_grid(
     frame: FrameView<'_>,
     g: GridGeometry,
