@@ -11,7 +11,8 @@
 //! (an arm swung back less so) or, thighs, a little inwards; the legs' priors are taken in the
 //! pelvis's frame, the arms' in the key triangle's; of two arms that fit equally, the
 //! straighter and the one nearer the trunk's frontal plane; in a stride each arm swings against
-//! its own thigh; a wrist stays out of the trunk and the thighs), and the candidates are chained
+//! its own thigh; a wrist stays out of the trunk and the thighs; the pelvis also pays the least
+//! prior the hips and legs can take below it), and the candidates are chained
 //! over the frames by dynamic programming (Viterbi over pairs of consecutive choices) that
 //! minimises the joints' 3D acceleration in camera space plus the priors. Groups
 //! are solved centre outwards, each on the trajectory chosen for its root. A user's choice for a
@@ -113,10 +114,10 @@ pub struct AmbiguityWeights {
     /// bone-frames (walk_across_side 195 → 184), from the height 39.0 → 37.9; 2 px noise 46.0 →
     /// 44.4 (from the height 60.9 → 59.1); from the tracker 82.0 → 80.6 (from the height 88.7 →
     /// 87.9); the real sample unchanged (with noise, from the height, 103.9 → 103.7); the
-    /// per-frame solve 2249 → 2009 frames/s. The suite from exact 2D at 0.1 / 0.3 / 1 / 3: 820 / 817 / 826
-    /// / 841. Looking ahead from the hips to the legs as well cut exact 2D to 799, but from the
-    /// tracker's output it took the badly tracked legs' side: treadmill_raised 105.9 → 169.3
-    /// mm, the real sample 153.9 → 168.4.
+    /// per-frame solve 2249 → 2009 frames/s. The suite's wrong roots from exact 2D at 0.1 / 0.3 /
+    /// 1 / 3: 820 / 817 / 826 / 841. Looking ahead from the hips to the legs as well cut exact
+    /// 2D to 799, but from the tracker's output it took the badly tracked legs' side:
+    /// treadmill_raised 105.9 → 169.3 mm, the real sample 153.9 → 168.4.
     pub lookahead: f64,
 }
 
@@ -363,8 +364,9 @@ pub struct Resolved {
     /// Whether each bone was too long for its 2D image (flagged, placed off its ray).
     pub too_long: Vec<[bool; BONE_COUNT]>,
     /// The minimised total of each group of bones, priors (but the arms' swing and the spine's
-    /// look ahead, which only steer their roots) plus squared accelerations (squared metres), in the order they are
-    /// solved: head and neck, spine, hips, left leg, right leg, left arm, right arm.
+    /// look ahead, which only steer their roots) plus squared accelerations (squared metres), in
+    /// the order they are solved: head and neck, spine, hips, left leg, right leg, left arm, right
+    /// arm.
     pub group_costs: [f64; GROUP_COUNT],
 }
 
