@@ -1124,6 +1124,27 @@ mod tests {
         );
     }
 
+    /// Key joints, viewing rays and frame indices: [`resolve`]'s inputs.
+    type Seen = (
+        Vec<[Point3<f64>; 3]>,
+        Vec<PerJoint<Vector3<f64>>>,
+        Vec<usize>,
+    );
+
+    /// What [`resolve`] is given for a sequence of known bodies: their key joints, every
+    /// joint's viewing ray and the frame indices.
+    fn seen(frames: &[PerJoint<Point3<f64>>]) -> Seen {
+        let key = frames
+            .iter()
+            .map(|p| [p[LeftShoulder], p[RightShoulder], p[Chest]])
+            .collect();
+        let rays = frames
+            .iter()
+            .map(|p| p.map(|_, q| q.coords.normalize()))
+            .collect();
+        (key, rays, (0..frames.len()).collect())
+    }
+
     #[test]
     fn the_arms_swing_stays_out_of_the_reported_cost() {
         // A body three metres in front of the camera, facing away from it, walking on the
@@ -1140,15 +1161,7 @@ mod tests {
                 p.map(|_, q| q + Vector3::new(0.0, 0.0, 3.0))
             })
             .collect();
-        let key: Vec<[Point3<f64>; 3]> = frames
-            .iter()
-            .map(|p| [p[LeftShoulder], p[RightShoulder], p[Chest]])
-            .collect();
-        let rays: Vec<PerJoint<Vector3<f64>>> = frames
-            .iter()
-            .map(|p| p.map(|_, q| q.coords.normalize()))
-            .collect();
-        let index: Vec<usize> = (0..frames.len()).collect();
+        let (key, rays, index) = seen(&frames);
         let solve = |arm_swing: f64, overrides: &DepthOverrides| {
             let w = AmbiguityWeights {
                 arm_swing,
@@ -1206,15 +1219,7 @@ mod tests {
                 p.map(|_, q| q + Vector3::new(0.0, -3.0, 2.0))
             })
             .collect();
-        let key: Vec<[Point3<f64>; 3]> = frames
-            .iter()
-            .map(|p| [p[LeftShoulder], p[RightShoulder], p[Chest]])
-            .collect();
-        let rays: Vec<PerJoint<Vector3<f64>>> = frames
-            .iter()
-            .map(|p| p.map(|_, q| q.coords.normalize()))
-            .collect();
-        let index: Vec<usize> = (0..frames.len()).collect();
+        let (key, rays, index) = seen(&frames);
         let solve = |lookahead: f64| {
             // The spine's own prior blind: only the look ahead tells its roots apart.
             let w = AmbiguityWeights {
