@@ -33,7 +33,8 @@ pub const SYMMETRY_ROUNDS: usize = 2;
 
 /// The lag (frames, half a stride) at which the right thigh's forward swing best repeats the
 /// left's, when it does so closely enough ([`MIN_CORRELATION`]) and both thighs swing
-/// ([`MIN_SWING`]); `None` otherwise (and for clips shorter than four lags).
+/// ([`MIN_SWING`]); `None` otherwise. Lags up to half the clip are tried, so a clip must hold a
+/// whole stride.
 pub fn gait_lag(points: &[PerJoint<Point3<f64>>], trunks: &[TrunkFrame]) -> Option<usize> {
     let swing = |hip: Joint, knee: Joint| -> Vec<f64> {
         points
@@ -226,6 +227,7 @@ mod tests {
         let trunks = vec![facing(); 120];
         assert_eq!(gait_lag(&together, &trunks), None);
         assert_eq!(gait_lag(&still, &trunks), None);
+        // Half a stride (20 frames) is more than half of a 12-frame clip.
         assert_eq!(gait_lag(&walk(12, 40.0), &trunks[..12]), None);
     }
 
