@@ -733,6 +733,25 @@ mod tests {
     use super::*;
     use nalgebra::Vector3;
 
+    #[test]
+    fn the_documented_defaults_are_the_defaults() {
+        let doc = include_str!("../../docs/formats.md");
+        let section = doc
+            .split("## lift settings")
+            .nth(1)
+            .expect("docs/formats.md has a lift settings section");
+        let json = section
+            .split("```json")
+            .nth(1)
+            .and_then(|s| s.split("```").next())
+            .expect("the section has a JSON block");
+        // Every setting is written out, each at its default.
+        let documented: serde_json::Value = serde_json::from_str(json).unwrap();
+        let defaults = serde_json::to_value(LiftParams::default()).unwrap();
+        assert_eq!(documented, defaults);
+        assert!(LiftParams::default().validate().is_ok());
+    }
+
     /// The costs measured on the suite's treadmill_raised from the tracker's output (true
     /// lengths): the right pose's trunk groups fit far better, but its badly tracked right leg
     /// costs more than the whole wrong pose does.
