@@ -171,3 +171,15 @@ pub(crate) fn save_json<T: serde::Serialize>(value: &T, path: &Path) -> Result<(
     text.push('\n');
     write_atomically(path, text.as_bytes())
 }
+
+/// The JSON example under the heading that starts with `heading` in `docs/formats.md`, for the
+/// tests that hold the documented settings to the code's defaults.
+#[cfg(test)]
+pub(crate) fn documented_json(heading: &str) -> &'static str {
+    include_str!("../../docs/formats.md")
+        .split(heading)
+        .nth(1)
+        .and_then(|section| section.split("```json").nth(1))
+        .and_then(|block| block.split("```").next())
+        .unwrap_or_else(|| panic!("docs/formats.md has a JSON block under {heading:?}"))
+}

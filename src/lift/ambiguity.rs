@@ -678,22 +678,22 @@ pub fn resolve(
         overrides,
         trunks: &trunks,
     };
-    let mut solved = Resolved {
+    let mut resolved = Resolved {
         points,
         choices: vec![[Root::Near; BONE_COUNT]; n],
         too_long: vec![[false; BONE_COUNT]; n],
         group_costs: [0.0; GROUP_COUNT],
     };
     for g in 0..GROUP_COUNT {
-        solve_group(g, &inputs, &mut solved, None);
+        solve_group(g, &inputs, &mut resolved, None);
     }
     // The arms again, each steered towards the other arm's pose half a stride away
     // ([`AmbiguityWeights::gait_symmetry`]), both from the same previous round.
     if weights.gait_symmetry > 0.0
-        && let Some(lag) = gait::gait_lag(&solved.points, &trunks)
+        && let Some(lag) = gait::gait_lag(&resolved.points, &trunks)
     {
         for _ in 0..gait::SYMMETRY_ROUNDS {
-            let previous = solved.points.clone();
+            let previous = resolved.points.clone();
             let symmetry = gait::Symmetry {
                 lag,
                 previous: &previous,
@@ -701,12 +701,12 @@ pub fn resolve(
             };
             for g in ARM_GROUPS {
                 if symmetry.holds(&GROUPS[g]) {
-                    solve_group(g, &inputs, &mut solved, Some(&symmetry));
+                    solve_group(g, &inputs, &mut resolved, Some(&symmetry));
                 }
             }
         }
     }
-    solved
+    resolved
 }
 
 /// What every group's solve reads: the rays, the frames' video indices (for overrides), the
@@ -721,12 +721,12 @@ struct Inputs<'a> {
 }
 
 /// Chooses the roots of group `g` over the whole sequence on the trajectories already chosen
-/// for its parents, and writes its joints, choices and cost into `solved`. `symmetry`, when
+/// for its parents, and writes its joints, choices and cost into `resolved`. `symmetry`, when
 /// given, steers an arm towards the other arm's pose half a stride away.
 fn solve_group(
     g: usize,
     inputs: &Inputs<'_>,
-    solved: &mut Resolved,
+    resolved: &mut Resolved,
     symmetry: Option<&gait::Symmetry<'_>>,
 ) {
     let Inputs {
@@ -739,11 +739,11 @@ fn solve_group(
     } = *inputs;
     let group = &GROUPS[g];
     let combos = 1usize << group.bones.len();
-    let candidates: Vec<Vec<Candidate>> = (0..solved.points.len())
+    let candidates: Vec<Vec<Candidate>> = (0..resolved.points.len())
         .map(|t| {
             (0..combos)
                 .map(|combo| {
-                    let mut p = solved.points[t];
+                    let mut p = resolved.points[t];
                     let mut c = Candidate {
                         absolute: [Point3::origin(); 2],
                         too_long: [false; 2],
@@ -797,14 +797,14 @@ fn solve_group(
         .enumerate()
         .map(|(t, &c)| candidates[t][c].steer)
         .sum();
-    solved.group_costs[g] = cost - steer;
+    resolved.group_costs[g] = cost - steer;
     for (t, &combo) in path.iter().enumerate() {
         let c = &candidates[t][combo];
         for (k, bone) in group.bones.iter().enumerate() {
-            solved.points[t].0[lift_order(*bone).1.index()] = c.absolute[k];
+            resolved.points[t].0[lift_order(*bone).1.index()] = c.absolute[k];
             let b = bone.index();
-            solved.choices[t][b] = root_of(combo, k);
-            solved.too_long[t][b] = c.too_long[k];
+            resolved.choices[t][b] = root_of(combo, k);
+            resolved.too_long[t][b] = c.too_long[k];
         }
     }
 }
@@ -1231,22 +1231,39 @@ mod tests {
         (key, rays, (0..frames.len()).collect())
     }
 
+    /// `n` frames of a standing body moved by `offset`, whose limbs on side `s` (1 left, −1
+    /// right) point along `limbs(phase, s)` with `phase = sin(step · t)`.
+    fn striding(
+        subject: &SubjectModel,
+        n: u32,
+        step: f64,
+        offset: Vector3<f64>,
+        limbs: impl Fn(f64, f64) -> [Vector3<f64>; 4],
+    ) -> Vec<PerJoint<Point3<f64>>> {
+        (0..n)
+            .map(|t| {
+                let phase = (f64::from(t) * step).sin();
+                standing(subject, |s| limbs(phase, s)).map(|_, q| q + offset)
+            })
+            .collect()
+    }
+
     #[test]
     fn the_arms_swing_stays_out_of_the_reported_cost() {
         // A body three metres in front of the camera, facing away from it, walking on the
         // spot: each thigh swings forwards and backwards in depth and each arm against it.
         let subject = SubjectModel::default();
-        let frames: Vec<PerJoint<Point3<f64>>> = (0..12)
-            .map(|t| {
-                let phase = (f64::from(t) * 0.5).sin();
-                let p = standing(&subject, |s| {
-                    let thigh = Vector3::new(0.0, -1.0, 0.4 * s * phase).normalize();
-                    let arm = Vector3::new(0.15 * s, -1.0, -0.3 * s * phase).normalize();
-                    [arm, arm, thigh, thigh]
-                });
-                p.map(|_, q| q + Vector3::new(0.0, 0.0, 3.0))
-            })
-            .collect();
+        let frames = striding(
+            &subject,
+            12,
+            0.5,
+            Vector3::new(0.0, 0.0, 3.0),
+            |phase, s| {
+                let thigh = Vector3::new(0.0, -1.0, 0.4 * s * phase).normalize();
+                let arm = Vector3::new(0.15 * s, -1.0, -0.3 * s * phase).normalize();
+                [arm, arm, thigh, thigh]
+            },
+        );
         let (key, rays, index) = seen(&frames);
         let solve = |arm_swing: f64, overrides: &DepthOverrides| {
             let w = AmbiguityWeights {
@@ -1297,18 +1314,18 @@ mod tests {
         // with its knees bent: seen this steeply, the pelvis's two roots lie well apart in depth,
         // and the truth is the far one (a tie would take the near).
         let subject = SubjectModel::default();
-        let frames: Vec<PerJoint<Point3<f64>>> = (0..10)
-            .map(|t| {
-                let phase = (f64::from(t) * 0.3).sin();
-                let p = standing(&subject, |s| {
-                    let thigh = Vector3::new(0.0, -1.0, 0.5 * s * phase).normalize();
-                    let shank = Vector3::new(0.0, -1.0, -0.3).normalize();
-                    let arm = Vector3::new(0.15 * s, -1.0, 0.0).normalize();
-                    [arm, arm, thigh, shank]
-                });
-                p.map(|_, q| q + Vector3::new(0.0, -3.0, 2.0))
-            })
-            .collect();
+        let frames = striding(
+            &subject,
+            10,
+            0.3,
+            Vector3::new(0.0, -3.0, 2.0),
+            |phase, s| {
+                let thigh = Vector3::new(0.0, -1.0, 0.5 * s * phase).normalize();
+                let shank = Vector3::new(0.0, -1.0, -0.3).normalize();
+                let arm = Vector3::new(0.15 * s, -1.0, 0.0).normalize();
+                [arm, arm, thigh, shank]
+            },
+        );
         let (key, rays, index) = seen(&frames);
         let solve = |lookahead: f64| {
             // The spine's own prior blind: only the look ahead tells its roots apart.

@@ -735,16 +735,7 @@ mod tests {
 
     #[test]
     fn the_documented_defaults_are_the_defaults() {
-        let doc = include_str!("../../docs/formats.md");
-        let section = doc
-            .split("## lift settings")
-            .nth(1)
-            .expect("docs/formats.md has a lift settings section");
-        let json = section
-            .split("```json")
-            .nth(1)
-            .and_then(|s| s.split("```").next())
-            .expect("the section has a JSON block");
+        let json = crate::formats::documented_json("## lift settings");
         // Every setting is written out, each at its default.
         let documented: serde_json::Value = serde_json::from_str(json).unwrap();
         let defaults = serde_json::to_value(LiftParams::default()).unwrap();

@@ -444,16 +444,7 @@ mod tests {
 
     #[test]
     fn the_documented_defaults_are_the_defaults() {
-        let doc = include_str!("../../docs/formats.md");
-        let section = doc
-            .split("## tracker settings")
-            .nth(1)
-            .expect("docs/formats.md has a tracker settings section");
-        let json = section
-            .split("```json")
-            .nth(1)
-            .and_then(|s| s.split("```").next())
-            .expect("the section has a JSON block");
+        let json = crate::formats::documented_json("## tracker settings");
         let documented: TrackerParams = serde_json::from_str(json).unwrap();
         // The document rounds the thirds.
         assert!(

@@ -12,7 +12,7 @@ pub const MIN_LAG: usize = 5;
 
 /// How closely (Pearson correlation) the right thigh's forward swing must repeat the left's
 /// at the lag for the motion to count as a gait. The suite's walks and runs reach 0.97 to 1.00
-/// at their calibrated pose; its dances 0.47 to 0.84 (below, or gated by the arms themselves:
+/// at their calibrated pose; its dances 0.39 to 0.84 (below, or gated by the arms themselves:
 /// [`SYMMETRY_MAX_DISCREPANCY`]).
 pub const MIN_CORRELATION: f64 = 0.8;
 
@@ -101,16 +101,14 @@ impl Symmetry<'_> {
                 Vector3::new(d.dot(&trunk.left), d.dot(&trunk.up), d.dot(&trunk.forward))
             })
         };
-        let partners: Vec<usize> = [t.checked_sub(self.lag), Some(t + self.lag)]
+        let partners = [t.checked_sub(self.lag), Some(t + self.lag)]
             .into_iter()
             .flatten()
-            .filter(|&u| u < self.previous.len())
-            .collect();
-        if partners.is_empty() {
-            return None;
-        }
+            .filter(|&u| u < self.previous.len());
         let mut sum = [0.0; 2];
-        for &u in &partners {
+        let mut count = 0;
+        for u in partners {
+            count += 1;
             let q = &self.previous[u];
             for (k, s) in sum.iter_mut().enumerate() {
                 let mine = local(p[own[k + 1]] - p[own[k]], &self.trunks[t]);
@@ -118,7 +116,7 @@ impl Symmetry<'_> {
                 *s += (mine - Vector3::new(-theirs.x, theirs.y, theirs.z)).norm_squared();
             }
         }
-        Some(sum.map(|s| s / partners.len() as f64))
+        (count > 0).then(|| sum.map(|s| s / f64::from(count)))
     }
 
     /// [`super::AmbiguityWeights::gait_symmetry`]'s cost (unweighted, squared metres) of an arm
