@@ -151,12 +151,18 @@ fn on_reference_key(
 }
 
 /// The line that splits (a) with true lengths into the key triangle's share and the roots'.
+/// Its coin flips are the reference's own: with the key triangle exact, a root lies off the truth
+/// only where the reference's bones do not keep their mean lengths (its chest–pelvis distance
+/// varies, and a spine nearly square to its viewing ray turns that into centimetres of depth).
 fn isolation_line(score: &Pose3dScore, flex_m: f64) -> String {
     format!(
-        "(a) true lengths with the reference's own key triangle in every frame (root choices alone): MPJPE {:.1} mm, PA-MPJPE {:.1} mm, wrong roots {:.1}%; the reference's key triangle flexes by {:.1} mm (mean standard deviation of its sides), the lift holds it rigid",
+        "(a) true lengths with the reference's own key triangle in every frame (root choices alone): MPJPE {:.1} mm, PA-MPJPE {:.1} mm, wrong roots {:.1}% ({} of {} bone-frames; {} of them coin flips); the reference's key triangle flexes by {:.1} mm (mean standard deviation of its sides), the lift holds it rigid",
         score.mpjpe_mm(),
         score.pa_mpjpe_mm(),
         100.0 * score.wrong_share(),
+        score.wrong,
+        score.choices,
+        score.coin_flips_wrong,
         1000.0 * flex_m
     )
 }
