@@ -417,6 +417,15 @@ impl TrunkFrame {
         }
     }
 
+    /// How far the bone from `from` to `to` points forwards (the forward component of its unit
+    /// direction, the sine of its swing from the trunk's plane; 0 where the joints coincide):
+    /// a thigh's swing, read by [`arm_swing`] and the gait's lag.
+    fn forward_sine(&self, from: &Point3<f64>, to: &Point3<f64>) -> f64 {
+        (to - from)
+            .try_normalize(f64::EPSILON)
+            .map_or(0.0, |d| d.dot(&self.forward))
+    }
+
     /// The pelvis's frame: left along the hip line (solved before the legs), up the key
     /// triangle's up made square to it. The shoulders turn against the pelvis as the body
     /// walks, and a thigh's lean and its knee's hinge belong to the pelvis: in the key
@@ -623,11 +632,7 @@ fn arm_swing(
     root: Joint,
     upper: Vector3<f64>,
 ) -> f64 {
-    let forward = |hip: Joint, knee: Joint| {
-        (p[knee] - p[hip])
-            .try_normalize(f64::EPSILON)
-            .map_or(0.0, |d| d.dot(&trunk.forward))
-    };
+    let forward = |hip: Joint, knee: Joint| trunk.forward_sine(&p[hip], &p[knee]);
     let (left, right) = (forward(LeftHip, LeftKnee), forward(RightHip, RightKnee));
     let stride = (-left * right / GAIT_SPLIT).clamp(0.0, 1.0);
     let own = if root == LeftShoulder { left } else { right };

@@ -40,11 +40,7 @@ pub fn gait_lag(points: &[PerJoint<Point3<f64>>], trunks: &[TrunkFrame]) -> Opti
         points
             .iter()
             .zip(trunks)
-            .map(|(p, trunk)| {
-                (p[knee] - p[hip])
-                    .try_normalize(f64::EPSILON)
-                    .map_or(0.0, |d| d.dot(&trunk.forward))
-            })
+            .map(|(p, trunk)| trunk.forward_sine(&p[hip], &p[knee]))
             .collect()
     };
     let (left, right) = (swing(LeftHip, LeftKnee), swing(RightHip, RightKnee));
