@@ -78,6 +78,10 @@ pub struct AmbiguityWeights {
     ///   5.03 / 5.56 / 8.63 %. At 1 sit_down_frontal went 19.4 → 1.7 mm, but
     ///   jumping_jacks_frontal went 7.8 → 32.8 and walk_toward_frontal 14.9 → 29.1. Counted only
     ///   beyond a sine of 0.3, it gave 5.23 %, sit_down_frontal unchanged.
+    /// - Forward tilts cheaper than backward ones (forward ×0.5 / ×0.3; forward ×0.3 and
+    ///   backward ×3), against 722 wrong bone-frames: 874 / 1024 / 1069, jumping_jacks_frontal
+    ///   26 → 178–328, sit_down_frontal unchanged (its mirror hangs along the trunk at frames
+    ///   40–49 and 70–79, where the truth reaches 0.48 forward).
     pub frontal: f64,
     /// In a walking or running stride (the thighs split forwards and backwards), each arm
     /// swings against its own thigh (the left arm forward with the right leg): the arm
@@ -891,6 +895,11 @@ fn hanging_cost(
 /// tracker 83.0 → 82.0 (from the height 89.1 → 88.7); the real sample unchanged but from its
 /// exact 2D and the height, 97.2 → 98.8. Half relative and half absolute gave 826 wrong roots;
 /// absolute scaled by 0.5 / 0.7 / 1.4 / 2 against the priors, 887 / 900 / 899 / 966.
+///
+/// It is per frame, not per second: scaled to physical units by (fps/30)^k for k = 1 / 2 / 4
+/// the suite's wrong roots went 722 → 786 / 852 / 1034 (walk_toward_frontal at 60 frames/s
+/// 63 → 138–140), for k = −0.5 / −1 to 755 / 768. Weighed ×10 / ×100 / ×1000 where the
+/// group's first bone has its two roots under 5 mm apart: 770 / 845 / 909.
 fn acceleration(a: &Candidate, b: &Candidate, c: &Candidate) -> f64 {
     (0..2)
         .map(|k| {
