@@ -31,7 +31,7 @@
 //! width read like the limbs raised the suite's error from height, 58.3 → 70 mm.
 //!
 //! Read from exact 2D on the suite with height-based lengths: 82.0 → 58.3 mm MPJPE; the real
-//! sample 209.9 → 106.0 mm (the README and `bench lift` have the rest).
+//! sample 209.9 → 106.0 mm (`docs/method.md` and `bench lift` have the rest).
 
 use super::smoothing::{adaptive_sigmas, smoothed_images};
 use super::solve::{LiftJob, LiftParams, lift_per_frame};
