@@ -137,6 +137,7 @@ fn truth_of(s: SubjectModel) -> (GroundTruth, SubjectModel) {
         cx: cam.cx,
         cy: cam.cy,
         joints: Joint::ALL.iter().map(|j| j.name().to_owned()).collect(),
+        stated_height_m: None,
         derived_joints: vec![],
         bone_lengths_m: Default::default(),
         frames,

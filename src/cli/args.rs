@@ -239,7 +239,7 @@ pub struct SynthArgs {
     /// Image height, pixels.
     #[arg(long, default_value_t = 480)]
     pub height: u32,
-    /// Camera view: frontal, oblique, side, raised.
+    /// Camera view: frontal, oblique, side, raised, behind, low.
     #[arg(long, default_value = "oblique")]
     pub view: String,
     /// Focal length, pixels.
@@ -325,7 +325,4 @@ pub struct BenchArgs {
     /// Lift settings as JSON for `bench lift`.
     #[arg(long)]
     pub lift_settings: Option<PathBuf>,
-    /// Most correction rounds per clip for `bench correct`.
-    #[arg(long, default_value_t = 5)]
-    pub corrections: usize,
 }

@@ -1,6 +1,7 @@
 //! `videomocap bench correct`: what correcting the tracks costs a user.
 //!
-//! Each clip of the tracking suite, and the real sample, is tracked from its marks; then a
+//! Each clip of the benchmark suite (dev and test), and the two real clips, is tracked from its
+//! marks as a user clicks them; then a
 //! simulated user ([`videomocap::eval::correction`]) goes to the first frame with a lost joint
 //! (the guide's advice), drags every joint there more than 0.2 torso off onto the reference and
 //! re-tracks from there, as the app's correction does (that frame becomes a key frame, the
@@ -9,10 +10,11 @@
 //! clip needs to reach PCK@0.2 ≥ 0.95.
 
 use super::args::{BenchArgs, GlobalArgs};
-use super::bench_track::{ensure_suite, threads_and_settings, track_opened};
+use super::bench_suite::{BenchClip, Tally, bench_clips};
+use super::bench_track::{threads_and_settings, track_opened};
+use videomocap::eval::suite::{CLICK_NOISE_PX, clicked_marks};
 use super::{ExitError, say};
 use std::collections::BTreeSet;
-use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use videomocap::eval::correction::next_correction;
 use videomocap::eval::{Accuracy, score_tracks};
@@ -34,13 +36,18 @@ struct Rounds {
 /// Tracks a clip and corrects it for `rounds` rounds at most (fewer when nothing is left
 /// visibly wrong).
 fn correct_clip(
-    dir: &Path,
+    clip: &BenchClip,
     rounds: usize,
     threads: usize,
     params: TrackerParams,
 ) -> Result<Rounds, ExitError> {
+    let dir = &clip.dir;
     let gt = GroundTruth::load(&dir.join("gt.json")).map_err(ExitError::failed)?;
-    let marks = Marks::load(&dir.join("marks.json")).map_err(ExitError::failed)?;
+    let marks = clicked_marks(
+        &Marks::load(&dir.join("marks.json")).map_err(ExitError::failed)?,
+        CLICK_NOISE_PX,
+        &clip.name,
+    );
     let mut video =
         Video::open(&dir.join("video.mp4"), &OpenOptions::default()).map_err(ExitError::failed)?;
     let mut tracks = track_opened(&mut video, &marks, threads, params)?;
@@ -93,63 +100,64 @@ fn at_round(r: &Rounds, k: usize) -> &Accuracy {
     &r.scores[k.min(r.scores.len() - 1)]
 }
 
+/// Corrections a clip may use: one per [`FRAMES_PER_CORRECTION`] frames (at least one).
+const FRAMES_PER_CORRECTION: usize = 25;
+
+/// A split's column: PCK@0.2 and lost before any correction, then after the clip's budget.
+fn cell(s: &[Accuracy; 2]) -> String {
+    format!(
+        "{:>6.3} {:>5.1}% {:>6.3} {:>5.1}%",
+        s[0].pck02(),
+        100.0 * s[0].lost(),
+        s[1].pck02(),
+        100.0 * s[1].lost()
+    )
+}
+
 /// Runs the correction benchmark and prints its table.
 pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let (threads, params) = threads_and_settings(a)?;
-    let rounds = a.corrections;
-    let mut clips = ensure_suite(&a.suite_dir, global)?;
-    let suite_len = clips.len();
-    clips.push((
-        "real sample".to_owned(),
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("sample_videos/pose2sim_balancing_cam01"),
-    ));
+    let clips = bench_clips(&a.suite_dir, global)?;
     let mut results = Vec::with_capacity(clips.len());
-    for (name, dir) in &clips {
-        say(global, &format!("correcting {name}"));
-        results.push(correct_clip(dir, rounds, threads, params)?);
+    let mut tally: Tally<[Accuracy; 2]> = Tally::default();
+    for clip in &clips {
+        say(global, &format!("correcting {}", clip.name));
+        let gt = GroundTruth::load(&clip.dir.join("gt.json")).map_err(ExitError::failed)?;
+        let budget = gt.frames.len().div_ceil(FRAMES_PER_CORRECTION).max(1);
+        let r = correct_clip(clip, budget, threads, params)?;
+        tally.add(clip, &[r.scores[0], *at_round(&r, budget)]);
+        results.push((budget, r));
     }
     let mut lines = vec![
         format!(
-            "simulated correction: each round goes to the first frame with a joint lost (over 0.5 \
-             torso off), drags every joint there over 0.2 torso off onto the reference and \
-             re-tracks from there ({rounds} rounds at most)"
+            "simulated correction from clicked marks: each round goes to the first frame with a \
+             joint lost (over 0.5 torso off), drags every joint there over 0.2 torso off onto \
+             the reference and re-tracks from there; one round per {FRAMES_PER_CORRECTION} \
+             frames of clip"
         ),
         String::new(),
-        format!(
-            "{:<24} {:>6} {:>8} {:>8} {:>8} {:>14}",
-            "suite overall", "round", "PCK@0.2", "lost", "mean px", "joints dragged"
-        ),
     ];
-    for k in 0..=rounds {
-        let mut acc = Accuracy::default();
-        let mut dragged = 0;
-        for r in &results[..suite_len] {
-            acc.merge(at_round(r, k));
-            dragged += r.drags.iter().take(k + 1).sum::<usize>();
-        }
-        lines.push(format!(
-            "{:<24} {:>6} {:>8.3} {:>7.1}% {:>8.1} {:>14}",
-            "",
-            k,
-            acc.pck02(),
-            100.0 * acc.lost(),
-            acc.mean_px(),
-            dragged
-        ));
-    }
+    const WIDTH: usize = 28;
+    lines.extend(Tally::<[Accuracy; 2]>::heading(
+        WIDTH,
+        "before: PCK.2  lost  after",
+    ));
+    lines.extend(tally.lines(WIDTH, cell));
     lines.push(String::new());
     lines.push(format!(
-        "{:<24} {:>8} {:>8} {:>8} {:>14} {:>16}",
-        "clip", "PCK@0.2", "→ last", "lost", "joints dragged", "rounds to 0.95"
+        "{:<26} {:<5} {:>8} {:>8} {:>8} {:>7} {:>14} {:>16}",
+        "clip", "split", "PCK@0.2", "→ after", "lost", "rounds", "joints dragged", "rounds to 0.95"
     ));
-    for ((name, _), r) in clips.iter().zip(&results) {
-        let last = at_round(r, rounds);
+    for (clip, (budget, r)) in clips.iter().zip(&results) {
+        let last = at_round(r, *budget);
         lines.push(format!(
-            "{:<24} {:>8.3} {:>8.3} {:>7.1}% {:>14} {:>16}",
-            name,
+            "{:<26} {:<5} {:>8.3} {:>8.3} {:>7.1}% {:>7} {:>14} {:>16}",
+            clip.name,
+            clip.split.name(),
             r.scores[0].pck02(),
             last.pck02(),
             100.0 * last.lost(),
+            r.scores.len() - 1,
             r.drags.iter().sum::<usize>(),
             rounds_to_goal(r)
         ));
@@ -158,16 +166,21 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         let rows: Vec<_> = clips
             .iter()
             .zip(&results)
-            .map(|((name, _), r)| {
+            .map(|(clip, (budget, r))| {
                 serde_json::json!({
-                    "clip": name,
+                    "clip": clip.name, "split": clip.split.name(), "family": clip.family.name(),
+                    "budget": budget,
                     "pck02": r.scores.iter().map(Accuracy::pck02).collect::<Vec<_>>(),
                     "lost": r.scores.iter().map(Accuracy::lost).collect::<Vec<_>>(),
                     "drags": r.drags,
                 })
             })
             .collect();
-        println!("{}", serde_json::json!({"clips": rows, "table": lines}));
+        let split = tally.json(|s| serde_json::json!({
+            "before": super::bench_track::accuracy_json(&s[0]),
+            "after": super::bench_track::accuracy_json(&s[1]),
+        }));
+        println!("{}", serde_json::json!({"clips": rows, "splits": split, "table": lines}));
     } else {
         for l in lines {
             println!("{l}");

@@ -1,11 +1,13 @@
 //! `videomocap bench track`: tracking accuracy and speed.
 //!
-//! Accuracy: a synthetic suite rendered by `synth` (real CMU motion capture from `tests/data`
-//! and procedural motions, several views, photographic and procedural backgrounds, sensor
-//! noise; persons 200–450 px tall at 640×480) plus the real sample, each tracked from the marks
-//! of frame 0 by the VBA tracker and by a fixed-template matcher per joint (the baseline written
-//! here: the marked patch of each joint searched around its last position, no prediction, no
-//! model update). Metrics from [`videomocap::eval`].
+//! Accuracy: suite v3 ([`videomocap::eval::suite`]: every bundled motion-capture take and the
+//! procedural motions on varied bodies, views and scenes, split by take into dev and test) plus
+//! the two real clips, each tracked from the marks of frame 0 as a user clicks them (2 px of
+//! noise; the exact marks as a second condition) by the VBA tracker and by a fixed-template
+//! matcher per joint (the baseline written here: the marked patch of each joint searched around
+//! its last position, no prediction, no model update), and by OpenCV's Lucas–Kanade and CSRT
+//! when Python's OpenCV is present (`bench_opencv`). Tables put dev and test side by side per
+//! clip family. Metrics from [`videomocap::eval`].
 //!
 //! Speed: frames per second of the tracker at 640×480 and 1080×1920, with frames already in
 //! memory (decoding excluded) and with decoding, on one thread and on all; and how much longer
@@ -19,238 +21,15 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
-use videomocap::eval::{Accuracy, ClipScore, score_positions, score_tracks};
+use super::bench_suite::{BenchClip, Tally, bench_clips, root};
+use videomocap::eval::suite::{CLICK_NOISE_PX, Family, REAL_CLIPS, Split, clicked_marks};
+use videomocap::eval::{Accuracy, score_positions, score_tracks};
 use videomocap::formats::Marks;
 use videomocap::skeleton::{Joint, PerJoint};
-use videomocap::synth::{
-    GroundTruth, MotionSource, ProceduralMotion, SynthParams, VideoOutput, View, render_clip,
-    stature_range_px,
-};
+use videomocap::synth::GroundTruth;
 use videomocap::track::similarity::FloatFrame;
 use videomocap::track::{TrackJob, TrackerParams, track_video};
 use videomocap::video::{OpenOptions, Video};
-
-/// One clip of the synthetic suite. The issue asks for clips of 100–200 frames with the person
-/// 200–450 px tall at 640×480; the short motion-capture takes (a 2.9 s walk, a 1.4 s run) are
-/// therefore filmed at 60 and 120 frames/s, as a sports camera would, and the oblique and raised
-/// walks are on a treadmill (a walker crossing 4.8 m in depth shrinks from 230 to 130 px).
-/// A test checks every clip against those bounds.
-#[derive(Debug)]
-struct ClipSpec {
-    name: &'static str,
-    motion: Motion,
-    view: View,
-    person_px: f64,
-    frames: usize,
-    fps: u32,
-    /// Photograph under `assets/backgrounds/`, or a procedural background.
-    background: Option<&'static str>,
-}
-
-#[derive(Debug)]
-enum Motion {
-    /// A file under `tests/data/` from this many seconds in.
-    Bvh(&'static str, f64),
-    Procedural(ProceduralMotion),
-}
-
-const SUITE: &[ClipSpec] = &[
-    ClipSpec {
-        name: "walk_across_side",
-        motion: Motion::Bvh("cmu_02_01_walk.bvh", 0.0),
-        view: View::Side,
-        person_px: 300.0,
-        background: Some("pose2sim_room.jpg"),
-        frames: 171,
-        fps: 60,
-    },
-    ClipSpec {
-        name: "walk_toward_frontal",
-        motion: Motion::Bvh("cmu_02_01_walk.bvh", 1.0),
-        view: View::Frontal,
-        person_px: 450.0,
-        background: Some("pose2sim_floor.jpg"),
-        frames: 111,
-        fps: 60,
-    },
-    ClipSpec {
-        name: "treadmill_oblique",
-        motion: Motion::Procedural(ProceduralMotion::Treadmill),
-        view: View::Oblique,
-        person_px: 260.0,
-        background: None,
-        frames: 120,
-        fps: 30,
-    },
-    ClipSpec {
-        name: "run_side",
-        motion: Motion::Bvh("cmu_02_03_run.bvh", 0.0),
-        view: View::Side,
-        person_px: 240.0,
-        background: Some("pose2sim_room.jpg"),
-        frames: 171,
-        fps: 120,
-    },
-    ClipSpec {
-        name: "dance_turns_frontal",
-        motion: Motion::Bvh("cmu_60_02_dance.bvh", 1.0),
-        view: View::Frontal,
-        person_px: 330.0,
-        background: Some("pose2sim_room.jpg"),
-        frames: 120,
-        fps: 30,
-    },
-    ClipSpec {
-        name: "dance_oblique",
-        motion: Motion::Bvh("cmu_61_05_dance.bvh", 0.5),
-        view: View::Oblique,
-        person_px: 380.0,
-        background: Some("pose2sim_floor.jpg"),
-        frames: 120,
-        fps: 30,
-    },
-    ClipSpec {
-        name: "dribble_oblique",
-        motion: Motion::Bvh("cmu_06_03_dribble.bvh", 0.0),
-        view: View::Oblique,
-        person_px: 300.0,
-        background: None,
-        frames: 100,
-        fps: 30,
-    },
-    ClipSpec {
-        name: "jumping_jacks_frontal",
-        motion: Motion::Procedural(ProceduralMotion::JumpingJacks),
-        view: View::Frontal,
-        person_px: 300.0,
-        background: Some("pose2sim_room.jpg"),
-        frames: 120,
-        fps: 30,
-    },
-    ClipSpec {
-        name: "wave_oblique",
-        motion: Motion::Procedural(ProceduralMotion::Wave),
-        view: View::Oblique,
-        person_px: 420.0,
-        background: Some("pose2sim_floor.jpg"),
-        frames: 120,
-        fps: 30,
-    },
-    ClipSpec {
-        name: "sit_down_frontal",
-        motion: Motion::Procedural(ProceduralMotion::SitDown),
-        view: View::Frontal,
-        person_px: 350.0,
-        background: Some("pose2sim_room.jpg"),
-        frames: 120,
-        fps: 30,
-    },
-    ClipSpec {
-        name: "bend_side",
-        motion: Motion::Procedural(ProceduralMotion::Bend),
-        view: View::Side,
-        person_px: 300.0,
-        background: None,
-        frames: 120,
-        fps: 30,
-    },
-    ClipSpec {
-        name: "treadmill_raised",
-        motion: Motion::Procedural(ProceduralMotion::Treadmill),
-        view: View::Raised,
-        person_px: 220.0,
-        background: Some("pose2sim_floor.jpg"),
-        frames: 120,
-        fps: 30,
-    },
-];
-
-/// Bumped whenever the suite's clips or the renderer change, so rendered clips are redone.
-const SUITE_VERSION: u32 = 2;
-
-/// The file in the suite's folder listing its clips, one name per line.
-const SUITE_INDEX: &str = "clips.txt";
-
-/// The file in each rendered clip's folder naming the spec it was rendered from.
-const SPEC_FILE: &str = "suite_spec.txt";
-
-/// The render parameters of the `k`-th suite clip; files are found under `root` (the crate).
-fn synth_params(spec: &ClipSpec, k: usize, root: &Path) -> SynthParams {
-    let motion = match spec.motion {
-        Motion::Bvh(file, start_s) => MotionSource::Bvh {
-            path: root.join("tests/data").join(file),
-            start_s,
-        },
-        Motion::Procedural(p) => MotionSource::Procedural(p),
-    };
-    let mut params = SynthParams {
-        motion,
-        frames: spec.frames,
-        fps: spec.fps,
-        view: spec.view,
-        person_px: spec.person_px,
-        background_seed: 11 + k as u64,
-        background_image: spec
-            .background
-            .map(|b| root.join("assets/backgrounds").join(b)),
-        output: VideoOutput::Mp4,
-        ..SynthParams::default()
-    };
-    params.effects.seed = 100 + k as u64;
-    params
-}
-
-/// Renders the clips missing from `dir`, or rendered from another spec, lists the suite's clips
-/// in its [`SUITE_INDEX`], and returns every clip's directory.
-pub fn ensure_suite(dir: &Path, global: &GlobalArgs) -> Result<Vec<(String, PathBuf)>, ExitError> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut out = Vec::new();
-    for (k, spec) in SUITE.iter().enumerate() {
-        let clip = dir.join(spec.name);
-        let stamp = format!("suite v{SUITE_VERSION}: {spec:?}\n");
-        let current = std::fs::read_to_string(clip.join(SPEC_FILE)).is_ok_and(|s| s == stamp);
-        if !current || !clip.join("gt.json").is_file() {
-            say(global, &format!("rendering suite clip {} …", spec.name));
-            render_clip(
-                &synth_params(spec, k, root),
-                &clip,
-                &mut |_, _| {},
-                &AtomicBool::new(false),
-            )
-            .map_err(ExitError::failed)?;
-            videomocap::formats::write_atomically(&clip.join(SPEC_FILE), stamp.as_bytes())
-                .map_err(ExitError::failed)?;
-        }
-        out.push((spec.name.to_owned(), clip));
-    }
-    // The current clips by name, for scripts/opencv_baselines.py (an older suite's clips may
-    // still lie beside them).
-    let names: String = SUITE.iter().map(|s| format!("{}\n", s.name)).collect();
-    videomocap::formats::write_atomically(&dir.join(SUITE_INDEX), names.as_bytes())
-        .map_err(ExitError::failed)?;
-    Ok(out)
-}
-
-/// One line per suite clip: its frames, frame rate and the person's height in the image.
-fn suite_summary() -> Result<Vec<String>, ExitError> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut lines = vec![format!(
-        "{:<24} {:>7} {:>5} {:>13}",
-        "suite clip", "frames", "fps", "person px"
-    )];
-    for (k, spec) in SUITE.iter().enumerate() {
-        let (low, high) =
-            stature_range_px(&synth_params(spec, k, root)).map_err(ExitError::failed)?;
-        lines.push(format!(
-            "{:<24} {:>7} {:>5} {:>13}",
-            spec.name,
-            spec.frames,
-            spec.fps,
-            format!("{low:.0}–{high:.0}")
-        ));
-    }
-    Ok(lines)
-}
 
 /// The fixed-template baseline: each joint's marked square patch (side 8% of the marked
 /// stature) searched by the sum of absolute RGB differences within ±20% of the stature of its
@@ -336,25 +115,6 @@ pub fn fixed_template_track(
     Ok(out)
 }
 
-fn fmt_row(name: &str, a: &Accuracy) -> String {
-    format!(
-        "{:<24} {:>8.1} {:>8.3} {:>8.3} {:>8.3} {:>7.1}%",
-        name,
-        a.mean_px(),
-        a.mean_torso(),
-        a.pck01(),
-        a.pck02(),
-        100.0 * a.lost()
-    )
-}
-
-fn header(title: &str) -> String {
-    format!(
-        "{:<24} {:>8} {:>8} {:>8} {:>8} {:>8}",
-        title, "mean px", "err/torso", "PCK@0.1", "PCK@0.2", "lost"
-    )
-}
-
 /// Tracks an opened suite clip from its marks with the VBA tracker.
 pub fn track_opened(
     video: &mut Video,
@@ -366,27 +126,6 @@ pub fn track_opened(
     let out = track_video(video, &job, &mut |_| {}, &AtomicBool::new(false))
         .map_err(ExitError::failed)?;
     Ok(out.tracks)
-}
-
-struct Scored {
-    vba: ClipScore,
-    baseline: ClipScore,
-}
-
-fn score_clip(dir: &Path, threads: usize, params: TrackerParams) -> Result<Scored, ExitError> {
-    let gt = GroundTruth::load(&dir.join("gt.json")).map_err(ExitError::failed)?;
-    let marks = Marks::load(&dir.join("marks.json")).map_err(ExitError::failed)?;
-    let mut video =
-        Video::open(&dir.join("video.mp4"), &OpenOptions::default()).map_err(ExitError::failed)?;
-    let tracks = track_opened(&mut video, &marks, threads, params)?;
-    let vba = score_tracks(&gt, &tracks).map_err(ExitError::failed)?;
-    let stature = videomocap::track::body::stature_px(
-        &marks.points,
-        &videomocap::skeleton::Proportions::default(),
-    );
-    let base = fixed_template_track(&mut video, &marks.points, stature)?;
-    let baseline = score_positions(&gt, base.into_iter().enumerate()).map_err(ExitError::failed)?;
-    Ok(Scored { vba, baseline })
 }
 
 /// Runs per speed figure; the fastest counts.
@@ -405,62 +144,113 @@ pub fn threads_and_settings(a: &BenchArgs) -> Result<(usize, TrackerParams), Exi
     Ok((threads, params))
 }
 
+/// A clip's tracking scores: the VBA tracker from the clicked marks and from the exact ones, the
+/// fixed template from the clicked marks.
+type TrackScores = [Accuracy; 3];
+
+/// The column of one split in the tracking table.
+fn track_cell(s: &TrackScores) -> String {
+    format!(
+        "{:>6.3} {:>5.1}% {:>6.1} {:>6.3} {:>6.3}",
+        s[0].pck02(),
+        100.0 * s[0].lost(),
+        s[0].mean_px(),
+        s[1].pck02(),
+        s[2].pck02()
+    )
+}
+
+/// The columns of [`track_cell`].
+const TRACK_COLUMNS: &str = " PCK.2   lost  mean px  exact  templ";
+const TRACK_WIDTH: usize = 36;
+
+/// Tracks and scores one clip: (VBA from the clicked marks, VBA from the exact marks, the fixed
+/// template from the clicked marks), and the clicked marks.
+fn score_clip(
+    clip: &BenchClip,
+    threads: usize,
+    params: TrackerParams,
+) -> Result<(TrackScores, Marks), ExitError> {
+    let gt = GroundTruth::load(&clip.dir.join("gt.json")).map_err(ExitError::failed)?;
+    let marks = Marks::load(&clip.dir.join("marks.json")).map_err(ExitError::failed)?;
+    let clicked = clicked_marks(&marks, CLICK_NOISE_PX, &clip.name);
+    let mut video = Video::open(&clip.dir.join("video.mp4"), &OpenOptions::default())
+        .map_err(ExitError::failed)?;
+    let mut vba = |m: &Marks| -> Result<Accuracy, ExitError> {
+        let tracks = track_opened(&mut video, m, threads, params)?;
+        Ok(score_tracks(&gt, &tracks).map_err(ExitError::failed)?.overall)
+    };
+    let (from_clicks, from_exact) = (vba(&clicked)?, vba(&marks)?);
+    let stature = videomocap::track::body::stature_px(
+        &clicked.points,
+        &videomocap::skeleton::Proportions::default(),
+    );
+    let base = fixed_template_track(&mut video, &clicked.points, stature)?;
+    let template = score_positions(&gt, base.into_iter().enumerate())
+        .map_err(ExitError::failed)?
+        .overall;
+    Ok(([from_clicks, from_exact, template], clicked))
+}
+
 /// Runs the accuracy and speed benchmark and prints its tables.
 pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let (threads, params) = threads_and_settings(a)?;
-    let clips = ensure_suite(&a.suite_dir, global)?;
-    let mut total_vba = ClipScore::default();
-    let mut total_base = ClipScore::default();
-    let mut lines = suite_summary()?;
-    lines.push(String::new());
-    lines.push("synthetic suite (VBA tracker | fixed-template baseline)".to_owned());
-    lines.push(format!("{}  | baseline PCK@0.2, mean px", header("clip")));
+    let clips = bench_clips(&a.suite_dir, global)?;
+    let mut tally: Tally<TrackScores> = Tally::default();
+    let mut lines = vec![
+        format!(
+            "suite v3: {} clips ({} dev, {} test) and 2 real clips (dev); marks clicked with {} px of noise unless 'exact'",
+            clips.len() - 2,
+            clips.iter().filter(|c| c.split == Split::Dev && c.family != Family::Real).count(),
+            clips.iter().filter(|c| c.split == Split::Test).count(),
+            CLICK_NOISE_PX
+        ),
+        String::new(),
+        format!(
+            "{:<26} {:<5} {:<11} {TRACK_COLUMNS}",
+            "clip", "split", "family"
+        ),
+    ];
     let mut rows_json = Vec::new();
-    for (name, dir) in &clips {
-        let s = score_clip(dir, threads, params)?;
+    let mut clicked = Vec::new();
+    for clip in &clips {
+        say(global, &format!("tracking {} …", clip.name));
+        let (s, marks) = score_clip(clip, threads, params)?;
         lines.push(format!(
-            "{}  | {:.3} {:6.1}",
-            fmt_row(name, &s.vba.overall),
-            s.baseline.overall.pck02(),
-            s.baseline.overall.mean_px()
+            "{:<26} {:<5} {:<11} {}",
+            clip.name,
+            clip.split.name(),
+            clip.family.name(),
+            track_cell(&s)
         ));
         rows_json.push(serde_json::json!({
-            "clip": name,
-            "vba": {"mean_px": s.vba.overall.mean_px(), "pck02": s.vba.overall.pck02(), "lost": s.vba.overall.lost()},
-            "baseline": {"mean_px": s.baseline.overall.mean_px(), "pck02": s.baseline.overall.pck02(), "lost": s.baseline.overall.lost()},
+            "clip": clip.name, "split": clip.split.name(), "family": clip.family.name(),
+            "vba": accuracy_json(&s[0]), "vba_exact_marks": accuracy_json(&s[1]),
+            "fixed_template": accuracy_json(&s[2]),
         }));
-        merge(&mut total_vba, &s.vba);
-        merge(&mut total_base, &s.baseline);
+        tally.add(clip, &s);
+        clicked.push(marks);
     }
     lines.push(String::new());
-    lines.push(header("suite overall"));
-    for (label, v) in [
-        ("VBA all", &total_vba.overall),
-        ("VBA visible", &total_vba.visible),
-        ("VBA occluded", &total_vba.occluded),
-        ("fixed-template all", &total_base.overall),
-        ("fixed-template visible", &total_base.visible),
-        ("fixed-template occluded", &total_base.occluded),
-    ] {
-        lines.push(fmt_row(label, v));
-    }
-    lines.push(String::new());
-    lines.push(header("suite per joint (VBA)"));
-    for (j, acc) in total_vba.per_joint.iter() {
-        lines.push(fmt_row(j.name(), acc));
-    }
-
-    // The real sample.
-    let real = Path::new(env!("CARGO_MANIFEST_DIR")).join("sample_videos/pose2sim_balancing_cam01");
-    let s = score_clip(&real, threads, params)?;
-    lines.push(String::new());
-    lines.push(header("real sample (no chest)"));
-    lines.push(fmt_row("VBA", &s.vba.overall));
-    lines.push(fmt_row("fixed-template", &s.baseline.overall));
-    for (j, acc) in s.vba.per_joint.iter() {
-        if acc.count > 0 {
-            lines.push(fmt_row(&format!("  {}", j.name()), acc));
-        }
+    lines.push(
+        "VBA from clicked marks (PCK@0.2, lost, mean px), from exact marks (PCK@0.2), fixed template from clicked marks (PCK@0.2)"
+            .to_owned(),
+    );
+    lines.extend(Tally::<TrackScores>::heading(TRACK_WIDTH, TRACK_COLUMNS));
+    lines.extend(tally.lines(TRACK_WIDTH, track_cell));
+    let opencv = super::bench_opencv::run(&clips, &clicked, &a.suite_dir, global)?;
+    if let Some(t) = &opencv {
+        lines.push(String::new());
+        lines.push(
+            "OpenCV from the same clicked marks: Lucas–Kanade (PCK@0.2, lost), CSRT (PCK@0.2, lost; test split and real clips only)".to_owned(),
+        );
+        lines.extend(Tally::<[Accuracy; 2]>::heading(
+            super::bench_opencv::WIDTH,
+            super::bench_opencv::COLUMNS,
+        ));
+        lines.extend(t.lines(super::bench_opencv::WIDTH, super::bench_opencv::cell));
+    } else {
+        lines.push("(OpenCV baselines: python3 with cv2 not found; `python3 -m pip install opencv-contrib-python-headless numpy` adds them)".to_owned());
     }
 
     // Speed.
@@ -469,7 +259,12 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         "{:<48} {:>12}",
         "speed (all 16 joints; fastest of 3 runs)", "frames/s"
     ));
-    let speed_clip = &clips[0].1;
+    let speed_clip = clips
+        .iter()
+        .find(|c| c.family != Family::Real && c.dir.join("video.mp4").is_file())
+        .map(|c| c.dir.clone())
+        .ok_or_else(|| ExitError::failed(anyhow!("no suite clip to time")))?;
+    let real = root().join(REAL_CLIPS[0].1);
     for (label, dir) in [
         ("640×480", speed_clip.as_path()),
         ("1080×1920", real.as_path()),
@@ -511,7 +306,17 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     if global.json {
         println!(
             "{}",
-            serde_json::json!({"clips": rows_json, "table": lines})
+            serde_json::json!({
+                "clips": rows_json,
+                "vba": tally.json(|s| accuracy_json(&s[0])),
+                "vba_exact_marks": tally.json(|s| accuracy_json(&s[1])),
+                "fixed_template": tally.json(|s| accuracy_json(&s[2])),
+                "opencv": opencv.map(|t| serde_json::json!({
+                    "lucas_kanade": t.json(|s| accuracy_json(&s[0])),
+                    "csrt": t.json(|s| accuracy_json(&s[1])),
+                })),
+                "table": lines,
+            })
         );
     } else {
         for l in lines {
@@ -521,13 +326,9 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     Ok(())
 }
 
-fn merge(total: &mut ClipScore, s: &ClipScore) {
-    total.overall.merge(&s.overall);
-    total.visible.merge(&s.visible);
-    total.occluded.merge(&s.occluded);
-    for j in Joint::ALL {
-        total.per_joint[j].merge(&s.per_joint[j]);
-    }
+/// An accuracy as JSON: PCK@0.2, lost share, mean error in pixels, samples.
+pub fn accuracy_json(a: &Accuracy) -> serde_json::Value {
+    serde_json::json!({"pck02": a.pck02(), "lost": a.lost(), "mean_px": a.mean_px(), "samples": a.count})
 }
 
 /// A prepared speed measurement of tracking one clip: the job and, when decoding is excluded,
@@ -671,33 +472,3 @@ fn paired_ratio(
     ))
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use videomocap::synth::load_motion;
-
-    /// Every suite clip is what the tracking issue asks for: 100–200 frames, the person
-    /// 200–450 px tall at 640×480 in every frame.
-    #[test]
-    fn every_suite_clip_has_100_to_200_frames_and_the_person_200_to_450_px_tall() {
-        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-        assert!(SUITE.len() >= 10);
-        for (k, spec) in SUITE.iter().enumerate() {
-            let params = synth_params(spec, k, root);
-            assert_eq!((params.width, params.height), (640, 480), "{}", spec.name);
-            let frames = load_motion(&params).unwrap().frames.len();
-            assert_eq!(frames, spec.frames, "{}: the motion ends early", spec.name);
-            assert!(
-                (100..=200).contains(&frames),
-                "{}: {frames} frames",
-                spec.name
-            );
-            let (low, high) = stature_range_px(&params).unwrap();
-            assert!(
-                low >= 200.0 && high <= 450.0,
-                "{}: {low:.0}–{high:.0} px",
-                spec.name
-            );
-        }
-    }
-}

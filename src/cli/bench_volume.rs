@@ -11,8 +11,11 @@ use std::path::Path;
 use std::time::Instant;
 use videomocap::eval::volume::{VolumeScore, carve_and_score, score_volume};
 use videomocap::skeleton::SubjectModel;
+use super::bench_suite::{BenchClip, Tally, root};
+use videomocap::eval::suite::Suite;
 use videomocap::synth::{
-    Motion, ProceduralMotion, VoxelParams, from_bvh, procedural, stature_of, volume_truth, voxelise,
+    BodyShape, Motion, ProceduralMotion, SynthParams, VoxelParams, from_bvh, load_motion,
+    procedural, stature_of, volume_truth, voxelise,
 };
 use videomocap::volume::{VolumeParams, assemble, process_frame};
 
@@ -61,8 +64,13 @@ struct Row {
     sides: String,
 }
 
-fn run_sequence(name: &str, motion: &Motion, voxel: VoxelParams, params: &VolumeParams) -> Row {
-    let stature = stature_of(motion);
+fn run_sequence(
+    name: &str,
+    motion: &Motion,
+    stature: f64,
+    voxel: VoxelParams,
+    params: &VolumeParams,
+) -> Row {
     let clouds: Vec<_> = motion
         .frames
         .par_iter()
@@ -88,6 +96,60 @@ fn run_sequence(name: &str, motion: &Motion, voxel: VoxelParams, params: &Volume
         score,
         sides: format!("{:?}", assembled.sides_from).to_lowercase(),
     }
+}
+
+/// One split's column of the suite table: topology, mean error, in voxel sizes, labels.
+fn suite_cell(s: &VolumeScore) -> String {
+    format!(
+        "{:>7.1}% {:>7.1} {:>6.2} {:>6.1}%",
+        100.0 * s.topology(),
+        s.mean_mm(),
+        s.mean_mm() / 40.0,
+        100.0 * s.consistency()
+    )
+}
+
+/// The volume pipeline on every take of suite v3 (its first clip's body and start, {FRAMES}
+/// frames at {FPS} fps, 40 mm voxels), dev and test side by side per family.
+fn suite_takes(
+    params: &VolumeParams,
+    global: &GlobalArgs,
+    lines: &mut Vec<String>,
+) -> Result<(), ExitError> {
+    let suite = Suite::load(root()).map_err(ExitError::failed)?;
+    let mut tally: Tally<VolumeScore> = Tally::default();
+    let mut seen = std::collections::BTreeSet::new();
+    for clip in &suite.clips {
+        if !seen.insert(clip.take.clone()) {
+            continue;
+        }
+        say(global, &format!("volumes of take {} …", clip.take));
+        let synth = SynthParams {
+            frames: FRAMES,
+            fps: FPS as u32,
+            ..clip.params.clone()
+        };
+        let motion = load_motion(&synth).map_err(ExitError::failed)?;
+        let stature = synth
+            .body
+            .as_ref()
+            .map_or_else(|| stature_of(&motion), BodyShape::stature_m);
+        let r = run_sequence(&clip.take, &motion, stature, VoxelParams::default(), params);
+        let bench = BenchClip {
+            name: clip.name.clone(),
+            family: clip.family,
+            split: clip.split,
+            dir: Default::default(),
+        };
+        tally.add(&bench, &r.score);
+    }
+    lines.push(format!(
+        "suite v3 takes (the bodies of their first clips, {FRAMES} frames at {FPS} fps, 40 mm voxels): topology, mean mm, voxel sizes, labels consistent"
+    ));
+    const WIDTH: usize = 31;
+    lines.extend(Tally::<VolumeScore>::heading(WIDTH, "  topo    mean voxels labels"));
+    lines.extend(tally.lines(WIDTH, suite_cell));
+    Ok(())
 }
 
 /// Runs the volume benchmark and prints its tables.
@@ -123,7 +185,7 @@ pub fn run(_a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
                 voxel_m,
                 ..VoxelParams::default()
             };
-            let r = run_sequence(name, motion, voxel, &params);
+            let r = run_sequence(name, motion, stature_of(motion), voxel, &params);
             let s = &r.score;
             lines.push(format!(
                 "{:<20} {:>4.0}mm {:>7.0} {:>8.1}% {:>9.1} {:>9.2} {:>8.1} {:>9.1}% {:>9}",
@@ -159,6 +221,8 @@ pub fn run(_a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         others.mean_mm(),
         100.0 * others.consistency()
     ));
+    lines.push(String::new());
+    suite_takes(&params, global, &mut lines)?;
     lines.push(String::new());
 
     // Carved from silhouettes (paper §2): the visual hull is fatter than the body and fills

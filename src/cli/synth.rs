@@ -35,7 +35,7 @@ pub fn params_from_args(a: &SynthArgs) -> Result<SynthParams, ExitError> {
     };
     let view = View::from_name(&a.view).ok_or_else(|| {
         ExitError::bad_input(anyhow!(
-            "--view {}: expected frontal, oblique, side or raised",
+            "--view {}: expected frontal, oblique, side, raised, behind or low",
             a.view
         ))
     })?;
@@ -78,6 +78,7 @@ pub fn params_from_args(a: &SynthArgs) -> Result<SynthParams, ExitError> {
         } else {
             VideoOutput::Mp4
         },
+        ..SynthParams::default()
     })
 }
 
@@ -110,7 +111,7 @@ pub fn run(a: &SynthArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             "frames": result.frames,
             "focal_px": result.camera.focal_px,
             "render_ms_per_frame": result.render_s_per_frame * 1e3,
-            "person_px": [result.stature_px.0, result.stature_px.1],
+            "person_px": [result.framing.stature_px.0, result.framing.stature_px.1],
         });
         println!("{summary}");
     } else {
@@ -123,8 +124,8 @@ pub fn run(a: &SynthArgs, global: &GlobalArgs) -> Result<(), ExitError> {
                 result.ground_truth.display(),
                 result.marks.display(),
                 result.render_s_per_frame * 1e3,
-                result.stature_px.0,
-                result.stature_px.1
+                result.framing.stature_px.0,
+                result.framing.stature_px.1
             ),
         );
     }

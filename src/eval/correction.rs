@@ -98,6 +98,7 @@ mod tests {
             cx: 160.0,
             cy: 160.0,
             joints: Joint::ALL.iter().map(|j| j.name().to_owned()).collect(),
+            stated_height_m: None,
             derived_joints: vec!["chest".into()],
             bone_lengths_m: Default::default(),
             frames: (0..n)

@@ -6,6 +6,7 @@
 
 pub mod correction;
 pub mod pose3d;
+pub mod suite;
 pub mod volume;
 
 use crate::formats::Tracks2d;

@@ -8,7 +8,8 @@ use crate::formats::{
     Frame3d, FrameTracks, PointSource, Skeleton3d, SourceInfo, TrackedPoint, Tracks2d,
 };
 use crate::lift::ambiguity::{AmbiguityWeights, lift_order, resolve};
-use crate::skeleton::{Bone, Joint, PerJoint, Proportions, SubjectModel};
+use crate::skeleton::{Bone, Joint, PerJoint, SubjectModel};
+use crate::camera::PinholeCamera;
 use crate::synth::GroundTruth;
 use nalgebra::{Matrix3, Point2, Point3, Vector3};
 use rand::SeedableRng;
@@ -259,27 +260,11 @@ fn mean_distance(gt: &GroundTruth, a: Joint, b: Joint) -> f64 {
     distances(gt, a, b).iter().sum::<f64>() / gt.frames.len().max(1) as f64
 }
 
-/// The subject's stature as a user would give it: the reference's leg, spine, neck and head
-/// lengths stacked, divided by the fraction of stature the default proportions give that stack
-/// (ankle height is not in the stack).
-pub fn stature_from_truth(gt: &GroundTruth) -> f64 {
-    let p = Proportions::default();
-    let chain = [
-        (Joint::LeftKnee, Joint::LeftAnkle),
-        (Joint::LeftHip, Joint::LeftKnee),
-        (Joint::Pelvis, Joint::Chest),
-        (Joint::Chest, Joint::Neck),
-        (Joint::Neck, Joint::HeadTop),
-    ];
-    let stack: f64 = chain.iter().map(|&(a, b)| mean_distance(gt, a, b)).sum();
-    let fraction: f64 = chain.iter().map(|&(a, b)| p.fraction_between(a, b)).sum();
-    stack / fraction
-}
-
-/// The subject with the reference's own mean bone lengths and shoulder width.
+/// The subject with the reference's own mean bone lengths and shoulder width (the height, which
+/// only sizes the body's breadths, is the clip's stated height, else the default).
 pub fn subject_from_truth(gt: &GroundTruth) -> SubjectModel {
     let mut s = SubjectModel {
-        height_m: stature_from_truth(gt),
+        height_m: gt.stated_height_m.unwrap_or(crate::skeleton::DEFAULT_HEIGHT_M),
         ..SubjectModel::default()
     };
     for (k, b) in Bone::ALL.iter().enumerate() {
@@ -456,5 +441,32 @@ mod tests {
         for (p, q) in procrustes(&a, &b).iter().zip(&b) {
             assert!((p - q).norm() < 1e-9);
         }
+    }
+}
+
+/// The flat cut-out, the baseline of every 3D table: each joint of `tracks` on its viewing ray
+/// (through `camera`) at the depth of the reference's pelvis on that frame, as if the body were a
+/// figure cut out of card facing the camera. A lift that does not beat it has added no depth.
+pub fn cutout(gt: &GroundTruth, tracks: &Tracks2d, camera: PinholeCamera) -> Skeleton3d {
+    let frames = tracks
+        .frames
+        .iter()
+        .filter_map(|f| {
+            let depth = gt.frames.get(f.index)?.points3d()[Joint::Pelvis].z;
+            Some(Frame3d {
+                index: f.index,
+                points: f.points.map(|_, p| {
+                    let ray = camera.ray(&p.pos);
+                    Point3::from(ray * (depth / ray.z))
+                }),
+                flags: Vec::new(),
+            })
+        })
+        .collect();
+    Skeleton3d {
+        camera,
+        fps: Some(gt.fps),
+        bone_lengths_m: BTreeMap::new(),
+        frames,
     }
 }

@@ -45,6 +45,10 @@ pub struct GroundTruth {
     /// Joints computed from others rather than measured (not to be scored).
     #[serde(default)]
     pub derived_joints: Vec<String>,
+    /// The subject's height as a person would state it (sole to vertex), metres: for a
+    /// synthetic clip the rendered body's, for a real clip the one its source gives.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stated_height_m: Option<f64>,
     /// True bone lengths, metres, keyed "parent-child" (mean over frames).
     #[serde(default)]
     pub bone_lengths_m: BTreeMap<String, f64>,

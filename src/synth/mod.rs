@@ -3,16 +3,20 @@
 //! with `gt.json` (2D, 3D, visibility, intrinsics, bone lengths) and `marks.json` for frame 0.
 //! This is the ground truth for every accuracy test and benchmark.
 
+mod appearance;
+mod body;
 mod ground_truth;
 mod motion;
 mod render;
 mod volume;
 
+pub use appearance::{Appearance, Cloth, Clothes, Pattern};
+pub use body::{BodyShape, JointDefinitions, retarget, shoulder_girdle};
 pub use ground_truth::{GroundTruth, GroundTruthFrame};
 pub use motion::{
     Motion, ProceduralMotion, from_bvh, normalise_orientation, procedural, stature_of,
 };
-pub use render::{Rendered, SensorEffects, background, render_frame};
+pub use render::{Figure, Rendered, SensorEffects, background, render_frame};
 pub use volume::{
     VoxelParams, ring_cameras, silhouette, truth as volume_truth, voxelise, write_carving_setup,
     write_volume_sequence,
@@ -23,7 +27,7 @@ use crate::camera::PinholeCamera;
 use crate::formats::{FormatError, Marks};
 use crate::skeleton::{Bone, Joint, PerJoint, SubjectModel};
 use crate::video::VideoError;
-use nalgebra::{Matrix3, Point3, Rotation3, Vector3};
+use nalgebra::{Matrix3, Point2, Point3, Rotation3, Vector3};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -38,16 +42,22 @@ pub enum View {
     Side,
     /// 30° to the left and 30° above (a camera on a shelf).
     Raised,
+    /// From behind, at chest height.
+    Behind,
+    /// 30° to the right and 15° below chest height (a camera on the floor or a low tripod).
+    Low,
 }
 
 impl View {
-    /// Parses `frontal`, `oblique`, `side` or `raised`.
+    /// Parses `frontal`, `oblique`, `side`, `raised`, `behind` or `low`.
     pub fn from_name(name: &str) -> Option<View> {
         match name {
             "frontal" => Some(View::Frontal),
             "oblique" => Some(View::Oblique),
             "side" => Some(View::Side),
             "raised" => Some(View::Raised),
+            "behind" => Some(View::Behind),
+            "low" => Some(View::Low),
             _ => None,
         }
     }
@@ -59,6 +69,8 @@ impl View {
             View::Oblique => (45.0, 0.0),
             View::Side => (90.0, 0.0),
             View::Raised => (30.0, 30.0),
+            View::Behind => (180.0, 0.0),
+            View::Low => (-30.0, -15.0),
         }
     }
 }
@@ -113,6 +125,20 @@ pub struct SynthParams {
     pub background_image: Option<PathBuf>,
     /// Output kind.
     pub output: VideoOutput,
+    /// The subject's body: the motion is carried onto it ([`retarget`]); `None` keeps the
+    /// motion's own.
+    pub body: Option<BodyShape>,
+    /// Shoulders that ride with the arms ([`shoulder_girdle`]), so the key triangle flexes.
+    pub shoulder_girdle: bool,
+    /// Where the ground truth puts the joints relative to the rendered body (an annotator's
+    /// definitions; [`JointDefinitions::exact`] for the model's own).
+    pub joint_definitions: JointDefinitions,
+    /// The subject's clothes.
+    pub appearance: Appearance,
+    /// A second person walking across behind the subject, drawn from this seed.
+    pub distractor: Option<u64>,
+    /// Motion blur: each frame the mean of three instants a third of a frame apart.
+    pub motion_blur: bool,
 }
 
 impl Default for SynthParams {
@@ -136,6 +162,12 @@ impl Default for SynthParams {
             background_seed: 7,
             background_image: None,
             output: VideoOutput::Mp4,
+            body: None,
+            shoulder_girdle: false,
+            joint_definitions: JointDefinitions::exact(),
+            appearance: Appearance::default(),
+            distractor: None,
+            motion_blur: false,
         }
     }
 }
@@ -177,9 +209,8 @@ pub struct SynthResult {
     pub camera: PinholeCamera,
     /// Mean seconds to render one frame (excluding encoding).
     pub render_s_per_frame: f64,
-    /// The person's stature in the image, pixels: (smallest, largest) over the frames
-    /// ([`stature_range_px`]).
-    pub stature_px: (f64, f64),
+    /// How the clip frames its subject ([`framing`]).
+    pub framing: Framing,
 }
 
 /// Places the camera: looking at the clip's mean pelvis from the view's direction, at the distance
@@ -191,20 +222,13 @@ fn place_camera(
     params: &SynthParams,
     camera: &PinholeCamera,
 ) -> (Matrix3<f64>, Vector3<f64>) {
-    let n = motion.frames.len().max(1) as f64;
-    let target: Vector3<f64> = motion
-        .frames
-        .iter()
-        .map(|p| p[Joint::Pelvis].coords)
-        .sum::<Vector3<f64>>()
-        / n
-        + Vector3::y() * 0.05;
+    let target = mean_pelvis(motion) + Vector3::y() * 0.05;
     let (az, el) = params.view.angles_deg();
     // Facing +Z; azimuth turns towards the subject's left (+X), elevation upwards.
     let dir = Rotation3::from_axis_angle(&Vector3::y_axis(), az.to_radians())
         * Rotation3::from_axis_angle(&(-Vector3::x_axis()), el.to_radians())
         * Vector3::z();
-    let stature = stature_of(motion);
+    let stature = subject_stature(params, motion);
     let mut distance = camera.focal_px * stature / params.person_px.max(1.0);
     let z = -dir; // camera looks back at the subject
     let down = -(Vector3::y() - z * z.dot(&Vector3::y())).normalize();
@@ -239,15 +263,31 @@ fn place_camera(
     (r, target + dir * distance)
 }
 
-/// The person's stature in the image over a clip, pixels: the smallest and the largest of
-/// `f · stature / depth of the pelvis` over its frames (a person walking in depth grows and
-/// shrinks). The tracking benchmark's suite keeps it within 200–450 px at 640×480.
-pub fn stature_range_px(params: &SynthParams) -> Result<(f64, f64), SynthError> {
+/// How a clip frames its subject, over its frames: the stature in the image, pixels, and the
+/// pelvis's depth from the camera, metres, each as (smallest, largest).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Framing {
+    /// `f · stature / depth of the pelvis`, pixels (a person walking in depth grows and
+    /// shrinks).
+    pub stature_px: (f64, f64),
+    /// The pelvis's depth, metres.
+    pub depth_m: (f64, f64),
+}
+
+/// The framing of a clip without rendering it.
+pub fn framing(params: &SynthParams) -> Result<Framing, SynthError> {
     check_params(params)?;
     let motion = load_motion(params)?;
     let camera = PinholeCamera::centred(params.focal_px, params.width, params.height);
     let (camera_from_world, centre) = place_camera(&motion, params, &camera);
-    Ok(stature_range(&motion, &camera, &camera_from_world, &centre))
+    let stature = subject_stature(params, &motion);
+    Ok(framing_of(
+        &motion,
+        stature,
+        &camera,
+        &camera_from_world,
+        &centre,
+    ))
 }
 
 /// Refuses parameters no clip can be made from: no frames, under 16×16 pixels, 0 fps, or a
@@ -268,33 +308,107 @@ fn check_params(params: &SynthParams) -> Result<(), SynthError> {
     Ok(())
 }
 
-/// [`stature_range_px`] for a motion seen by a placed camera.
-fn stature_range(
+/// [`framing`] for a motion seen by a placed camera.
+fn framing_of(
     motion: &Motion,
+    stature: f64,
     camera: &PinholeCamera,
     camera_from_world: &Matrix3<f64>,
     centre: &Vector3<f64>,
-) -> (f64, f64) {
-    let stature = stature_of(motion);
-    motion
+) -> Framing {
+    let range = |v: &mut dyn Iterator<Item = f64>| {
+        v.fold((f64::INFINITY, 0.0f64), |(lo, hi), s| (lo.min(s), hi.max(s)))
+    };
+    let depths: Vec<f64> = motion
         .frames
         .iter()
-        .map(|p| {
-            let depth = (camera_from_world * (p[Joint::Pelvis].coords - centre)).z;
-            camera.focal_px * stature / depth.max(1e-6)
-        })
-        .fold((f64::INFINITY, 0.0), |(lo, hi), s| (lo.min(s), hi.max(s)))
+        .map(|p| (camera_from_world * (p[Joint::Pelvis].coords - centre)).z)
+        .collect();
+    Framing {
+        stature_px: range(
+            &mut depths
+                .iter()
+                .map(|d| camera.focal_px * stature / d.max(1e-6)),
+        ),
+        depth_m: range(&mut depths.iter().copied()),
+    }
 }
 
-/// Loads or builds the motion of a clip.
+/// Loads or builds the motion of a clip, carried onto the clip's body ([`SynthParams::body`])
+/// with its shoulder girdle when asked.
 pub fn load_motion(params: &SynthParams) -> Result<Motion, SynthError> {
     let fps = f64::from(params.fps);
-    Ok(match &params.motion {
+    let mut motion = match &params.motion {
         MotionSource::Procedural(kind) => {
             procedural(*kind, &SubjectModel::default(), params.frames, fps)
         }
         MotionSource::Bvh { path, start_s } => from_bvh(path, *start_s, params.frames, fps)?,
-    })
+    };
+    if let Some(body) = &params.body {
+        motion = retarget(&motion, body);
+    }
+    if params.shoulder_girdle {
+        let stature = subject_stature(params, &motion);
+        shoulder_girdle(&mut motion, stature);
+    }
+    Ok(motion)
+}
+
+/// The subject's stature, sole to vertex: the body's when the clip has one, else the motion's
+/// ([`stature_of`]).
+fn subject_stature(params: &SynthParams, motion: &Motion) -> f64 {
+    params
+        .body
+        .as_ref()
+        .map_or_else(|| stature_of(motion), BodyShape::stature_m)
+}
+
+/// The second person of a clip ([`SynthParams::distractor`]), in camera space per frame: a
+/// procedural walk on a body drawn from `seed`, crossing the view 2.5 m behind the subject's
+/// mean position, from the camera's left to its right (or back, by the seed).
+fn distractor_frames(
+    seed: u64,
+    params: &SynthParams,
+    target: &Vector3<f64>,
+    camera_from_world: &Matrix3<f64>,
+    centre: &Vector3<f64>,
+) -> (Vec<PerJoint<Point3<f64>>>, f64, Appearance) {
+    let body = BodyShape::drawn(seed, 0.12);
+    let fps = f64::from(params.fps);
+    let walk = retarget(
+        &procedural(
+            ProceduralMotion::Walk,
+            &SubjectModel::default(),
+            params.frames,
+            fps,
+        ),
+        &body,
+    );
+    let horizontal = |v: Vector3<f64>| {
+        Vector3::new(v.x, 0.0, v.z)
+            .try_normalize(1e-9)
+            .unwrap_or_else(Vector3::z)
+    };
+    let forward = horizontal(camera_from_world.row(2).transpose());
+    let sign = if seed % 2 == 0 { 1.0 } else { -1.0 };
+    let across = horizontal(camera_from_world.row(0).transpose()) * sign;
+    let duration = params.frames as f64 / fps;
+    let start = Vector3::new(target.x, 0.0, target.z) + forward * 2.5 - across * (0.6 * duration);
+    // The walk goes along +Z: turn +Z onto `across`.
+    let yaw = across.x.atan2(across.z);
+    let turn = Rotation3::from_axis_angle(&Vector3::y_axis(), yaw);
+    let frames = walk
+        .frames
+        .iter()
+        .map(|p| {
+            p.map(|_, q| {
+                let world = start + turn * q.coords;
+                Point3::from(camera_from_world * (world - centre))
+            })
+        })
+        .collect();
+    let appearance = Appearance::drawn(Clothes::Print, false, &image::RgbImage::new(1, 1), seed);
+    (frames, body.stature_m(), appearance)
 }
 
 /// Renders a clip into `out_dir`, calling `progress(done, total)` after each frame; stops with
@@ -313,7 +427,7 @@ pub fn render_clip(
     let motion = load_motion(params)?;
     let camera = PinholeCamera::centred(params.focal_px, params.width, params.height);
     let (camera_from_world, centre) = place_camera(&motion, params, &camera);
-    let stature = stature_of(&motion);
+    let stature = subject_stature(params, &motion);
     let bg = match &params.background_image {
         Some(path) => image::open(path)
             .map_err(|e| SynthError::Background {
@@ -328,6 +442,15 @@ pub fn render_clip(
             .to_rgb8(),
         None => background(params.width, params.height, params.background_seed),
     };
+    let distractor = params.distractor.map(|seed| {
+        distractor_frames(
+            seed,
+            params,
+            &mean_pelvis(&motion),
+            &camera_from_world,
+            &centre,
+        )
+    });
 
     let video_path = match params.output {
         VideoOutput::Mp4 => out_dir.join("video.mp4"),
@@ -339,31 +462,54 @@ pub fn render_clip(
     let mut render_s = 0.0;
     let total = motion.frames.len();
     let mut first_points2d = None;
+    let to_camera = |p: &PerJoint<Point3<f64>>| -> PerJoint<Point3<f64>> {
+        p.map(|_, q| Point3::from(camera_from_world * (q.coords - centre)))
+    };
     for (i, world) in motion.frames.iter().enumerate() {
         if cancel.load(Ordering::Relaxed) {
             return Err(SynthError::Cancelled);
         }
-        let cam_pts: PerJoint<Point3<f64>> =
-            world.map(|_, p| Point3::from(camera_from_world * (p.coords - centre)));
+        let cam_pts = to_camera(world);
+        let others: Vec<Figure> = distractor
+            .iter()
+            .filter_map(|(frames, stature, appearance)| {
+                frames.get(i).map(|points| Figure {
+                    points,
+                    stature_m: *stature,
+                    appearance: *appearance,
+                })
+            })
+            .collect();
+        let subject = Figure {
+            points: &cam_pts,
+            stature_m: stature,
+            appearance: params.appearance,
+        };
         let t0 = std::time::Instant::now();
-        let r = render_frame(&camera, &cam_pts, stature, &bg, &params.effects, i);
+        let r = if params.motion_blur {
+            blurred_frame(&camera, &motion, i, &to_camera, subject, &others, &bg, params)
+        } else {
+            render_frame(&camera, &subject, &others, &bg, &params.effects, i)
+        };
         render_s += t0.elapsed().as_secs_f64();
         sink.write(i, &r.image)?;
+        // The ground truth's joints as the clip's annotator defines them.
+        let truth = to_camera(&params.joint_definitions.apply(world));
+        let points2d = truth.map(|_, p| camera.project(p).unwrap_or(Point2::new(-1e6, -1e6)));
         for (k, b) in Bone::ALL.iter().enumerate() {
-            bone_sums[k] += (cam_pts[b.child] - cam_pts[b.parent]).norm();
+            bone_sums[k] += (truth[b.child] - truth[b.parent]).norm();
         }
         if i == 0 {
-            first_points2d = Some(r.points2d);
+            first_points2d = Some(points2d);
         }
         gt_frames.push(GroundTruthFrame {
             index: i,
-            points2d: r
-                .points2d
+            points2d: points2d
                 .0
                 .iter()
                 .map(|p| [round4(p.x), round4(p.y)])
                 .collect(),
-            points3d: cam_pts
+            points3d: truth
                 .0
                 .iter()
                 .map(|p| [round6(p.x), round6(p.y), round6(p.z)])
@@ -386,6 +532,7 @@ pub fn render_clip(
         cy: camera.cy,
         joints: Joint::ALL.iter().map(|j| j.name().to_owned()).collect(),
         derived_joints: Vec::new(),
+        stated_height_m: Some(round4(stature)),
         bone_lengths_m: Bone::ALL
             .iter()
             .enumerate()
@@ -410,8 +557,67 @@ pub fn render_clip(
         frames: total,
         camera,
         render_s_per_frame: render_s / total.max(1) as f64,
-        stature_px: stature_range(&motion, &camera, &camera_from_world, &centre),
+        framing: framing_of(&motion, stature, &camera, &camera_from_world, &centre),
     })
+}
+
+/// The mean position of the pelvis over a motion.
+fn mean_pelvis(motion: &Motion) -> Vector3<f64> {
+    let n = motion.frames.len().max(1) as f64;
+    motion
+        .frames
+        .iter()
+        .map(|p| p[Joint::Pelvis].coords)
+        .sum::<Vector3<f64>>()
+        / n
+}
+
+/// Frame `i` with motion blur: the mean of the frame rendered at three instants a third of a
+/// frame apart (poses interpolated between frames), then the sensor's effects; the ground truth
+/// is the middle instant's.
+#[allow(clippy::too_many_arguments)]
+fn blurred_frame(
+    camera: &PinholeCamera,
+    motion: &Motion,
+    i: usize,
+    to_camera: &dyn Fn(&PerJoint<Point3<f64>>) -> PerJoint<Point3<f64>>,
+    subject: Figure,
+    others: &[Figure],
+    bg: &image::RgbImage,
+    params: &SynthParams,
+) -> Rendered {
+    let still = SensorEffects {
+        noise_sigma: 0.0,
+        flicker: 0.0,
+        seed: 0,
+    };
+    let last = motion.frames.len() - 1;
+    let at = |t: f64| -> PerJoint<Point3<f64>> {
+        let t = t.clamp(0.0, last as f64);
+        let (a, b) = (t.floor() as usize, (t.floor() as usize + 1).min(last));
+        let k = t - t.floor();
+        to_camera(&PerJoint::from_fn(|j| {
+            motion.frames[a][j] + (motion.frames[b][j] - motion.frames[a][j]) * k
+        }))
+    };
+    let mut middle = render_frame(camera, &subject, others, bg, &still, i);
+    let mut sum: Vec<u32> = middle.image.as_raw().iter().map(|&v| u32::from(v)).collect();
+    for dt in [-1.0 / 3.0, 1.0 / 3.0] {
+        let points = at(i as f64 + dt);
+        let shifted = Figure {
+            points: &points,
+            ..subject
+        };
+        let r = render_frame(camera, &shifted, others, bg, &still, i);
+        for (s, &v) in sum.iter_mut().zip(r.image.as_raw()) {
+            *s += u32::from(v);
+        }
+    }
+    for (p, s) in middle.image.iter_mut().zip(sum) {
+        *p = ((s + 1) / 3) as u8;
+    }
+    render::apply_effects(&mut middle.image, &params.effects, i);
+    middle
 }
 
 fn round4(v: f64) -> f64 {

@@ -2,6 +2,7 @@
 //! trunk and limbs, an ellipsoid head with hair, over a textured background, seen by a pinhole
 //! camera; optional sensor noise and brightness flicker.
 
+use super::appearance::{Appearance, Material, value_noise};
 use crate::camera::PinholeCamera;
 use crate::skeleton::{Joint, PerJoint};
 use image::{Rgb, RgbImage};
@@ -23,14 +24,6 @@ mod radius {
     pub const SHANK: (f64, f64) = (0.033, 0.024);
     /// Head semi-axes: up, across, front-back.
     pub const HEAD: (f64, f64, f64) = (0.068, 0.050, 0.058);
-}
-
-/// The surface a primitive wears.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Material {
-    Shirt,
-    Trousers,
-    Skin,
 }
 
 /// A tapered capsule: the union of spheres swept from `a` (radius `ra`) to `b` (radius `rb`).
@@ -109,6 +102,7 @@ enum Hit {
 /// The person posed for one frame, in camera space.
 pub struct Body {
     cones: Vec<RoundCone>,
+    appearance: Appearance,
     head: Head,
     /// Radius around each joint used for the visibility test, metres.
     joint_radius: PerJoint<f64>,
@@ -119,8 +113,18 @@ fn v(p: &Point3<f64>) -> Vector3<f64> {
 }
 
 impl Body {
-    /// Builds the primitives for joints given in camera space, for a subject of `stature_m`.
+    /// Builds the primitives for joints given in camera space, for a subject of `stature_m`
+    /// in the default clothes.
     pub fn new(points: &PerJoint<Point3<f64>>, stature_m: f64) -> Body {
+        Body::dressed(points, stature_m, Appearance::default())
+    }
+
+    /// [`Body::new`] in the given clothes (loose clothes widen the clothed parts).
+    pub fn dressed(
+        points: &PerJoint<Point3<f64>>,
+        stature_m: f64,
+        appearance: Appearance,
+    ) -> Body {
         use Joint::*;
         let s = stature_m;
         let p = |j: Joint| v(&points[j]);
@@ -142,11 +146,16 @@ impl Body {
         let mut cones = Vec::new();
         let mut cone = |a: Joint, b: Joint, ra: f64, rb: f64, material: Material| {
             let (pa, pb) = (p(a), p(b));
+            let k = if material == Material::Skin {
+                s
+            } else {
+                s * appearance.looseness
+            };
             cones.push(RoundCone {
                 a: pa,
                 b: pb,
-                ra: ra * s,
-                rb: rb * s,
+                ra: ra * k,
+                rb: rb * k,
                 across: across_of(pa, pb),
                 material,
                 seed: cones.len() as f64 * 1.7,
@@ -239,6 +248,7 @@ impl Body {
         });
         Body {
             cones,
+            appearance,
             head: Head {
                 centre,
                 to_unit,
@@ -332,7 +342,10 @@ impl Body {
                 let radial = (p - c.a) - axis * ((p - c.a).dot(&axis) / (len * len));
                 let other = axis.cross(&c.across) / len;
                 let angle = radial.dot(&other).atan2(radial.dot(&c.across));
-                (c.normal(p), material_colour(c.material, u, angle, c.seed))
+                (
+                    c.normal(p),
+                    self.appearance.colour(c.material, u, angle, c.seed),
+                )
             }
             Hit::Head => {
                 let local = self.head.to_unit * (p - self.head.centre);
@@ -343,9 +356,10 @@ impl Body {
                 let hair = rel.dot(&self.head.up) > 0.25 || rel.dot(&self.head.front) < -0.35;
                 let colour = if hair {
                     let streak = 0.85 + 0.15 * (rel.dot(&self.head.up) * 40.0).sin();
-                    [60.0 * streak, 42.0 * streak, 30.0 * streak]
+                    self.appearance.hair.map(|c| c * streak)
                 } else {
-                    [224.0, 172.0, 140.0]
+                    // The face a little lighter than the forearms.
+                    self.appearance.skin.map(|c| (c * 1.05).min(255.0))
                 };
                 (n, colour)
             }
@@ -353,58 +367,6 @@ impl Body {
         let lambert = normal.dot(&-light).max(0.0);
         let k = 0.35 + 0.65 * lambert;
         base.map(|c| c * k)
-    }
-}
-
-/// Cheap deterministic value noise in [0, 1] on a 2D lattice (for textures).
-fn hash2(x: i64, y: i64, seed: u64) -> f64 {
-    let mut h = (x as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
-        ^ (y as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F)
-        ^ seed.wrapping_mul(0x1656_67B1_9E37_79F9);
-    h ^= h >> 29;
-    h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    h ^= h >> 32;
-    (h >> 11) as f64 / (1u64 << 53) as f64
-}
-
-fn value_noise(x: f64, y: f64, seed: u64) -> f64 {
-    let (xi, yi) = (x.floor() as i64, y.floor() as i64);
-    let (fx, fy) = (x - x.floor(), y - y.floor());
-    let s = |t: f64| t * t * (3.0 - 2.0 * t);
-    let (sx, sy) = (s(fx), s(fy));
-    let a = hash2(xi, yi, seed);
-    let b = hash2(xi + 1, yi, seed);
-    let c = hash2(xi, yi + 1, seed);
-    let d = hash2(xi + 1, yi + 1, seed);
-    let top = a + (b - a) * sx;
-    let bottom = c + (d - c) * sx;
-    top + (bottom - top) * sy
-}
-
-fn material_colour(m: Material, along_m: f64, angle: f64, seed: f64) -> [f64; 3] {
-    let n = value_noise(along_m * 30.0 + seed, angle * 3.0, 7);
-    match m {
-        Material::Shirt => {
-            // Red and white stripes around the body with a woven noise: strong texture to track.
-            let stripe = ((along_m * 18.0 + seed).sin() > 0.0) as u8 as f64;
-            let base = if stripe > 0.5 {
-                [200.0, 45.0, 40.0]
-            } else {
-                [230.0, 225.0, 210.0]
-            };
-            base.map(|c| c * (0.8 + 0.2 * n))
-        }
-        Material::Trousers => {
-            let check =
-                (((angle * 3.0).floor() as i64 + (along_m * 12.0).floor() as i64) & 1) as f64;
-            let base = [
-                40.0 + 30.0 * check,
-                60.0 + 30.0 * check,
-                120.0 + 40.0 * check,
-            ];
-            base.map(|c| c * (0.75 + 0.25 * n))
-        }
-        Material::Skin => [214.0, 160.0, 128.0].map(|c| c * (0.9 + 0.1 * n)),
     }
 }
 
@@ -485,16 +447,59 @@ pub struct Rendered {
     pub visible: PerJoint<bool>,
 }
 
-/// Renders a posed body (joints in camera space) over `background`.
+/// One person to draw: joints in camera space, stature, clothes.
+#[derive(Debug, Clone, Copy)]
+pub struct Figure<'a> {
+    /// The 16 joints in camera space, metres.
+    pub points: &'a PerJoint<Point3<f64>>,
+    /// Stature, metres (sizes the body's parts).
+    pub stature_m: f64,
+    /// Clothes, skin and hair.
+    pub appearance: Appearance,
+}
+
+/// Renders the subject over `background`, with `others` (people or things moving behind it)
+/// drawn first; the ground truth (points, visibility) is the subject's.
 pub fn render_frame(
     camera: &PinholeCamera,
-    points: &PerJoint<Point3<f64>>,
-    stature_m: f64,
+    subject: &Figure,
+    others: &[Figure],
     background: &RgbImage,
     effects: &SensorEffects,
     frame_index: usize,
 ) -> Rendered {
-    let body = Body::new(points, stature_m);
+    let mut image = background.clone();
+    for other in others {
+        let body = Body::dressed(other.points, other.stature_m, other.appearance);
+        paint(camera, &body, &mut image);
+    }
+    let body = Body::dressed(subject.points, subject.stature_m, subject.appearance);
+    let depth = paint(camera, &body, &mut image);
+    apply_effects(&mut image, effects, frame_index);
+    let points = subject.points;
+    let (w, h) = (camera.width, camera.height);
+    let points2d = points.map(|_, p| camera.project(p).unwrap_or(Point2::new(-1e6, -1e6)));
+    let visible = PerJoint::from_fn(|j| {
+        let p2 = points2d[j];
+        if !camera.contains(&p2) {
+            return false;
+        }
+        let (px, py) = (p2.x.round() as u32, p2.y.round() as u32);
+        let surface = depth[(py.min(h - 1) * w + px.min(w - 1)) as usize];
+        // Seen when the nearest surface there is the joint's own (no more than its body radius
+        // plus 3 cm in front of it).
+        surface >= points[j].z - body.joint_radius[j] - 0.03
+    });
+    Rendered {
+        image,
+        points2d,
+        visible,
+    }
+}
+
+/// Draws `body` over `image` (z-buffered against itself) and returns its depth per pixel
+/// (infinite where it is not).
+fn paint(camera: &PinholeCamera, body: &Body, image: &mut RgbImage) -> Vec<f64> {
     let (w, h) = (camera.width, camera.height);
     // Screen-space bounds of each cone from its bounding sphere.
     let spheres: Vec<(Vector3<f64>, f64)> =
@@ -511,7 +516,6 @@ pub fn render_frame(
         })
         .collect();
     let light = Vector3::new(0.3, 0.8, 0.5).normalize(); // from upper left, behind the camera
-    let mut image = background.clone();
     let mut depth = vec![f64::INFINITY; (w * h) as usize];
     let rows: Vec<(u32, Vec<[u8; 3]>, Vec<f64>)> = (0..h)
         .into_par_iter()
@@ -563,27 +567,11 @@ pub fn render_frame(
             }
         }
     }
-    apply_effects(&mut image, effects, frame_index);
-    let points2d = points.map(|_, p| camera.project(p).unwrap_or(Point2::new(-1e6, -1e6)));
-    let visible = PerJoint::from_fn(|j| {
-        let p2 = points2d[j];
-        if !camera.contains(&p2) {
-            return false;
-        }
-        let (px, py) = (p2.x.round() as u32, p2.y.round() as u32);
-        let surface = depth[(py.min(h - 1) * w + px.min(w - 1)) as usize];
-        // Seen when the nearest surface there is the joint's own (no more than its body radius
-        // plus 3 cm in front of it).
-        surface >= points[j].z - body.joint_radius[j] - 0.03
-    });
-    Rendered {
-        image,
-        points2d,
-        visible,
-    }
+    depth
 }
 
-fn apply_effects(image: &mut RgbImage, effects: &SensorEffects, frame_index: usize) {
+/// Sensor noise and flicker on a finished frame (seeded per frame).
+pub(crate) fn apply_effects(image: &mut RgbImage, effects: &SensorEffects, frame_index: usize) {
     if effects.noise_sigma <= 0.0 && effects.flicker <= 0.0 {
         return;
     }

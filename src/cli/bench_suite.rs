@@ -1,0 +1,168 @@
+//! What every accuracy benchmark shares: the clips (suite v3, rendered once, and the two real
+//! clips) and tables that put `dev` and `test` side by side, per clip family and overall.
+
+use super::args::GlobalArgs;
+use super::{ExitError, say};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use videomocap::eval::suite::{Family, REAL_CLIPS, Split, Suite};
+
+/// One clip a benchmark scores.
+#[derive(Debug, Clone)]
+pub struct BenchClip {
+    /// Its name.
+    pub name: String,
+    /// Its family ([`Family::Real`] for the real clips).
+    pub family: Family,
+    /// Its split (the real clips are development material).
+    pub split: Split,
+    /// Its folder (video.mp4, gt.json, marks.json).
+    pub dir: PathBuf,
+}
+
+/// The crate's folder.
+pub fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The suite's clips, rendered into `suite_dir` when missing, then the real clips.
+pub fn bench_clips(suite_dir: &Path, global: &GlobalArgs) -> Result<Vec<BenchClip>, ExitError> {
+    let suite = Suite::load(root()).map_err(ExitError::failed)?;
+    let dirs = suite
+        .ensure_rendered(suite_dir, &mut |name| {
+            say(global, &format!("rendering suite clip {name} …"))
+        })
+        .map_err(ExitError::failed)?;
+    let mut out: Vec<BenchClip> = suite
+        .clips
+        .iter()
+        .zip(dirs)
+        .map(|(c, dir)| BenchClip {
+            name: c.name.clone(),
+            family: c.family,
+            split: c.split,
+            dir,
+        })
+        .collect();
+    out.extend(REAL_CLIPS.iter().map(|(name, dir)| BenchClip {
+        name: (*name).to_owned(),
+        family: Family::Real,
+        split: Split::Dev,
+        dir: root().join(dir),
+    }));
+    Ok(out)
+}
+
+/// Scores that add up over clips.
+pub trait Merge: Default + Clone {
+    /// Adds another's samples.
+    fn merge_from(&mut self, other: &Self);
+}
+
+impl Merge for videomocap::eval::Accuracy {
+    fn merge_from(&mut self, other: &Self) {
+        self.merge(other);
+    }
+}
+
+impl Merge for videomocap::eval::pose3d::Pose3dScore {
+    fn merge_from(&mut self, other: &Self) {
+        self.merge(other);
+    }
+}
+
+impl Merge for videomocap::eval::volume::VolumeScore {
+    fn merge_from(&mut self, other: &Self) {
+        self.merge(other);
+    }
+}
+
+impl<A: Merge, B: Merge> Merge for (A, B) {
+    fn merge_from(&mut self, other: &Self) {
+        self.0.merge_from(&other.0);
+        self.1.merge_from(&other.1);
+    }
+}
+
+impl<T: Merge, const N: usize> Merge for [T; N]
+where
+    [T; N]: Default,
+{
+    fn merge_from(&mut self, other: &Self) {
+        for (a, b) in self.iter_mut().zip(other) {
+            a.merge_from(b);
+        }
+    }
+}
+
+/// A score per (split, family) and per split over all synthetic clips.
+#[derive(Debug, Clone, Default)]
+pub struct Tally<T> {
+    cells: BTreeMap<(Split, Option<Family>), T>,
+}
+
+impl<T: Merge> Tally<T> {
+    /// Adds a clip's score to its family and, for synthetic clips, to its split's overall.
+    pub fn add(&mut self, clip: &BenchClip, score: &T) {
+        self.cells
+            .entry((clip.split, Some(clip.family)))
+            .or_default()
+            .merge_from(score);
+        if clip.family != Family::Real {
+            self.cells
+                .entry((clip.split, None))
+                .or_default()
+                .merge_from(score);
+        }
+    }
+
+    /// The score of a split's family (`None`: all its synthetic clips).
+    pub fn get(&self, split: Split, family: Option<Family>) -> Option<&T> {
+        self.cells.get(&(split, family))
+    }
+
+    /// One line per family and one overall, `dev` and `test` side by side: `cell` formats a
+    /// score into a fixed-width column (`width` characters, shown blank where a split has no
+    /// clip of the family).
+    pub fn lines(&self, width: usize, cell: impl Fn(&T) -> String) -> Vec<String> {
+        let rows = Family::ALL
+            .iter()
+            .map(|f| (f.name(), Some(*f)))
+            .chain(std::iter::once(("synthetic overall", None)));
+        rows.map(|(name, family)| {
+            let col = |split| {
+                self.get(split, family)
+                    .map_or_else(|| format!("{:width$}", ""), &cell)
+            };
+            format!("{name:<18} | {} | {}", col(Split::Dev), col(Split::Test))
+        })
+        .collect()
+    }
+
+    /// The table's heading: the split names over columns of `width` characters, then the
+    /// columns' own heading.
+    pub fn heading(width: usize, columns: &str) -> Vec<String> {
+        vec![
+            format!("{:<18} | {:<width$} | {:<width$}", "", "dev", "test"),
+            format!("{:<18} | {columns:<width$} | {columns:<width$}", "family"),
+        ]
+    }
+
+    /// Every cell as JSON: `{"dev": {"walk/run": …, "overall": …}, "test": …}`.
+    pub fn json(&self, value: impl Fn(&T) -> serde_json::Value) -> serde_json::Value {
+        let mut out = serde_json::Map::new();
+        for split in [Split::Dev, Split::Test] {
+            let mut m = serde_json::Map::new();
+            for ((s, family), v) in &self.cells {
+                if *s == split {
+                    m.insert(
+                        family.map_or("synthetic overall", Family::name).to_owned(),
+                        value(v),
+                    );
+                }
+            }
+            out.insert(split.name().to_owned(), serde_json::Value::Object(m));
+        }
+        serde_json::Value::Object(out)
+    }
+}
