@@ -95,7 +95,7 @@ def main():
         with open(tmp, "w") as f:
             json.dump(out, f)
         os.replace(tmp, job["out"])
-        print(f"{job['name']}: {', '.join(out)}", flush=True)
+        print(f"{job['name']}: {', '.join(out)}", file=sys.stderr, flush=True)
 
 
 if __name__ == "__main__":

@@ -72,8 +72,9 @@ pub fn run(
         let stamp = serde_json::json!({"video": video, "marks": joints, "methods": methods});
         let file = out_dir.join(format!("{}.json", clip.name.replace(' ', "_")));
         let stamp_file = file.with_extension("stamp");
-        let fresh = std::fs::read_to_string(&stamp_file).is_ok_and(|s| s == stamp.to_string())
-            && file.is_file();
+        let stamp_text = stamp.to_string();
+        let fresh =
+            std::fs::read_to_string(&stamp_file).is_ok_and(|s| s == stamp_text) && file.is_file();
         if !fresh {
             jobs.push(serde_json::json!({
                 "name": clip.name, "video": video, "marks": joints, "methods": methods,

@@ -14,6 +14,7 @@
 //! tracking with decoding takes than decoding alone, timed back to back in paired rounds.
 
 use super::args::{BenchArgs, GlobalArgs};
+use super::bench_suite::{BenchClip, Tally, bench_clips, root};
 use super::{ExitError, say};
 use anyhow::anyhow;
 use nalgebra::Point2;
@@ -21,7 +22,6 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
-use super::bench_suite::{BenchClip, Tally, bench_clips, root};
 use videomocap::eval::suite::{CLICK_NOISE_PX, Family, REAL_CLIPS, Split, clicked_marks};
 use videomocap::eval::{Accuracy, score_positions, score_tracks};
 use videomocap::formats::Marks;
@@ -151,7 +151,7 @@ type TrackScores = [Accuracy; 3];
 /// The column of one split in the tracking table.
 fn track_cell(s: &TrackScores) -> String {
     format!(
-        "{:>6.3} {:>5.1}% {:>6.1} {:>6.3} {:>6.3}",
+        "{:>6.3} {:>5.1}% {:>7.1} {:>6.3} {:>6.3}",
         s[0].pck02(),
         100.0 * s[0].lost(),
         s[0].mean_px(),
@@ -161,8 +161,8 @@ fn track_cell(s: &TrackScores) -> String {
 }
 
 /// The columns of [`track_cell`].
-const TRACK_COLUMNS: &str = " PCK.2   lost  mean px  exact  templ";
-const TRACK_WIDTH: usize = 36;
+const TRACK_COLUMNS: &str = " PCK.2   lost mean px  exact  templ";
+const TRACK_WIDTH: usize = 35;
 
 /// Tracks and scores one clip: (VBA from the clicked marks, VBA from the exact marks, the fixed
 /// template from the clicked marks), and the clicked marks.
@@ -178,7 +178,9 @@ fn score_clip(
         .map_err(ExitError::failed)?;
     let mut vba = |m: &Marks| -> Result<Accuracy, ExitError> {
         let tracks = track_opened(&mut video, m, threads, params)?;
-        Ok(score_tracks(&gt, &tracks).map_err(ExitError::failed)?.overall)
+        Ok(score_tracks(&gt, &tracks)
+            .map_err(ExitError::failed)?
+            .overall)
     };
     let (from_clicks, from_exact) = (vba(&clicked)?, vba(&marks)?);
     let stature = videomocap::track::body::stature_px(
@@ -201,7 +203,10 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         format!(
             "suite v3: {} clips ({} dev, {} test) and 2 real clips (dev); marks clicked with {} px of noise unless 'exact'",
             clips.len() - 2,
-            clips.iter().filter(|c| c.split == Split::Dev && c.family != Family::Real).count(),
+            clips
+                .iter()
+                .filter(|c| c.split == Split::Dev && c.family != Family::Real)
+                .count(),
             clips.iter().filter(|c| c.split == Split::Test).count(),
             CLICK_NOISE_PX
         ),
@@ -471,4 +476,3 @@ fn paired_ratio(
         ratios[RATIO_ROUNDS - 1],
     ))
 }
-

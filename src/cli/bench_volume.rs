@@ -5,14 +5,14 @@
 //! N = 3k, 10k and 30k points on one core with Isomap's share.
 
 use super::args::{BenchArgs, GlobalArgs};
+use super::bench_suite::{BenchClip, Tally, root};
 use super::{ExitError, say};
 use rayon::prelude::*;
 use std::path::Path;
 use std::time::Instant;
+use videomocap::eval::suite::Suite;
 use videomocap::eval::volume::{VolumeScore, carve_and_score, score_volume};
 use videomocap::skeleton::SubjectModel;
-use super::bench_suite::{BenchClip, Tally, root};
-use videomocap::eval::suite::Suite;
 use videomocap::synth::{
     BodyShape, Motion, ProceduralMotion, SynthParams, VoxelParams, from_bvh, load_motion,
     procedural, stature_of, volume_truth, voxelise,
@@ -147,7 +147,10 @@ fn suite_takes(
         "suite v3 takes (the bodies of their first clips, {FRAMES} frames at {FPS} fps, 40 mm voxels): topology, mean mm, voxel sizes, labels consistent"
     ));
     const WIDTH: usize = 31;
-    lines.extend(Tally::<VolumeScore>::heading(WIDTH, "  topo    mean voxels labels"));
+    lines.extend(Tally::<VolumeScore>::heading(
+        WIDTH,
+        "    topo    mean voxels  labels",
+    ));
     lines.extend(tally.lines(WIDTH, suite_cell));
     Ok(())
 }

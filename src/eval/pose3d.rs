@@ -4,12 +4,12 @@
 //! inputs of the lift benchmark from ground truth (true or noisy 2D, the true subject).
 
 use super::EvalError;
+use crate::camera::PinholeCamera;
 use crate::formats::{
     Frame3d, FrameTracks, PointSource, Skeleton3d, SourceInfo, TrackedPoint, Tracks2d,
 };
 use crate::lift::ambiguity::{AmbiguityWeights, lift_order, resolve};
 use crate::skeleton::{Bone, Joint, PerJoint, SubjectModel};
-use crate::camera::PinholeCamera;
 use crate::synth::GroundTruth;
 use nalgebra::{Matrix3, Point2, Point3, Vector3};
 use rand::SeedableRng;
@@ -264,7 +264,9 @@ fn mean_distance(gt: &GroundTruth, a: Joint, b: Joint) -> f64 {
 /// only sizes the body's breadths, is the clip's stated height, else the default).
 pub fn subject_from_truth(gt: &GroundTruth) -> SubjectModel {
     let mut s = SubjectModel {
-        height_m: gt.stated_height_m.unwrap_or(crate::skeleton::DEFAULT_HEIGHT_M),
+        height_m: gt
+            .stated_height_m
+            .unwrap_or(crate::skeleton::DEFAULT_HEIGHT_M),
         ..SubjectModel::default()
     };
     for (k, b) in Bone::ALL.iter().enumerate() {
@@ -373,6 +375,33 @@ pub fn lift_on_reference_key(
     }
 }
 
+/// The flat cut-out, the baseline of every 3D table: each joint of `tracks` on its viewing ray
+/// (through `camera`) at the depth of the reference's pelvis on that frame, as if the body were a
+/// figure cut out of card facing the camera. A lift that does not beat it has added no depth.
+pub fn cutout(gt: &GroundTruth, tracks: &Tracks2d, camera: PinholeCamera) -> Skeleton3d {
+    let frames = tracks
+        .frames
+        .iter()
+        .filter_map(|f| {
+            let depth = gt.frames.get(f.index)?.points3d()[Joint::Pelvis].z;
+            Some(Frame3d {
+                index: f.index,
+                points: f.points.map(|_, p| {
+                    let ray = camera.ray(&p.pos);
+                    Point3::from(ray * (depth / ray.z))
+                }),
+                flags: Vec::new(),
+            })
+        })
+        .collect();
+    Skeleton3d {
+        camera,
+        fps: Some(gt.fps),
+        bone_lengths_m: BTreeMap::new(),
+        frames,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -441,32 +470,5 @@ mod tests {
         for (p, q) in procrustes(&a, &b).iter().zip(&b) {
             assert!((p - q).norm() < 1e-9);
         }
-    }
-}
-
-/// The flat cut-out, the baseline of every 3D table: each joint of `tracks` on its viewing ray
-/// (through `camera`) at the depth of the reference's pelvis on that frame, as if the body were a
-/// figure cut out of card facing the camera. A lift that does not beat it has added no depth.
-pub fn cutout(gt: &GroundTruth, tracks: &Tracks2d, camera: PinholeCamera) -> Skeleton3d {
-    let frames = tracks
-        .frames
-        .iter()
-        .filter_map(|f| {
-            let depth = gt.frames.get(f.index)?.points3d()[Joint::Pelvis].z;
-            Some(Frame3d {
-                index: f.index,
-                points: f.points.map(|_, p| {
-                    let ray = camera.ray(&p.pos);
-                    Point3::from(ray * (depth / ray.z))
-                }),
-                flags: Vec::new(),
-            })
-        })
-        .collect();
-    Skeleton3d {
-        camera,
-        fps: Some(gt.fps),
-        bone_lengths_m: BTreeMap::new(),
-        frames,
     }
 }

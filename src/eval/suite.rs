@@ -26,7 +26,10 @@ pub const SUITE_FILE: &str = "tests/data/suite/suite.json";
 /// The two real clips, under the crate's root: (name, folder).
 pub const REAL_CLIPS: [(&str, &str); 2] = [
     ("real balancing", "sample_videos/pose2sim_balancing_cam01"),
-    ("real + distractor", "sample_videos/pose2sim_distractor_cam01"),
+    (
+        "real + distractor",
+        "sample_videos/pose2sim_distractor_cam01",
+    ),
 ];
 
 /// The spread of the bodies' segment lengths around the proportions table (±12 %).
@@ -237,8 +240,7 @@ impl Suite {
         for clip in &self.clips {
             let folder = dir.join(&clip.name);
             let stamp = format!("suite v3: {:?}\n", clip.params);
-            let current = std::fs::read_to_string(folder.join(SPEC_FILE))
-                .is_ok_and(|s| s == stamp)
+            let current = std::fs::read_to_string(folder.join(SPEC_FILE)).is_ok_and(|s| s == stamp)
                 && folder.join("gt.json").is_file();
             if !current {
                 progress(&clip.name);
@@ -271,7 +273,8 @@ pub const SUITE_INDEX: &str = "clips.txt";
 
 /// The render parameters of one clip of the file.
 fn clip_params(c: &ClipEntry, motion: MotionSource, root: &Path) -> Result<SynthParams, String> {
-    let view = View::from_name(&c.view).ok_or_else(|| format!("clip {}: view {}", c.name, c.view))?;
+    let view =
+        View::from_name(&c.view).ok_or_else(|| format!("clip {}: view {}", c.name, c.view))?;
     let clothes = Clothes::from_name(&c.clothes)
         .ok_or_else(|| format!("clip {}: clothes {}", c.name, c.clothes))?;
     let [width, height] = c.size;
@@ -341,11 +344,9 @@ pub fn clip_frames(clip: &SuiteClip) -> Result<usize, SuiteError> {
 /// The marks as a user clicks them: each coordinate moved by Gaussian noise of `sigma_px`
 /// (seeded by the clip's name, so every run and every benchmark sees the same clicks).
 pub fn clicked_marks(marks: &Marks, sigma_px: f64, clip_name: &str) -> Marks {
-    let seed = clip_name
-        .bytes()
-        .fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
-            (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-        });
+    let seed = clip_name.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    });
     let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
     let normal = Normal::new(0.0, sigma_px.max(0.0)).ok();
     let mut jitter = || normal.map_or(0.0, |n| n.sample(&mut rng));

@@ -106,7 +106,7 @@ impl Appearance {
     /// colour and a shade of it), skin and hair from a few tones, `loose` clothes 1.3 times as
     /// wide.
     pub fn drawn(clothes: Clothes, loose: bool, background: &RgbImage, seed: u64) -> Appearance {
-        let mut rng = rand::rngs::StdRng::seed_from_u64(seed ^ 0xC107_E5);
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed ^ 0x00C1_07E5);
         let colour = |rng: &mut rand::rngs::StdRng| -> [f64; 3] {
             [
                 rng.random_range(20.0..235.0),

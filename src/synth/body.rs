@@ -36,7 +36,7 @@ impl BodyShape {
     /// shoulders' and the hips' half-widths included, uniform within ±`spread` (0.12: ±12 %) of
     /// the proportions table at that height; left and right alike.
     pub fn drawn(seed: u64, spread: f64) -> BodyShape {
-        let mut rng = rand::rngs::StdRng::seed_from_u64(seed ^ 0xB0D1_E5);
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed ^ 0x00B0_D1E5);
         let height = rng.random_range(1.50..=1.95);
         let table = Proportions::default();
         let mut factor = [1.0; BONE_COUNT];
@@ -269,7 +269,9 @@ mod tests {
         let before: Vec<f64> = motion.frames.iter().map(side).collect();
         shoulder_girdle(&mut motion, 1.7);
         let after: Vec<f64> = motion.frames.iter().map(side).collect();
-        let spread = |v: &[f64]| v.iter().cloned().fold(0.0, f64::max) - v.iter().cloned().fold(9.0, f64::min);
+        let spread = |v: &[f64]| {
+            v.iter().cloned().fold(0.0, f64::max) - v.iter().cloned().fold(9.0, f64::min)
+        };
         assert!(spread(&before) < 1e-6);
         assert!(spread(&after) > 0.01, "{}", spread(&after));
     }

@@ -317,7 +317,9 @@ fn framing_of(
     centre: &Vector3<f64>,
 ) -> Framing {
     let range = |v: &mut dyn Iterator<Item = f64>| {
-        v.fold((f64::INFINITY, 0.0f64), |(lo, hi), s| (lo.min(s), hi.max(s)))
+        v.fold((f64::INFINITY, 0.0f64), |(lo, hi), s| {
+            (lo.min(s), hi.max(s))
+        })
     };
     let depths: Vec<f64> = motion
         .frames
@@ -390,7 +392,7 @@ fn distractor_frames(
             .unwrap_or_else(Vector3::z)
     };
     let forward = horizontal(camera_from_world.row(2).transpose());
-    let sign = if seed % 2 == 0 { 1.0 } else { -1.0 };
+    let sign = if seed.is_multiple_of(2) { 1.0 } else { -1.0 };
     let across = horizontal(camera_from_world.row(0).transpose()) * sign;
     let duration = params.frames as f64 / fps;
     let start = Vector3::new(target.x, 0.0, target.z) + forward * 2.5 - across * (0.6 * duration);
@@ -462,9 +464,11 @@ pub fn render_clip(
     let mut render_s = 0.0;
     let total = motion.frames.len();
     let mut first_points2d = None;
-    let to_camera = |p: &PerJoint<Point3<f64>>| -> PerJoint<Point3<f64>> {
-        p.map(|_, q| Point3::from(camera_from_world * (q.coords - centre)))
+    let placement = Placement {
+        camera_from_world,
+        centre,
     };
+    let to_camera = |p: &PerJoint<Point3<f64>>| placement.to_camera(p);
     for (i, world) in motion.frames.iter().enumerate() {
         if cancel.load(Ordering::Relaxed) {
             return Err(SynthError::Cancelled);
@@ -487,7 +491,9 @@ pub fn render_clip(
         };
         let t0 = std::time::Instant::now();
         let r = if params.motion_blur {
-            blurred_frame(&camera, &motion, i, &to_camera, subject, &others, &bg, params)
+            blurred_frame(
+                &camera, &motion, i, &placement, subject, &others, &bg, params,
+            )
         } else {
             render_frame(&camera, &subject, &others, &bg, &params.effects, i)
         };
@@ -561,6 +567,19 @@ pub fn render_clip(
     })
 }
 
+/// Where the camera stands: world → camera rotation and the camera's centre in the world.
+struct Placement {
+    camera_from_world: Matrix3<f64>,
+    centre: Vector3<f64>,
+}
+
+impl Placement {
+    /// A pose in camera space.
+    fn to_camera(&self, p: &PerJoint<Point3<f64>>) -> PerJoint<Point3<f64>> {
+        p.map(|_, q| Point3::from(self.camera_from_world * (q.coords - self.centre)))
+    }
+}
+
 /// The mean position of the pelvis over a motion.
 fn mean_pelvis(motion: &Motion) -> Vector3<f64> {
     let n = motion.frames.len().max(1) as f64;
@@ -580,7 +599,7 @@ fn blurred_frame(
     camera: &PinholeCamera,
     motion: &Motion,
     i: usize,
-    to_camera: &dyn Fn(&PerJoint<Point3<f64>>) -> PerJoint<Point3<f64>>,
+    placement: &Placement,
     subject: Figure,
     others: &[Figure],
     bg: &image::RgbImage,
@@ -596,12 +615,17 @@ fn blurred_frame(
         let t = t.clamp(0.0, last as f64);
         let (a, b) = (t.floor() as usize, (t.floor() as usize + 1).min(last));
         let k = t - t.floor();
-        to_camera(&PerJoint::from_fn(|j| {
+        placement.to_camera(&PerJoint::from_fn(|j| {
             motion.frames[a][j] + (motion.frames[b][j] - motion.frames[a][j]) * k
         }))
     };
     let mut middle = render_frame(camera, &subject, others, bg, &still, i);
-    let mut sum: Vec<u32> = middle.image.as_raw().iter().map(|&v| u32::from(v)).collect();
+    let mut sum: Vec<u32> = middle
+        .image
+        .as_raw()
+        .iter()
+        .map(|&v| u32::from(v))
+        .collect();
     for dt in [-1.0 / 3.0, 1.0 / 3.0] {
         let points = at(i as f64 + dt);
         let shifted = Figure {

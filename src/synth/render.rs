@@ -120,11 +120,7 @@ impl Body {
     }
 
     /// [`Body::new`] in the given clothes (loose clothes widen the clothed parts).
-    pub fn dressed(
-        points: &PerJoint<Point3<f64>>,
-        stature_m: f64,
-        appearance: Appearance,
-    ) -> Body {
+    pub fn dressed(points: &PerJoint<Point3<f64>>, stature_m: f64, appearance: Appearance) -> Body {
         use Joint::*;
         let s = stature_m;
         let p = |j: Joint| v(&points[j]);
