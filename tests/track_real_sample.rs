@@ -69,23 +69,3 @@ fn a_bare_upper_arm_keeps_its_length_on_real_video() {
         0.02,
     );
 }
-
-/// The subject's left forearm, swinging across the body, shrinks towards the elbow with the
-/// ordinary pull (the default), and the wrist stays short of the hand. A stronger forearm pull
-/// (`forearm_short_penalty` 12) keeps it long (measured: left wrist 82.5 → 57.5 px, PCK@0.2
-/// over the clip 0.811 → 0.827; before the arms' background lane, which tracks the clip better
-/// with the ordinary pull, 66.3 → 51.4 px and 0.805 → 0.834).
-#[test]
-fn a_stronger_forearm_pull_keeps_the_wrist_out_on_real_video() {
-    let stronger = TrackerParams {
-        forearm_short_penalty: 12.0,
-        ..TrackerParams::default()
-    };
-    assert_pull_helps(
-        TrackerParams::default(),
-        stronger,
-        Joint::LeftWrist,
-        0.85,
-        0.01,
-    );
-}

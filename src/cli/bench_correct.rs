@@ -12,13 +12,13 @@
 
 use super::args::{BenchArgs, GlobalArgs};
 use super::bench_suite::{BenchClip, Tally, bench_clips};
-use super::bench_track::{threads_and_settings, track_opened};
+use super::bench_track::{fixed_template_track, threads_and_settings, track_opened};
 use super::{ExitError, say};
 use std::collections::BTreeSet;
 use std::sync::atomic::AtomicBool;
 use videomocap::eval::correction::next_correction;
 use videomocap::eval::suite::{CLICK_NOISE_PX, clicked_marks};
-use videomocap::eval::{Accuracy, score_tracks};
+use videomocap::eval::{Accuracy, score_positions, score_tracks};
 use videomocap::formats::{Marks, Tracks2d};
 use videomocap::synth::GroundTruth;
 use videomocap::track::{KeyFrames, TrackJob, TrackerParams, track_video};
@@ -32,6 +32,8 @@ const GOAL_PCK02: f64 = 0.95;
 struct Rounds {
     scores: Vec<Accuracy>,
     drags: Vec<usize>,
+    /// The fixed-template baseline from the same clicked marks, uncorrected.
+    template: Accuracy,
 }
 
 /// Tracks a clip and corrects it for `rounds` rounds at most (fewer when nothing is left
@@ -59,9 +61,17 @@ fn correct_clip(
             .map(|s| s.overall)
             .map_err(ExitError::failed)
     };
+    let stature = videomocap::track::body::stature_px(
+        &marks.points,
+        &videomocap::skeleton::Proportions::default(),
+    );
+    let base = fixed_template_track(&mut video, &marks.points, stature)?;
     let mut out = Rounds {
         scores: vec![score(&tracks)?],
         drags: vec![0],
+        template: score_positions(&gt, base.into_iter().enumerate())
+            .map_err(ExitError::failed)?
+            .overall,
     };
     for _ in 0..rounds {
         let Some(c) = next_correction(&gt, &tracks, &done) else {
@@ -104,14 +114,16 @@ fn at_round(r: &Rounds, k: usize) -> &Accuracy {
 /// Corrections a clip may use: one per [`FRAMES_PER_CORRECTION`] frames (at least one).
 const FRAMES_PER_CORRECTION: usize = 25;
 
-/// A split's column: PCK@0.2 and lost before any correction, then after the clip's budget.
-fn cell(s: &[Accuracy; 2]) -> String {
+/// A split's column: PCK@0.2 and lost before any correction, then after the clip's budget,
+/// then the fixed template's PCK@0.2 (uncorrected).
+fn cell(s: &[Accuracy; 3]) -> String {
     format!(
-        "{:>6.3} {:>5.1}% {:>6.3} {:>5.1}%",
+        "{:>6.3} {:>5.1}% {:>6.3} {:>5.1}% {:>6.3}",
         s[0].pck02(),
         100.0 * s[0].lost(),
         s[1].pck02(),
-        100.0 * s[1].lost()
+        100.0 * s[1].lost(),
+        s[2].pck02()
     )
 }
 
@@ -120,13 +132,13 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let (threads, params) = threads_and_settings(a)?;
     let clips = bench_clips(&a.suite_dir, global)?;
     let mut results = Vec::with_capacity(clips.len());
-    let mut tally: Tally<[Accuracy; 2]> = Tally::default();
+    let mut tally: Tally<[Accuracy; 3]> = Tally::default();
     for clip in &clips {
         say(global, &format!("correcting {}", clip.name));
         let gt = GroundTruth::load(&clip.dir.join("gt.json")).map_err(ExitError::failed)?;
         let budget = gt.frames.len().div_ceil(FRAMES_PER_CORRECTION).max(1);
         let r = correct_clip(clip, budget, threads, params)?;
-        tally.add(clip, &[r.scores[0], *at_round(&r, budget)]);
+        tally.add(clip, &[r.scores[0], *at_round(&r, budget), r.template]);
         results.push((budget, r));
     }
     let mut lines = vec![
@@ -134,14 +146,15 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             "simulated correction from clicked marks: each round goes to the first frame with a \
              joint lost (over 0.5 torso off), drags every joint there over 0.2 torso off onto \
              the reference and re-tracks from there; one round per {FRAMES_PER_CORRECTION} \
-             frames of clip. Columns: PCK@0.2 and lost before any correction, then after them"
+             frames of clip. Columns: PCK@0.2 and lost before any correction, then after them, then \
+             the fixed template's PCK@0.2 from the same marks (uncorrected)"
         ),
         String::new(),
     ];
-    const WIDTH: usize = 27;
-    lines.extend(Tally::<[Accuracy; 2]>::heading(
+    const WIDTH: usize = 34;
+    lines.extend(Tally::<[Accuracy; 3]>::heading(
         WIDTH,
-        " PCK.2   lost  after   lost",
+        " PCK.2   lost  after   lost  templ",
     ));
     lines.extend(tally.lines(WIDTH, cell));
     lines.push(String::new());
@@ -181,6 +194,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             serde_json::json!({
                 "before": super::bench_track::accuracy_json(&s[0]),
                 "after": super::bench_track::accuracy_json(&s[1]),
+            "fixed_template": super::bench_track::accuracy_json(&s[2]),
             })
         });
         println!(

@@ -162,10 +162,10 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         "lift after refinement: MPJPE (pelvis aligned), the flat cut-out's on the same input (true rays at the true pelvis depth), MPJPE ÷ cut-out, PA-MPJPE, wrong depth roots; mm".to_owned(),
         String::new(),
         format!(
-            "{:<46} | {:<WIDTH$} | {:<WIDTH$}",
+            "{:<48} | {:<WIDTH$} | {:<WIDTH$}",
             "synthetic overall", "dev", "test"
         ),
-        format!("{:<46} | {COLUMNS:<WIDTH$} | {COLUMNS:<WIDTH$}", "input, lengths, camera"),
+        format!("{:<48} | {COLUMNS:<WIDTH$} | {COLUMNS:<WIDTH$}", "input, lengths, camera"),
     ];
     let blank = format!("{:WIDTH$}", "");
     for (i, input) in INPUTS.iter().enumerate() {
@@ -177,7 +177,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
                         .map_or_else(|| blank.clone(), |c| cell(&c[i][l][f]))
                 };
                 out.push(format!(
-                    "{:<46} | {} | {}",
+                    "{:<48} | {} | {}",
                     format!("{input}, {lengths}, {focal}"),
                     col(Split::Dev),
                     col(Split::Test)

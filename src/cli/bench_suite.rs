@@ -121,15 +121,20 @@ impl<T: Merge> Tally<T> {
         self.cells.get(&(split, family))
     }
 
-    /// One line per family and one overall, `dev` and `test` side by side: `cell` formats a
-    /// score into a fixed-width column (`width` characters, shown blank where a split has no
+    /// One line per family that has clips and one overall, `dev` and `test` side by side: `cell`
+    /// formats a score into a fixed-width column (`width` characters, blank where a split has no
     /// clip of the family).
     pub fn lines(&self, width: usize, cell: impl Fn(&T) -> String) -> Vec<String> {
         let rows = Family::ALL
             .iter()
             .map(|f| (f.name(), Some(*f)))
             .chain(std::iter::once(("synthetic overall", None)));
-        rows.map(|(name, family)| {
+        rows.filter(|(_, family)| {
+            [Split::Dev, Split::Test]
+                .iter()
+                .any(|s| self.get(*s, *family).is_some())
+        })
+        .map(|(name, family)| {
             let col = |split| {
                 self.get(split, family)
                     .map_or_else(|| format!("{:width$}", ""), &cell)
@@ -164,5 +169,49 @@ impl<T: Merge> Tally<T> {
             out.insert(split.name().to_owned(), serde_json::Value::Object(m));
         }
         serde_json::Value::Object(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use videomocap::eval::Accuracy;
+
+    fn clip(family: Family, split: Split) -> BenchClip {
+        BenchClip {
+            name: format!("{family:?}"),
+            family,
+            split,
+            dir: PathBuf::new(),
+        }
+    }
+
+    fn accuracy(error_px: f64, samples: usize) -> Accuracy {
+        let mut a = Accuracy::default();
+        for _ in 0..samples {
+            a.add(error_px, 100.0);
+        }
+        a
+    }
+
+    #[test]
+    fn the_tally_keeps_splits_apart_and_the_real_clips_out_of_the_synthetic_overall() {
+        let mut t: Tally<Accuracy> = Tally::default();
+        t.add(&clip(Family::WalkRun, Split::Dev), &accuracy(10.0, 4));
+        t.add(&clip(Family::Dance, Split::Test), &accuracy(50.0, 4));
+        t.add(&clip(Family::Real, Split::Dev), &accuracy(90.0, 4));
+        let dev = t.get(Split::Dev, None).unwrap();
+        assert_eq!(dev.count, 4);
+        assert!((dev.mean_px() - 10.0).abs() < 1e-9);
+        assert!((t.get(Split::Test, None).unwrap().mean_px() - 50.0).abs() < 1e-9);
+        assert!(t.get(Split::Test, Some(Family::WalkRun)).is_none());
+        let lines = t.lines(8, |a| format!("{:>8.1}", a.mean_px()));
+        // walk/run, dance, real and the overall; no line for the families without clips.
+        assert_eq!(lines.len(), 4, "{lines:#?}");
+        assert!(lines[0].starts_with("walk/run") && lines[0].contains("10.0"));
+        assert!(lines[3].starts_with("synthetic overall"));
+        let json = t.json(|a| serde_json::json!(a.mean_px()));
+        assert_eq!(json["test"]["dance"], serde_json::json!(50.0));
+        assert_eq!(json["dev"]["real"], serde_json::json!(90.0));
     }
 }

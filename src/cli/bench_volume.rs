@@ -109,13 +109,14 @@ fn suite_cell(s: &VolumeScore) -> String {
     )
 }
 
-/// The volume pipeline on every take of suite v3 (its first clip's body and start, {FRAMES}
-/// frames at {FPS} fps, 40 mm voxels), dev and test side by side per family.
+/// The volume pipeline on every take of suite v3 (its first clip's body and start, [`FRAMES`]
+/// frames at [`FPS`] fps, 40 mm voxels), dev and test side by side per family; returns the same
+/// as JSON.
 fn suite_takes(
     params: &VolumeParams,
     global: &GlobalArgs,
     lines: &mut Vec<String>,
-) -> Result<(), ExitError> {
+) -> Result<serde_json::Value, ExitError> {
     let suite = Suite::load(root()).map_err(ExitError::failed)?;
     let mut tally: Tally<VolumeScore> = Tally::default();
     let mut seen = std::collections::BTreeSet::new();
@@ -152,7 +153,12 @@ fn suite_takes(
         "    topo    mean voxels  labels",
     ));
     lines.extend(tally.lines(WIDTH, suite_cell));
-    Ok(())
+    Ok(tally.json(|s| {
+        serde_json::json!({
+            "topology": s.topology(), "mean_mm": s.mean_mm(),
+            "voxel_sizes": s.mean_mm() / 40.0, "labels_consistent": s.consistency(),
+        })
+    }))
 }
 
 /// Runs the volume benchmark and prints its tables.
@@ -225,7 +231,7 @@ pub fn run(_a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         100.0 * others.consistency()
     ));
     lines.push(String::new());
-    suite_takes(&params, global, &mut lines)?;
+    let suite_json = suite_takes(&params, global, &mut lines)?;
     lines.push(String::new());
 
     // Carved from silhouettes (paper §2): the visual hull is fatter than the body and fills
@@ -305,6 +311,13 @@ pub fn run(_a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             clouds.len()
         ));
     }
-    println!("{}", lines.join("\n"));
+    if global.json {
+        println!(
+            "{}",
+            serde_json::json!({"suite_40mm": suite_json, "table": lines})
+        );
+    } else {
+        println!("{}", lines.join("\n"));
+    }
     Ok(())
 }

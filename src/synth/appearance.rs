@@ -43,8 +43,10 @@ pub struct Appearance {
     pub shirt: Cloth,
     /// The trousers (hips and legs).
     pub trousers: Cloth,
-    /// Skin (forearms, neck, face).
+    /// Skin (forearms, neck).
     pub skin: [f64; 3],
+    /// The face, a little lighter than the forearms.
+    pub face: [f64; 3],
     /// Hair.
     pub hair: [f64; 3],
     /// Radius factor of clothed parts (1 = fitted, 1.3 = loose).
@@ -66,6 +68,7 @@ impl Default for Appearance {
                 b: [70.0, 90.0, 160.0],
             },
             skin: [214.0, 160.0, 128.0],
+            face: [224.0, 172.0, 140.0],
             hair: [60.0, 42.0, 30.0],
             looseness: 1.0,
         }
@@ -163,10 +166,12 @@ impl Appearance {
             [170.0, 130.0, 80.0],
             [120.0, 120.0, 120.0],
         ];
+        let skin = SKIN[rng.random_range(0..SKIN.len())];
         Appearance {
             shirt,
             trousers,
-            skin: SKIN[rng.random_range(0..SKIN.len())],
+            skin,
+            face: skin.map(|c| (c * 1.05).min(255.0)),
             hair: HAIR[rng.random_range(0..HAIR.len())],
             looseness: if loose { 1.3 } else { 1.0 },
         }

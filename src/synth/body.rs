@@ -27,7 +27,7 @@ pub struct BodyShape {
     /// Length of each bone of [`Bone::ALL`], in that order, metres.
     pub bone_length_m: [f64; BONE_COUNT],
     /// The height the segments were drawn for, metres (the ankle's height over the sole is
-    /// [`ANKLE_HEIGHT`] of it).
+    /// 3.9 % of it).
     pub drawn_height_m: f64,
 }
 
@@ -264,7 +264,13 @@ mod tests {
 
     #[test]
     fn raised_arms_lift_the_shoulders_so_the_key_triangle_flexes() {
-        let mut motion = procedural(ProceduralMotion::Wave, &SubjectModel::default(), 60, 30.0);
+        // Jumping jacks: the arms go from hanging to overhead and back.
+        let mut motion = procedural(
+            ProceduralMotion::JumpingJacks,
+            &SubjectModel::default(),
+            60,
+            30.0,
+        );
         let side = |p: &PerJoint<Point3<f64>>| (p[Joint::RightShoulder] - p[Joint::Chest]).norm();
         let before: Vec<f64> = motion.frames.iter().map(side).collect();
         shoulder_girdle(&mut motion, 1.7);

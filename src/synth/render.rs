@@ -354,8 +354,7 @@ impl Body {
                     let streak = 0.85 + 0.15 * (rel.dot(&self.head.up) * 40.0).sin();
                     self.appearance.hair.map(|c| c * streak)
                 } else {
-                    // The face a little lighter than the forearms.
-                    self.appearance.skin.map(|c| (c * 1.05).min(255.0))
+                    self.appearance.face
                 };
                 (n, colour)
             }
