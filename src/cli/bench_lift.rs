@@ -11,7 +11,7 @@
 //! [`videomocap::eval::pose3d`], after the global refinement; then the per-frame solve's speed.
 
 use super::args::{BenchArgs, GlobalArgs};
-use super::bench_suite::{BenchClip, Tally, bench_clips};
+use super::bench_suite::{BenchClip, Merge, Tally, bench_clips};
 use super::bench_track::track_opened;
 use super::{ExitError, say};
 use std::sync::atomic::AtomicBool;
@@ -24,7 +24,7 @@ use videomocap::eval::suite::{CLICK_NOISE_PX, Split, clicked_marks};
 use videomocap::formats::{Marks, Tracks2d};
 use videomocap::lift::subject_fit::subject_from_height;
 use videomocap::lift::{LiftJob, LiftParams, lift, lift_per_frame};
-use videomocap::skeleton::DEFAULT_HEIGHT_M;
+use videomocap::skeleton::{Bone, DEFAULT_HEIGHT_M};
 use videomocap::synth::GroundTruth;
 use videomocap::track::TrackerParams;
 use videomocap::video::{OpenOptions, Video};
@@ -38,8 +38,40 @@ const FOCALS: [&str; 2] = ["true focal", "default 60°"];
 
 /// The lift's score and the cut-out's on the same input and camera.
 type Pair = (Pose3dScore, Pose3dScore);
-/// Every case of one clip: [input][lengths][focal].
-type Cases = [[[Pair; 2]; 2]; 3];
+/// Every case of one clip: [input][lengths][focal], and per input the bone lengths the lift
+/// ended with from the stated height and the true focal length.
+type Cases = ([[[Pair; 2]; 2]; 3], [LengthErrors; 3]);
+
+/// How far the bone lengths a lift ended with are from the reference's: |read ÷ true − 1| per
+/// bone and clip.
+#[derive(Debug, Clone, Default)]
+struct LengthErrors(Vec<f64>);
+
+impl Merge for LengthErrors {
+    fn merge_from(&mut self, other: &Self) {
+        self.0.extend_from_slice(&other.0);
+    }
+}
+
+impl LengthErrors {
+    /// The median error, as a share.
+    fn median(&self) -> f64 {
+        let mut v = self.0.clone();
+        v.sort_by(f64::total_cmp);
+        v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+    }
+}
+
+/// The side table's column: the lengths' median error and the share of frames mirrored.
+fn side_cell(errors: &LengthErrors, score: &Pose3dScore) -> String {
+    format!(
+        "{:>9.1}% {:>10.1}%",
+        100.0 * errors.median(),
+        100.0 * score.facing_mirrored_share()
+    )
+}
+const SIDE_COLUMNS: &str = " lengths   mirrored";
+const SIDE_WIDTH: usize = 21;
 
 /// One split's column: MPJPE, the cut-out's, their ratio, PA-MPJPE and the wrong depth roots.
 fn cell(p: &Pair) -> String {
@@ -54,6 +86,20 @@ fn cell(p: &Pair) -> String {
 }
 const COLUMNS: &str = " MPJPE    cut ratio     PA  roots";
 const WIDTH: usize = 33;
+
+/// |read ÷ true − 1| for each bone the reference measures (not the derived joints').
+fn length_errors(gt: &GroundTruth, read: &std::collections::BTreeMap<String, f64>) -> Vec<f64> {
+    let truth = subject_from_truth(gt);
+    let derived = gt.derived();
+    Bone::ALL
+        .iter()
+        .filter(|b| !derived.contains(&b.parent) && !derived.contains(&b.child))
+        .filter_map(|b| {
+            let r = read.get(&b.key())?;
+            Some((r / truth.bone_length(*b).max(1e-9) - 1.0).abs())
+        })
+        .collect()
+}
 
 /// Lifts one clip in every case; returns its cases and the per-frame solve's (frames, seconds)
 /// on (a) with true lengths and focal.
@@ -109,7 +155,12 @@ fn run_clip(
                 let out =
                     lift(&job, &mut |_| {}, &AtomicBool::new(false)).map_err(ExitError::failed)?;
                 let score = score_skeleton(&gt, &out.skeleton).map_err(ExitError::failed)?;
-                let case = &mut cases[*i][l][f];
+                if (l, f) == (1, 0) {
+                    cases.1[*i]
+                        .0
+                        .extend(length_errors(&gt, &out.skeleton.bone_lengths_m));
+                }
+                let case = &mut cases.0[*i][l][f];
                 case.0.merge(&score);
                 case.1.merge(&flat);
             }
@@ -140,7 +191,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         let (cases, n, s) = run_clip(clip, threads, &params)?;
         solve_frames += n;
         solve_s += s;
-        let (ex, tr) = (&cases[0][1][0], &cases[2][1][0]);
+        let (ex, tr) = (&cases.0[0][1][0], &cases.0[2][1][0]);
         per_clip.push(format!(
             "{:<26} {:<5} {:<11} {:>8.1} {:>8.1} {:>8.1} {:>8.1}",
             clip.name,
@@ -174,7 +225,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
                 let col = |split| {
                     tally
                         .get(split, None)
-                        .map_or_else(|| blank.clone(), |c| cell(&c[i][l][f]))
+                        .map_or_else(|| blank.clone(), |c| cell(&c.0[i][l][f]))
                 };
                 out.push(format!(
                     "{:<48} | {} | {}",
@@ -192,7 +243,17 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             INPUTS[i], LENGTHS[l], FOCALS[f]
         ));
         out.extend(Tally::<Pair>::heading(WIDTH, COLUMNS));
-        out.extend(tally.lines(WIDTH, |c: &Cases| cell(&c[i][l][f])));
+        out.extend(tally.lines(WIDTH, |c: &Cases| cell(&c.0[i][l][f])));
+    }
+    out.push(String::new());
+    out.push(
+        "stated height, true focal: the bone lengths the lift ended with (median |read ÷ true − 1| over bones and clips) and the frames with the body mirrored (shoulders in the wrong depth order, where they differ by over 5 cm)"
+            .to_owned(),
+    );
+    for (i, input) in INPUTS.iter().enumerate() {
+        out.push((*input).to_owned());
+        out.extend(Tally::<Cases>::heading(SIDE_WIDTH, SIDE_COLUMNS));
+        out.extend(tally.lines(SIDE_WIDTH, |c: &Cases| side_cell(&c.1[i], &c.0[i][1][0].0)));
     }
     out.push(String::new());
     out.extend(per_clip);
@@ -209,10 +270,12 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
                     cases_json.insert(
                         format!("{input}, {lengths}, {focal}"),
                         tally.json(|c| {
-                            let p = &c[i][l][f];
+                            let p = &c.0[i][l][f];
                             serde_json::json!({
                                 "mpjpe_mm": p.0.mpjpe_mm(), "pa_mpjpe_mm": p.0.pa_mpjpe_mm(),
                                 "cutout_mm": p.1.mpjpe_mm(), "wrong_roots": p.0.wrong_share(),
+                                "facing_mirrored": p.0.facing_mirrored_share(),
+                                "length_median_error": ((l, f) == (1, 0)).then(|| c.1[i].median()),
                             })
                         }),
                     );

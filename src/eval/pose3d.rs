@@ -44,7 +44,16 @@ pub struct Pose3dScore {
     pub limb_choices: usize,
     /// Of those, the wrong ones.
     pub limb_wrong: usize,
+    /// Frames whose reference shoulders differ in depth by more than [`FACING_DEPTH_M`], where
+    /// the body's facing shows.
+    pub facing_frames: usize,
+    /// Of those, the frames whose shoulders are in the other depth order: the body mirrored.
+    pub facing_mirrored: usize,
 }
+
+/// How far apart in depth the reference's shoulders must be for a frame's facing to count
+/// ([`Pose3dScore::facing_frames`]), metres.
+pub const FACING_DEPTH_M: f64 = 0.05;
 
 /// How close, as a share of the bone's length, the two roots' distances from the truth must be
 /// for a depth choice to be a coin flip ([`Pose3dScore::coin_flips`]); the same share as the
@@ -118,6 +127,14 @@ impl Pose3dScore {
         self.coin_flips_wrong += o.coin_flips_wrong;
         self.limb_choices += o.limb_choices;
         self.limb_wrong += o.limb_wrong;
+        self.facing_frames += o.facing_frames;
+        self.facing_mirrored += o.facing_mirrored;
+    }
+
+    /// The share of frames whose facing shows that have the body mirrored (shoulders in the
+    /// wrong depth order).
+    pub fn facing_mirrored_share(&self) -> f64 {
+        self.facing_mirrored as f64 / self.facing_frames.max(1) as f64
     }
     /// MPJPE after pelvis alignment, mm.
     pub fn mpjpe_mm(&self) -> f64 {
@@ -206,6 +223,12 @@ pub fn score_skeleton(gt: &GroundTruth, skeleton: &Skeleton3d) -> Result<Pose3dS
             .points3d();
         let p = &frame.points;
         let (pp, tp) = (p[Joint::Pelvis], truth[Joint::Pelvis]);
+        let depth_order =
+            |q: &PerJoint<Point3<f64>>| q[Joint::LeftShoulder].z - q[Joint::RightShoulder].z;
+        if depth_order(&truth).abs() > FACING_DEPTH_M {
+            s.facing_frames += 1;
+            s.facing_mirrored += usize::from(depth_order(p) * depth_order(&truth) < 0.0);
+        }
         for &j in &scored {
             s.sum_pelvis_m += ((p[j] - pp) - (truth[j] - tp)).norm();
         }
@@ -405,6 +428,88 @@ pub fn cutout(gt: &GroundTruth, tracks: &Tracks2d, camera: PinholeCamera) -> Ske
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A reference of `frames` (joints in camera space) seen by a 500 px camera.
+    fn reference(frames: &[PerJoint<Point3<f64>>]) -> (GroundTruth, PinholeCamera) {
+        let camera = PinholeCamera::centred(500.0, 640, 480);
+        let gt = GroundTruth {
+            source: "test".into(),
+            fps: 30.0,
+            width: 640,
+            height: 480,
+            focal_px: camera.focal_px,
+            cx: camera.cx,
+            cy: camera.cy,
+            joints: Joint::ALL.iter().map(|j| j.name().to_owned()).collect(),
+            derived_joints: vec![],
+            stated_height_m: Some(1.7),
+            bone_lengths_m: BTreeMap::new(),
+            frames: frames
+                .iter()
+                .enumerate()
+                .map(|(index, p)| crate::synth::GroundTruthFrame {
+                    index,
+                    points2d: p
+                        .0
+                        .iter()
+                        .map(|q| {
+                            let uv = camera.project(q).unwrap_or(Point2::origin());
+                            [uv.x, uv.y]
+                        })
+                        .collect(),
+                    points3d: p.0.iter().map(|q| [q.x, q.y, q.z]).collect(),
+                    visible: vec![true; 16],
+                })
+                .collect(),
+        };
+        (gt, camera)
+    }
+
+    /// A body 3 m away with its left shoulder 20 cm nearer the camera than its right.
+    fn turned_body() -> PerJoint<Point3<f64>> {
+        PerJoint::from_fn(|j| {
+            let k = j.index() as f64;
+            let z = match j {
+                Joint::LeftShoulder => 2.9,
+                Joint::RightShoulder => 3.1,
+                _ => 3.0 + 0.01 * k,
+            };
+            Point3::new(0.05 * k - 0.4, 0.1 * k - 0.8, z)
+        })
+    }
+
+    #[test]
+    fn a_mirrored_body_is_counted_and_the_cutout_keeps_only_the_depth_of_the_pelvis() {
+        let body = turned_body();
+        let (gt, camera) = reference(&[body, body]);
+        let mut mirrored = body;
+        mirrored[Joint::LeftShoulder].z = 3.1;
+        mirrored[Joint::RightShoulder].z = 2.9;
+        let skeleton = Skeleton3d {
+            camera,
+            fps: Some(30.0),
+            bone_lengths_m: BTreeMap::new(),
+            frames: [body, mirrored]
+                .iter()
+                .enumerate()
+                .map(|(index, p)| Frame3d {
+                    index,
+                    points: *p,
+                    flags: vec![],
+                })
+                .collect(),
+        };
+        let s = score_skeleton(&gt, &skeleton).unwrap();
+        assert_eq!((s.facing_frames, s.facing_mirrored), (2, 1));
+        assert!((s.facing_mirrored_share() - 0.5).abs() < 1e-12);
+        // The cut-out flattens every joint onto the pelvis's depth: off by the joints' own
+        // depths, nothing else.
+        let flat = cutout(&gt, &tracks_from_truth(&gt, 0.0, 1), camera);
+        let c = score_skeleton(&gt, &flat).unwrap();
+        assert!(c.mpjpe_mm() > 10.0 && c.mpjpe_mm() < 200.0, "{}", c.mpjpe_mm());
+        let p = &flat.frames[0].points;
+        assert!(Joint::ALL.iter().all(|&j| (p[j].z - body[Joint::Pelvis].z).abs() < 1e-9));
+    }
 
     #[test]
     fn a_root_choice_is_wrong_right_or_a_coin_flip() {
