@@ -65,13 +65,13 @@ impl LengthErrors {
 /// The side table's column: the lengths' median error and the share of frames mirrored.
 fn side_cell(errors: &LengthErrors, score: &Pose3dScore) -> String {
     format!(
-        "{:>9.1}% {:>10.1}%",
+        "{:>8.1}% {:>9.1}%",
         100.0 * errors.median(),
         100.0 * score.facing_mirrored_share()
     )
 }
-const SIDE_COLUMNS: &str = " lengths   mirrored";
-const SIDE_WIDTH: usize = 21;
+const SIDE_COLUMNS: &str = " lengths  mirrored";
+const SIDE_WIDTH: usize = 20;
 
 /// One split's column: MPJPE, the cut-out's, their ratio, PA-MPJPE and the wrong depth roots.
 fn cell(p: &Pair) -> String {

@@ -506,9 +506,17 @@ mod tests {
         // depths, nothing else.
         let flat = cutout(&gt, &tracks_from_truth(&gt, 0.0, 1), camera);
         let c = score_skeleton(&gt, &flat).unwrap();
-        assert!(c.mpjpe_mm() > 10.0 && c.mpjpe_mm() < 200.0, "{}", c.mpjpe_mm());
+        assert!(
+            c.mpjpe_mm() > 10.0 && c.mpjpe_mm() < 200.0,
+            "{}",
+            c.mpjpe_mm()
+        );
         let p = &flat.frames[0].points;
-        assert!(Joint::ALL.iter().all(|&j| (p[j].z - body[Joint::Pelvis].z).abs() < 1e-9));
+        assert!(
+            Joint::ALL
+                .iter()
+                .all(|&j| (p[j].z - body[Joint::Pelvis].z).abs() < 1e-9)
+        );
     }
 
     #[test]

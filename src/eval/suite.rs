@@ -291,7 +291,7 @@ fn clip_params(c: &ClipEntry, motion: MotionSource, root: &Path) -> Result<Synth
     };
     let body = BodyShape::drawn(c.seed, BODY_SPREAD);
     let stature = body.stature_m();
-    let mut params = SynthParams {
+    Ok(SynthParams {
         motion,
         frames: c.frames,
         fps: c.fps,
@@ -316,11 +316,7 @@ fn clip_params(c: &ClipEntry, motion: MotionSource, root: &Path) -> Result<Synth
         appearance: Appearance::drawn(clothes, c.loose, &bg, c.seed),
         distractor: c.distractor.then_some(c.seed.wrapping_add(1)),
         motion_blur: c.motion_blur,
-    };
-    if params.frames == 0 {
-        params.frames = 1;
-    }
-    Ok(params)
+    })
 }
 
 /// How a suite clip frames its subject, without rendering it.
