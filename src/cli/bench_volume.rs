@@ -14,8 +14,8 @@ use videomocap::eval::suite::Suite;
 use videomocap::eval::volume::{VolumeScore, carve_and_score, score_volume};
 use videomocap::skeleton::SubjectModel;
 use videomocap::synth::{
-    BodyShape, Motion, ProceduralMotion, SynthParams, VoxelParams, from_bvh, load_motion,
-    procedural, stature_of, volume_truth, voxelise,
+    Motion, ProceduralMotion, SynthParams, VoxelParams, from_bvh, load_motion, procedural,
+    stature_of, subject_stature, volume_truth, voxelise,
 };
 use videomocap::volume::{VolumeParams, assemble, process_frame};
 
@@ -131,10 +131,7 @@ fn suite_takes(
             ..clip.params.clone()
         };
         let motion = load_motion(&synth).map_err(ExitError::failed)?;
-        let stature = synth
-            .body
-            .as_ref()
-            .map_or_else(|| stature_of(&motion), BodyShape::stature_m);
+        let stature = subject_stature(&synth, &motion);
         let r = run_sequence(&clip.take, &motion, stature, VoxelParams::default(), params);
         let bench = BenchClip {
             name: clip.name.clone(),

@@ -358,7 +358,7 @@ pub fn load_motion(params: &SynthParams) -> Result<Motion, SynthError> {
 
 /// The subject's stature, sole to vertex: the body's when the clip has one, else the motion's
 /// ([`stature_of`]).
-fn subject_stature(params: &SynthParams, motion: &Motion) -> f64 {
+pub fn subject_stature(params: &SynthParams, motion: &Motion) -> f64 {
     params
         .body
         .as_ref()
@@ -372,8 +372,7 @@ fn distractor_frames(
     seed: u64,
     params: &SynthParams,
     target: &Vector3<f64>,
-    camera_from_world: &Matrix3<f64>,
-    centre: &Vector3<f64>,
+    placement: &Placement,
 ) -> (Vec<PerJoint<Point3<f64>>>, f64, Appearance) {
     let body = BodyShape::drawn(seed, 0.12);
     let fps = f64::from(params.fps);
@@ -391,9 +390,9 @@ fn distractor_frames(
             .try_normalize(1e-9)
             .unwrap_or_else(Vector3::z)
     };
-    let forward = horizontal(camera_from_world.row(2).transpose());
+    let forward = horizontal(placement.camera_from_world.row(2).transpose());
     let sign = if seed.is_multiple_of(2) { 1.0 } else { -1.0 };
-    let across = horizontal(camera_from_world.row(0).transpose()) * sign;
+    let across = horizontal(placement.camera_from_world.row(0).transpose()) * sign;
     let duration = params.frames as f64 / fps;
     let start = Vector3::new(target.x, 0.0, target.z) + forward * 2.5 - across * (0.6 * duration);
     // The walk goes along +Z: turn +Z onto `across`.
@@ -402,12 +401,7 @@ fn distractor_frames(
     let frames = walk
         .frames
         .iter()
-        .map(|p| {
-            p.map(|_, q| {
-                let world = start + turn * q.coords;
-                Point3::from(camera_from_world * (world - centre))
-            })
-        })
+        .map(|p| placement.to_camera(&p.map(|_, q| Point3::from(start + turn * q.coords))))
         .collect();
     let appearance = Appearance::drawn(Clothes::Print, false, &image::RgbImage::new(1, 1), seed);
     (frames, body.stature_m(), appearance)
@@ -444,15 +438,13 @@ pub fn render_clip(
             .to_rgb8(),
         None => background(params.width, params.height, params.background_seed),
     };
-    let distractor = params.distractor.map(|seed| {
-        distractor_frames(
-            seed,
-            params,
-            &mean_pelvis(&motion),
-            &camera_from_world,
-            &centre,
-        )
-    });
+    let placement = Placement {
+        camera_from_world,
+        centre,
+    };
+    let distractor = params
+        .distractor
+        .map(|seed| distractor_frames(seed, params, &mean_pelvis(&motion), &placement));
 
     let video_path = match params.output {
         VideoOutput::Mp4 => out_dir.join("video.mp4"),
@@ -464,10 +456,6 @@ pub fn render_clip(
     let mut render_s = 0.0;
     let total = motion.frames.len();
     let mut first_points2d = None;
-    let placement = Placement {
-        camera_from_world,
-        centre,
-    };
     let to_camera = |p: &PerJoint<Point3<f64>>| placement.to_camera(p);
     for (i, world) in motion.frames.iter().enumerate() {
         if cancel.load(Ordering::Relaxed) {
