@@ -298,12 +298,14 @@ pub struct SynthArgs {
 #[derive(Debug, Args)]
 pub struct BenchArgs {
     /// What to measure: all (decode and synth), decode, synth, track (tracking accuracy on
-    /// the synthetic suite and the real sample, and tracking speed; takes 6 to 13 minutes on
-    /// two cores), lift (3D accuracy from true, noisy and tracked 2D, focal estimate, speed),
-    /// correct (how the tracks improve as a simulated user fixes the first frame with a lost
-    /// joint, round by round), scrub (the desktop app's frame access on a long 1080p clip:
-    /// open time, random seeks, scrubbing, peak memory), or volume (the point-volume pipeline:
-    /// topology, joint error, labels, time per frame at 3k/10k/30k points).
+    /// suite v3's dev and test splits and the two real clips from clicked marks, beside the
+    /// fixed template and OpenCV's trackers when present, and tracking speed), lift (3D
+    /// accuracy from true, noisy and tracked 2D with true lengths or a stated height, beside
+    /// the flat cut-out; speed), correct (the tracks before and after a simulated user's
+    /// corrections, one per 25 frames), scrub (the desktop app's frame access on a long 1080p
+    /// clip: open time, random seeks, scrubbing, peak memory), or volume (the point-volume
+    /// pipeline: topology, joint error, labels, dev and test takes, time per frame at
+    /// 3k/10k/30k points). The suite renders once into --suite-dir (about 6 minutes).
     #[arg(default_value = "all")]
     pub what: String,
     /// Frames per measured clip (decode).
@@ -316,7 +318,7 @@ pub struct BenchArgs {
     /// at 30 fps; phone cameras write about one keyframe a second, 30).
     #[arg(long, default_value_t = 250)]
     pub gop: u32,
-    /// Where the synthetic tracking suite is rendered (once) and kept.
+    /// Where the benchmark suite is rendered (once) and kept.
     #[arg(long, default_value = "out/bench-suite")]
     pub suite_dir: PathBuf,
     /// Tracker settings as JSON for `bench track`.
