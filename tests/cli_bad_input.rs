@@ -239,6 +239,36 @@ fn lift_writes_a_skeleton_and_refuses_a_bad_focal_length() {
     assert_eq!(s.frames.len(), gt.frames.len());
     assert_eq!(s.camera.focal_px, 600.0);
     assert!(stderr.contains("lifted 60 frames"), "{stderr}");
+    // The lengths read are said, each with where it came from.
+    assert!(
+        stderr.contains("body lengths:") && stderr.contains("thigh"),
+        "{stderr}"
+    );
+    // Known lengths: an unknown bone names the file and the key; one the video contradicts
+    // names the part; a good one is kept.
+    let lengths = dir.path().join("lengths.json");
+    let ls = lengths.to_str().unwrap();
+    std::fs::write(&lengths, r#"{"left_thigh": 0.4}"#).unwrap();
+    assert_bad(
+        &["lift", tp, "-o", outs, "--lengths", ls],
+        &[ls, "unknown bone \"left_thigh\""],
+    );
+    std::fs::write(
+        &lengths,
+        r#"{"left_hip-left_knee": 0.2, "left_knee-left_ankle": 0.4, "shoulder_width": 0.36}"#,
+    )
+    .unwrap();
+    assert_bad(
+        &["lift", tp, "-o", outs, "--lengths", ls],
+        &["thigh", "shorter than the video shows"],
+    );
+    std::fs::write(&lengths, r#"{"left_hip-left_knee": 0.43}"#).unwrap();
+    let (code, stderr) = run(&["lift", tp, "-o", outs, "--lengths", ls]);
+    assert_eq!(code, 0, "{stderr}");
+    let s = videomocap::formats::Skeleton3d::load(&out).unwrap();
+    // Kept, but for the refinement's own slack on every length (1 %).
+    let thigh = s.bone_lengths_m["left_hip-left_knee"];
+    assert!((thigh / 0.43 - 1.0).abs() < 0.011, "{thigh}");
 
     // lift --bvh, then export of the same skeleton to every format.
     let bvh = dir.path().join("lifted.bvh");

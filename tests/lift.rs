@@ -7,7 +7,7 @@ use videomocap::camera::PinholeCamera;
 use videomocap::eval::pose3d::{
     key_triangle_flex_m, lift_on_reference_key, score_skeleton, tracks_from_truth,
 };
-use videomocap::formats::Tracks2d;
+use videomocap::formats::{KnownLengths, Tracks2d};
 use videomocap::lift::ambiguity::lift_order;
 use videomocap::lift::backproject::bone_roots;
 use videomocap::lift::calibrate::KeyTriangle;
@@ -183,10 +183,16 @@ fn exact_tracks_give_back_the_skeleton() {
             flagged += 1;
             continue;
         }
+        // Unflagged, a joint misses its ray by no more than the flag lets pass: 5 % of its
+        // bone's image length and half a pixel (exact tracks have no noise).
         for (j, p) in f.points.iter() {
-            let e =
-                (cam.project(p).unwrap() - nalgebra::Point2::from(g.points2d[j.index()])).norm();
-            assert!(e < 1e-6, "frame {} {j}: {e} px", f.index);
+            let image = |j: Joint| nalgebra::Point2::from(g.points2d[j.index()]);
+            let e = (cam.project(p).unwrap() - image(j)).norm();
+            let allowed = Bone::to(j).map_or(0.0, |b| {
+                let parent = f.points[b.parent];
+                0.05 * cam.focal_px * subject.bone_length(b) / parent.z
+            }) + 0.5;
+            assert!(e < allowed + 1e-6, "frame {} {j}: {e} px", f.index);
         }
     }
     // The roots are chosen without knowing the truth: this clip turns and swings its legs
@@ -241,6 +247,43 @@ fn with_the_true_roots_exact_tracks_give_back_every_joint() {
         }
         assert!(f.flags.is_empty());
     }
+}
+
+#[test]
+fn a_bone_is_flagged_too_long_only_where_its_image_is_beyond_noise_and_length_doubt() {
+    // Limbs 3 % short of the truth: every frame where one lies square to the camera has its
+    // image a little too long, which says nothing about the tracks.
+    let (gt, truth) = truth();
+    let mut short = truth.clone();
+    for b in Bone::ALL {
+        if ![Joint::Pelvis, Joint::Chest].contains(&b.parent) {
+            short.bone_length_m[b.index()] *= 0.97;
+        }
+    }
+    let mut tracks = tracks_from_truth(&gt, 0.0, 3);
+    let too_long = |tracks: &Tracks2d| {
+        let job = job_for(tracks, &short, LiftParams::default());
+        let per = lift_per_frame(&job).unwrap();
+        per.reports
+            .iter()
+            .flat_map(|r| {
+                r.flags.iter().filter_map(move |f| match f {
+                    videomocap::lift::FrameFlag::TooLong(b) => Some((r.index, *b)),
+                    _ => None,
+                })
+            })
+            .collect::<Vec<_>>()
+    };
+    let quiet = too_long(&tracks);
+    assert!(quiet.is_empty(), "{quiet:?}");
+    // A wrist the tracker threw 40 px off its forearm on one frame: named there.
+    let forearm = Bone::new(Joint::LeftElbow, Joint::LeftWrist);
+    let p = &mut tracks.frames[30].points[Joint::LeftWrist].pos;
+    let away =
+        (*p - nalgebra::Point2::from(gt.frames[30].points2d[Joint::LeftElbow.index()])).normalize();
+    *p += away * 40.0;
+    let flagged = too_long(&tracks);
+    assert!(flagged.contains(&(30, forearm)), "{flagged:?}");
 }
 
 #[test]
@@ -457,8 +500,14 @@ fn a_subject_fitted_to_the_tracks_beats_the_table_for_a_different_build() {
     built.bone_length_m[Bone::new(Joint::Chest, Joint::RightShoulder).index()] = side;
     let (gt, built) = truth_of(built);
     let tracks = tracks_from_truth(&gt, 0.0, 3);
-    let (fitted, fit) =
-        subject_from_height(table.height_m, &tracks, gt.camera(), &LiftParams::default()).unwrap();
+    let (fitted, fit) = subject_from_height(
+        table.height_m,
+        &tracks,
+        gt.camera(),
+        &LiftParams::default(),
+        &Default::default(),
+    )
+    .unwrap();
     let drop = fit.chest_drop.unwrap();
     assert!((drop.measured - 0.335).abs() < 0.01, "{drop:?}");
     let error = |subject: &SubjectModel| {
@@ -478,6 +527,59 @@ fn a_subject_fitted_to_the_tracks_beats_the_table_for_a_different_build() {
         with_fit < 0.5 * with_table && exact < with_fit,
         "table {with_table:.1} mm, read from the tracks {with_fit:.1} mm, true lengths {exact:.1} mm"
     );
+}
+
+#[test]
+fn lengths_the_user_gives_are_kept_and_scale_the_rest_and_a_wrong_one_is_named() {
+    // The table's subject, stated 12 % short: the lengths read from the clip come out short
+    // with it; given the true thighs, every other part is scaled by them instead.
+    let (gt, truth) = truth();
+    let tracks = tracks_from_truth(&gt, 0.0, 3);
+    let thigh = Bone::new(Joint::LeftHip, Joint::LeftKnee);
+    let shank = Bone::new(Joint::RightKnee, Joint::RightAnkle);
+    let read = |known: &KnownLengths| {
+        subject_from_height(
+            0.88 * truth.height_m,
+            &tracks,
+            gt.camera(),
+            &LiftParams::default(),
+            known,
+        )
+    };
+    let (from_height, fit) = read(&KnownLengths::default()).unwrap();
+    assert!(!fit.scale_from_given);
+    let mut known = KnownLengths::default();
+    known.bones.insert(thigh, truth.bone_length(thigh));
+    let (given, fit) = read(&known).unwrap();
+    assert!(fit.scale_from_given, "{fit}");
+    assert_eq!(given.bone_length(thigh), truth.bone_length(thigh));
+    // The shank no longer carries the height's error: read against the given thigh it is
+    // about 1 / 0.88 of the one read against the height (measured 1.087: the clip never
+    // shows its thighs quite square, so the given one is a little longer than the read one).
+    let ratio = given.bone_length(shank) / from_height.bone_length(shank);
+    assert!(
+        (1.06..1.2).contains(&ratio),
+        "shank given ÷ height {ratio:.3}"
+    );
+    assert!(
+        fit.to_string().contains("thigh") && fit.to_string().contains("given"),
+        "{fit}"
+    );
+    // A thigh given at 0.6 of what the video shows (with a true shank setting the scale).
+    let mut wrong = KnownLengths::default();
+    wrong.bones.insert(thigh, 0.6 * truth.bone_length(thigh));
+    wrong.bones.insert(shank, truth.bone_length(shank));
+    wrong.bones.insert(
+        Bone::new(Joint::LeftKnee, Joint::LeftAnkle),
+        truth.bone_length(shank),
+    );
+    wrong.shoulder_width_m = Some(truth.shoulder_width_m);
+    match read(&wrong) {
+        Err(e @ LiftError::LengthContradicted { name: "thigh", .. }) => {
+            assert!(e.to_string().contains("thigh"), "{e}");
+        }
+        other => panic!("expected the thigh named, got {other:?}"),
+    }
 }
 
 #[test]

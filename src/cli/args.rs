@@ -131,6 +131,11 @@ pub struct LiftOptions {
     /// Lift settings as JSON (see docs/formats.md; every field optional, defaults documented).
     #[arg(long)]
     pub lift_settings: Option<PathBuf>,
+    /// Bone lengths you know, metres, as JSON (`{"left_knee-left_ankle": 0.42, …}`, any subset;
+    /// see docs/formats.md): kept, and they set the scale of the lengths read from the
+    /// video instead of the height.
+    #[arg(long)]
+    pub lengths: Option<PathBuf>,
 }
 
 /// `lift`.
@@ -327,4 +332,12 @@ pub struct BenchArgs {
     /// Lift settings as JSON for `bench lift`.
     #[arg(long)]
     pub lift_settings: Option<PathBuf>,
+    /// Which clips `bench track`, `lift` and `correct` measure: all, dev (the synthetic dev
+    /// split and the real clips: the ones to tune on) or test (the synthetic test split).
+    #[arg(long, default_value = "all")]
+    pub split: String,
+    /// `bench lift` only: leave out input (c), the tracker's output (tracking is most of the
+    /// bench's time; for quick looks at the lift from true and noisy 2D).
+    #[arg(long)]
+    pub no_tracker: bool,
 }

@@ -130,7 +130,7 @@ fn cell(s: &[Accuracy; 3]) -> String {
 /// Runs the correction benchmark and prints its table.
 pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let (threads, params) = threads_and_settings(a)?;
-    let clips = bench_clips(&a.suite_dir, global)?;
+    let clips = bench_clips(&a.suite_dir, &a.split, global)?;
     let mut results = Vec::with_capacity(clips.len());
     let mut tally: Tally<[Accuracy; 3]> = Tally::default();
     for clip in &clips {

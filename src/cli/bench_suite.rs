@@ -26,7 +26,21 @@ pub fn root() -> &'static Path {
 }
 
 /// The suite's clips, rendered into `suite_dir` when missing, then the real clips.
-pub fn bench_clips(suite_dir: &Path, global: &GlobalArgs) -> Result<Vec<BenchClip>, ExitError> {
+pub fn bench_clips(
+    suite_dir: &Path,
+    split: &str,
+    global: &GlobalArgs,
+) -> Result<Vec<BenchClip>, ExitError> {
+    let wanted = match split {
+        "all" => None,
+        "dev" => Some(Split::Dev),
+        "test" => Some(Split::Test),
+        other => {
+            return Err(ExitError::bad_input(anyhow::anyhow!(
+                "--split {other}: expected all, dev or test"
+            )));
+        }
+    };
     let suite = Suite::load(root()).map_err(ExitError::failed)?;
     let dirs = suite
         .ensure_rendered(suite_dir, &mut |name| {
@@ -50,6 +64,7 @@ pub fn bench_clips(suite_dir: &Path, global: &GlobalArgs) -> Result<Vec<BenchCli
         split: Split::Dev,
         dir: root().join(dir),
     }));
+    out.retain(|c| wanted.is_none_or(|w| c.split == w));
     Ok(out)
 }
 

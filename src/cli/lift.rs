@@ -6,15 +6,16 @@ use anyhow::anyhow;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use videomocap::camera::PinholeCamera;
-use videomocap::formats::Tracks2d;
+use videomocap::formats::{KnownLengths, Tracks2d};
 use videomocap::lift::focal::{DEFAULT_FOV_LONG_SIDE_DEG, default_focal, estimate_focal};
 use videomocap::lift::subject_fit::fit_in_perspective;
 use videomocap::lift::{FrameFlag, LiftError, LiftJob, LiftOutput, LiftParams, lift};
 use videomocap::skeleton::{DEFAULT_HEIGHT_M, Proportions, SubjectModel};
 
-/// Checks the camera and subject options before any work, and reads the lift settings they
-/// name (the defaults without `--lift-settings`).
-pub fn check_options(o: &LiftOptions) -> Result<LiftParams, ExitError> {
+/// Checks the camera and subject options before any work, and reads the lift settings (the
+/// defaults without `--lift-settings`) and the known lengths (none without `--lengths`) they
+/// name.
+pub fn check_options(o: &LiftOptions) -> Result<(LiftParams, KnownLengths), ExitError> {
     if let Some(f) = o.focal_px
         && !(f.is_finite() && f > 0.0)
     {
@@ -36,10 +37,15 @@ pub fn check_options(o: &LiftOptions) -> Result<LiftParams, ExitError> {
             "--height-m must be a person's height in metres (0.3 to 3), got {h}"
         )));
     }
-    match &o.lift_settings {
-        Some(p) => load_settings(p),
-        None => Ok(LiftParams::default()),
-    }
+    let params = match &o.lift_settings {
+        Some(p) => load_settings(p)?,
+        None => LiftParams::default(),
+    };
+    let known = match &o.lengths {
+        Some(p) => KnownLengths::load(p).map_err(ExitError::bad_input)?,
+        None => KnownLengths::default(),
+    };
+    Ok((params, known))
 }
 
 /// Reads lift settings from a JSON file.
@@ -71,6 +77,7 @@ pub fn lift_with_progress(
     source: &Path,
     o: &LiftOptions,
     params: LiftParams,
+    known: &KnownLengths,
     global: &GlobalArgs,
 ) -> Result<LiftOutput, ExitError> {
     let table = SubjectModel::from_height(
@@ -114,7 +121,8 @@ pub fn lift_with_progress(
             ),
         );
     }
-    let (subject, fit) = fit_in_perspective(&table, tracks, camera, &params);
+    let (subject, fit) = fit_in_perspective(&table, tracks, camera, &params, known)
+        .map_err(|e| lift_error(source, e))?;
     say(global, &fit.to_string());
     let job = LiftJob {
         tracks,
@@ -176,9 +184,9 @@ pub fn report(out: &LiftOutput, global: &GlobalArgs) {
 
 /// `lift`.
 pub fn run(a: &LiftArgs, global: &GlobalArgs) -> Result<(), ExitError> {
-    let params = check_options(&a.options)?;
+    let (params, known) = check_options(&a.options)?;
     let tracks = Tracks2d::load(&a.tracks).map_err(ExitError::bad_input)?;
-    let out = lift_with_progress(&tracks, &a.tracks, &a.options, params, global)?;
+    let out = lift_with_progress(&tracks, &a.tracks, &a.options, params, &known, global)?;
     out.skeleton.save(&a.output).map_err(ExitError::failed)?;
     report(&out, global);
     say(global, &format!("wrote {}", a.output.display()));

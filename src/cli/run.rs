@@ -15,7 +15,7 @@ pub const TRC: &str = "motion.trc";
 
 /// `run`.
 pub fn run(a: &RunArgs, global: &GlobalArgs) -> Result<(), ExitError> {
-    let params = super::lift::check_options(&a.options)?;
+    let (params, known) = super::lift::check_options(&a.options)?;
     let (mut video, marks) = super::track::open_checked(&a.video, &a.marks)?;
     std::fs::create_dir_all(&a.out_dir)
         .map_err(|e| ExitError::failed(anyhow!("{}: cannot create: {e}", a.out_dir.display())))?;
@@ -34,7 +34,7 @@ pub fn run(a: &RunArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     write_tracks_csv(&out.tracks, &csv)?;
     say(global, &format!("wrote {}", csv.display()));
     let lifted =
-        super::lift::lift_with_progress(&out.tracks, &a.video, &a.options, params, global)?;
+        super::lift::lift_with_progress(&out.tracks, &a.video, &a.options, params, &known, global)?;
     let path = a.out_dir.join(SKELETON_JSON);
     lifted.skeleton.save(&path).map_err(ExitError::failed)?;
     super::lift::report(&lifted, global);

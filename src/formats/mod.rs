@@ -3,12 +3,14 @@
 
 mod atomic;
 mod error;
+mod lengths;
 mod marks;
 mod skeleton3d;
 mod tracks2d;
 
 pub use atomic::write_atomically;
 pub use error::FormatError;
+pub use lengths::{KnownLengths, LENGTH_RANGE_M, LENGTHS_FORMAT, SHOULDER_WIDTH_KEY, TapeLengths};
 pub use marks::{MARKS_FORMAT, Marks};
 pub use skeleton3d::{Frame3d, LOST_FLAG, OFF_FRAME_FLAG, SKELETON3D_FORMAT, Skeleton3d};
 pub use tracks2d::{

@@ -625,6 +625,7 @@ impl App {
                 tracks,
                 focal,
                 p.settings.height_m,
+                p.settings.lengths.known(),
                 p.settings.lift,
                 p.overrides.clone(),
                 ctx,
@@ -1301,6 +1302,19 @@ impl App {
             if let Some(fit) = &self.subject_fit {
                 ui.label(egui::RichText::new(fit).small().weak());
             }
+            ui.collapsing("Lengths you know", |ui| {
+                ui.label(egui::RichText::new("Measured on the person (joint centre to joint centre), each kept as given and setting the scale of the rest instead of the height.").small().weak());
+                egui::Grid::new("known lengths").num_columns(2).show(ui, |ui| {
+                    for (name, value) in settings.lengths.fields_mut() {
+                        let mut known = value.is_some();
+                        ui.checkbox(&mut known, name);
+                        let mut v = value.unwrap_or(0.3);
+                        ui.add_enabled(known, egui::DragValue::new(&mut v).range(0.05..=1.0).speed(0.005).suffix(" m"));
+                        *value = known.then_some(v);
+                        ui.end_row();
+                    }
+                });
+            });
             ui.collapsing("Tracker", |ui| {
                 let t = &mut settings.tracker;
                 let d = TrackerParams::default();

@@ -75,11 +75,13 @@ impl Job {
         Job::new("Tracking", rx, cancel)
     }
 
-    /// Lifts `tracks` to 3D on a worker thread with the project's lift settings `params`.
+    /// Lifts `tracks` to 3D on a worker thread with the project's lift settings `params` and
+    /// the lengths the user knows.
     pub fn lift(
         tracks: Arc<Tracks2d>,
         focal_px: f64,
         height_m: f64,
+        known: videomocap::formats::KnownLengths,
         params: LiftParams,
         overrides: DepthOverrides,
         ctx: egui::Context,
@@ -93,7 +95,7 @@ impl Job {
                 tracks.source.width,
                 tracks.source.height,
             );
-            let result = subject_from_height(height_m, &tracks, camera, &params)
+            let result = subject_from_height(height_m, &tracks, camera, &params, &known)
                 .map_err(|e| e.to_string())
                 .and_then(|(subject, fit)| {
                     let job = LiftJob {

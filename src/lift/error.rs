@@ -34,6 +34,14 @@ pub enum LiftError {
     CalibrationFailed { frame: usize },
     #[error(transparent)]
     Subject(#[from] ProportionsError),
+    #[error(
+        "the given {name} ({given_m:.3} m) is shorter than the video shows it ({seen_m:.3} m at the clip's scale): check the length, its unit and the bone's name"
+    )]
+    LengthContradicted {
+        name: &'static str,
+        given_m: f64,
+        seen_m: f64,
+    },
     #[error("cancelled")]
     Cancelled,
 }

@@ -395,9 +395,19 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
             .sum();
         let score = fit_score(miss, &resolved.group_costs);
         if best.as_ref().is_none_or(|b| score < b.0) {
+            let all_noise_px = median_noise_px(tracks, &Joint::ALL);
             for (t, report) in reports.iter_mut().enumerate() {
                 for (b, bone) in Bone::ALL.iter().enumerate() {
-                    if resolved.too_long[t][b] {
+                    if resolved.too_long[t][b]
+                        && too_long_beyond_noise(
+                            cam,
+                            &resolved.points[t],
+                            &images[t],
+                            *bone,
+                            job.subject.bone_length(*bone),
+                            all_noise_px,
+                        )
+                    {
                         report.flags.push(FrameFlag::TooLong(*bone));
                     }
                 }
@@ -416,6 +426,39 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
         calibration_frame,
         images,
     })
+}
+
+/// How many times the tracks' own white noise a bone's child must miss its image point before
+/// the bone is flagged too long ([`too_long_beyond_noise`]).
+pub const TOO_LONG_NOISE_TIMES: f64 = 3.0;
+
+/// The share of a bone's own image length its child may miss its image point by before the bone
+/// is flagged too long: the lengths read from the clip are uncertain by a few per cent (the
+/// median bone within 2–5 % on the benchmark), so a bone a little short of its image says
+/// nothing about the tracks.
+pub const TOO_LONG_LENGTH_SHARE: f64 = 0.05;
+
+/// Whether a bone whose image is longer than its length allows misses by more than the 2D
+/// noise and the length's own uncertainty explain: its child's image point lies farther from
+/// where the placed child projects than [`TOO_LONG_NOISE_TIMES`] the tracks' noise (`noise_px`)
+/// plus [`TOO_LONG_LENGTH_SHARE`] of the bone's image length, and half a pixel. Only such a
+/// bone is flagged, so the flag points at a tracking slip or a wrong length, not at the frames
+/// where a bone lies square to the camera.
+pub(crate) fn too_long_beyond_noise(
+    cam: &PinholeCamera,
+    points: &PerJoint<Point3<f64>>,
+    image: &PerJoint<Point2<f64>>,
+    bone: Bone,
+    length_m: f64,
+    noise_px: f64,
+) -> bool {
+    let Some(placed) = cam.project(&points[bone.child]) else {
+        return true;
+    };
+    let miss_px = (placed - image[bone.child]).norm();
+    let depth = points[bone.parent].z.max(1e-6);
+    let length_px = cam.focal_px * length_m / depth;
+    miss_px > TOO_LONG_NOISE_TIMES * noise_px + TOO_LONG_LENGTH_SHARE * length_px + 0.5
 }
 
 /// The least a part's cost counts as in [`fit_score`] (in the part's own unit: metres for the
@@ -663,8 +706,72 @@ fn skeleton(
     }
 }
 
-/// The whole lift: per frame, then (if enabled) the global refinement.
+/// Each frame's joints with every bone given back `lengths` along its direction, parents first
+/// (the lift solved uncertain bones shorter: [`SubjectModel::leaning`]).
+fn with_lengths(
+    points: &[PerJoint<Point3<f64>>],
+    lengths: &[f64; BONE_COUNT],
+) -> Vec<PerJoint<Point3<f64>>> {
+    points
+        .iter()
+        .map(|p| {
+            let mut out = *p;
+            // Bone::ALL lists every parent's bone before its children's.
+            for (b, &length) in Bone::ALL.iter().zip(lengths) {
+                let d = p[b.child] - p[b.parent];
+                let n = d.norm();
+                out.0[b.child.index()] = if n > 0.0 {
+                    out[b.parent] + d * (length / n)
+                } else {
+                    out[b.parent] + (p[b.child] - p[b.parent])
+                };
+            }
+            out
+        })
+        .collect()
+}
+
+/// The whole lift: per frame, then (if enabled) the global refinement. Bones with a length
+/// doubt ([`SubjectModel::length_doubt`]) are solved that much shorter, leaning towards lying
+/// square to their rays, and given back their lengths along the directions found.
 pub fn lift(
+    job: &LiftJob<'_>,
+    progress: &mut dyn FnMut(&LiftProgress),
+    cancel: &AtomicBool,
+) -> Result<LiftOutput, LiftError> {
+    let leaning = LiftJob {
+        subject: job.subject.leaning(),
+        ..job.clone()
+    };
+    let mut out = lift_leaning(&leaning, progress, cancel)?;
+    if job.subject.length_doubt.iter().any(|&d| d > 0.0) {
+        // The refined lengths, each over its doubt's share.
+        let full = |s: &Skeleton3d| -> [f64; BONE_COUNT] {
+            std::array::from_fn(|k| {
+                let b = Bone::ALL[k];
+                s.bone_lengths_m
+                    .get(&b.key())
+                    .copied()
+                    .unwrap_or(job.subject.bone_length(b))
+                    / (1.0 - job.subject.length_doubt[k]).max(1e-6)
+            })
+        };
+        for s in [&mut out.skeleton, &mut out.per_frame] {
+            let lengths = full(s);
+            let points: Vec<_> = s.frames.iter().map(|f| f.points).collect();
+            for (f, p) in s.frames.iter_mut().zip(with_lengths(&points, &lengths)) {
+                f.points = p;
+            }
+            for (b, l) in Bone::ALL.iter().zip(lengths) {
+                s.bone_lengths_m.insert(b.key(), l);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// [`lift`] on the subject as given.
+fn lift_leaning(
     job: &LiftJob<'_>,
     progress: &mut dyn FnMut(&LiftProgress),
     cancel: &AtomicBool,

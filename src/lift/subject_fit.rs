@@ -33,11 +33,12 @@
 //! Read from exact 2D on the suite with height-based lengths: 82.0 → 58.3 mm MPJPE; the real
 //! sample 209.9 → 106.0 mm (`docs/method.md` and `bench lift` have the rest).
 
+use super::LiftError;
 use super::smoothing::{adaptive_sigmas, smoothed_images};
 use super::solve::{LiftJob, LiftParams, lift_per_frame};
 use crate::camera::PinholeCamera;
-use crate::formats::{PointSource, Tracks2d};
-use crate::skeleton::{Bone, Joint, PerJoint, Proportions, ProportionsError, SubjectModel};
+use crate::formats::{KnownLengths, PointSource, Tracks2d};
+use crate::skeleton::{Bone, Joint, PerJoint, Proportions, SubjectModel};
 use nalgebra::{Point2, Point3};
 use std::fmt;
 
@@ -53,6 +54,25 @@ const MIN_CONFIDENCE: f32 = 0.5;
 
 /// The quantile of a limb's image length (over the trunk's) taken as its length.
 const LIMB_QUANTILE: f64 = 0.8;
+
+/// The quantile of a group's image length times depth taken as its length (its upper envelope
+/// over the clip, short of the few frames where noise or a slip makes it longer). On the
+/// benchmark's dev split from exact 2D and the stated height (with [`LENGTH_MARGIN`] 0): 0.8 /
+/// 0.9 / 0.95 / 1.0 gave 119.7 / 118.5 / 122.2 / 136.7 mm; with the margin 0.9 and 0.95 were
+/// within 3 mm, 0.95 ahead with 2 px noise (118.0 against 120.5).
+pub const ENVELOPE_QUANTILE: f64 = 0.95;
+
+/// The doubt ([`SubjectModel::length_doubt`]) of a length read from the clip: the lift solves
+/// the limbs and the head (every bone hung from a joint by one of its two depth roots) this
+/// share shorter than read, then gives them back their length along the direction found. The costs are lopsided: a bone modelled longer
+/// than it is tilts out of the image plane by √(L² − l²) to make up for it (5 % too long on a
+/// 0.45 m thigh square to the camera is 0.14 m of depth, and a wrong root doubles it), while one
+/// modelled shorter misses its image by the difference and stays square to its ray. So when a
+/// length is uncertain by a few per cent, the answer leans to the bone lying flat. On the dev
+/// split from exact 2D and the stated height (quantile 0.95): margin 0 / 3 / 5 / 8 / 11 %:
+/// 122.2 / 114.9 / 110.9 / 111.4 / 116.1 mm MPJPE; with 2 px noise 125.1 / 118.9 / 118.0 /
+/// 119.7 / 123.6 mm (the cut-out: 138.5 and 142.6).
+pub const LENGTH_MARGIN: f64 = 0.05;
 
 /// A limb's measured length is held within these factors of the table's.
 pub const LIMB_RANGE: (f64, f64) = (0.8, 1.2);
@@ -103,6 +123,45 @@ pub struct ChestDrop {
     pub frames: usize,
 }
 
+/// Where a length of the subject model came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LengthOrigin {
+    /// Read from the clip (its upper envelope over the frames, scaled).
+    Read,
+    /// The proportions table scaled to the height (the clip showed too little).
+    Table,
+    /// Read from the clip above [`LIMB_RANGE`] of the table, so held at the range's end.
+    Held,
+    /// The clip never showed it square (its envelope below [`LIMB_RANGE`] of the table): the
+    /// table's.
+    Unseen,
+    /// Given by the user (`--lengths`).
+    Given,
+}
+
+impl LengthOrigin {
+    fn word(self) -> &'static str {
+        match self {
+            LengthOrigin::Read => "read",
+            LengthOrigin::Table => "table",
+            LengthOrigin::Held => "held to the table's range",
+            LengthOrigin::Unseen => "table: never seen square",
+            LengthOrigin::Given => "given",
+        }
+    }
+}
+
+/// One part of the body as the lift will use it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PartLength {
+    /// What it is, in plain words ("upper arm", "shoulders apart").
+    pub name: &'static str,
+    /// Metres (for a pair of sides, each side's).
+    pub metres: f64,
+    /// Where it came from.
+    pub origin: LengthOrigin,
+}
+
 /// What was read from the tracks.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SubjectFit {
@@ -112,36 +171,35 @@ pub struct SubjectFit {
     pub limbs: Vec<(&'static str, f64)>,
     /// The factor applied to every length to keep the stature.
     pub stature_scale: f64,
+    /// The body's parts as the lift uses them (empty when only the first, trunk-relative
+    /// reading ran).
+    pub parts: Vec<PartLength>,
+    /// The scale came from lengths the user gave (else from the height).
+    pub scale_from_given: bool,
 }
 
 impl fmt::Display for SubjectFit {
-    /// One line for the user: what was read, against the table.
+    /// One line for the user: the lengths the lift uses, where each came from.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let mut parts = Vec::new();
-        if let Some(d) = self.chest_drop {
-            parts.push(format!(
-                "the chest {:.3} of the trunk below the shoulders ({} frames; the table has {:.3})",
-                d.measured, d.frames, d.model
-            ));
-        }
-        if !self.limbs.is_empty() {
-            let limbs: Vec<String> = self
-                .limbs
-                .iter()
-                .map(|(name, factor)| format!("{name} ×{factor:.2}"))
-                .collect();
-            parts.push(format!("against the table {}", limbs.join(", ")));
-        }
-        if parts.is_empty() {
+        if self.parts.is_empty() {
             return f.write_str(
-                "subject: the proportions table (the tracks showed too little to read more)",
+                "body: the proportions table scaled to the height (the video showed too little to read the lengths)",
             );
         }
+        let parts: Vec<String> = self
+            .parts
+            .iter()
+            .map(|p| format!("{} {:.2} m ({})", p.name, p.metres, p.origin.word()))
+            .collect();
         write!(
             f,
-            "subject read from the tracks: {}; then every length ×{:.3} to keep the height",
-            parts.join("; "),
-            self.stature_scale
+            "body lengths: {}; scaled to {}",
+            parts.join(", "),
+            if self.scale_from_given {
+                "the lengths you gave"
+            } else {
+                "the height"
+            }
         )
     }
 }
@@ -269,6 +327,73 @@ fn measure_limb(views: &[FrameView<'_>], bones: &[(Joint, Joint)]) -> Option<f64
     ratios.get(k).copied()
 }
 
+/// What a whole-clip reading measures: each bone group's (or breadth's) image length times the
+/// depth of the joint it hangs from, in a first lift, in one unit common to every group (the
+/// first lift's scale); the group's upper envelope over the clip is its length in that unit.
+/// Each group: its name, its joint pairs, and the joint whose depth scales its image.
+const GROUPS: [Group; 8] = {
+    use Joint::*;
+    [
+        ("trunk", &[(Pelvis, Neck)], Some(Pelvis)),
+        ("head", &[(Neck, HeadTop)], None),
+        (
+            "upper arm",
+            &[(LeftShoulder, LeftElbow), (RightShoulder, RightElbow)],
+            None,
+        ),
+        (
+            "forearm",
+            &[(LeftElbow, LeftWrist), (RightElbow, RightWrist)],
+            None,
+        ),
+        ("thigh", &[(LeftHip, LeftKnee), (RightHip, RightKnee)], None),
+        (
+            "shank",
+            &[(LeftKnee, LeftAnkle), (RightKnee, RightAnkle)],
+            None,
+        ),
+        (
+            "shoulders apart",
+            &[(LeftShoulder, RightShoulder)],
+            Some(Chest),
+        ),
+        ("hips apart", &[(LeftHip, RightHip)], Some(Pelvis)),
+    ]
+};
+
+/// A part of the body read from the clip: its name, its joint pairs, and the joint whose depth
+/// scales its image (`None`: each pair's first joint).
+type Group = (&'static str, &'static [(Joint, Joint)], Option<Joint>);
+
+/// The upper envelope (the [`ENVELOPE_QUANTILE`]) over the frames of a group's image length times
+/// its depth (see [`GROUPS`]); `None` without depths or with too few frames.
+fn measure_at_depth(
+    views: &[FrameView<'_>],
+    pairs: &[(Joint, Joint)],
+    depth_of: Option<Joint>,
+    quantile: f64,
+) -> Option<f64> {
+    let mut lengths: Vec<f64> = views
+        .iter()
+        .flat_map(|v| {
+            pairs.iter().filter_map(move |&(a, b)| {
+                // The depth of the bone's parent end (the trunk's depth for the trunk and
+                // the widths): on the dev split from exact 2D, 110.7 mm against 114.6 with
+                // the body's depth for every part (perspective: a near limb looks longer).
+                let z = v.depth?[depth_of.unwrap_or(a)].z;
+                (v.all_trusted(&[a, b]) && z.is_finite() && z > 0.0)
+                    .then(|| (v.points[b] - v.points[a]).norm() * z)
+            })
+        })
+        .collect();
+    if lengths.len() < MIN_LIMB_FRAMES * pairs.len() {
+        return None;
+    }
+    lengths.sort_by(f64::total_cmp);
+    let k = ((lengths.len() - 1) as f64 * quantile).round() as usize;
+    lengths.get(k).copied()
+}
+
 /// The subject with its key triangle's height and its limbs' lengths read from the tracks (see
 /// the module's text), and what was read; unchanged where nothing could be measured.
 pub fn fit_to_tracks(subject: &SubjectModel, tracks: &Tracks2d) -> (SubjectModel, SubjectFit) {
@@ -285,7 +410,8 @@ pub fn fit_in_perspective(
     tracks: &Tracks2d,
     camera: PinholeCamera,
     params: &LiftParams,
-) -> (SubjectModel, SubjectFit) {
+    known: &KnownLengths,
+) -> Result<(SubjectModel, SubjectFit), LiftError> {
     let images = smoothed_images(tracks, &adaptive_sigmas(tracks));
     let first = fit(subject, &views(tracks, &images, None));
     let job = LiftJob {
@@ -295,10 +421,14 @@ pub fn fit_in_perspective(
         params: *params,
         overrides: Default::default(),
     };
-    match lift_per_frame(&job) {
-        Ok(per) => fit(subject, &views(tracks, &images, Some(&per.resolved.points))),
+    let read = match lift_per_frame(&job) {
+        Ok(per) => {
+            let v = views(tracks, &images, Some(&per.resolved.points));
+            fit_at_depth(subject, &v, known)?.unwrap_or_else(|| fit(subject, &v))
+        }
         Err(_) => first,
-    }
+    };
+    Ok(read)
 }
 
 /// The fit on the tracks' views (see the module's text).
@@ -309,6 +439,8 @@ fn fit(subject: &SubjectModel, views: &[FrameView<'_>]) -> (SubjectModel, Subjec
         chest_drop: None,
         limbs: Vec::new(),
         stature_scale: 1.0,
+        parts: Vec::new(),
+        scale_from_given: false,
     };
     if !(trunk.is_finite() && trunk > 0.0) {
         return (out, fit);
@@ -350,7 +482,238 @@ fn fit(subject: &SubjectModel, views: &[FrameView<'_>]) -> (SubjectModel, Subjec
         out.shoulder_width_m *= scale;
         fit.stature_scale = scale;
     }
+    // Read or from the table, the limbs and the head are uncertain (see `fit_at_depth`).
+    for (k, b) in Bone::ALL.iter().enumerate() {
+        if ![Joint::Pelvis, Joint::Chest].contains(&b.parent) {
+            out.length_doubt[k] = LENGTH_MARGIN;
+        }
+    }
     (out, fit)
+}
+
+/// The bones each group of [`GROUPS`] sets (both sides), and the share of the group's length
+/// each takes (the trunk's two bones split as the table splits it, the hips' width in halves).
+fn group_bones(g: usize, subject: &SubjectModel) -> Vec<(Bone, f64)> {
+    use Joint::*;
+    let both = |a: [Joint; 2], b: [Joint; 2]| {
+        vec![(Bone::new(a[0], b[0]), 1.0), (Bone::new(a[1], b[1]), 1.0)]
+    };
+    match g {
+        0 => {
+            let (lower, upper) = (
+                subject.bone_length(Bone::new(Pelvis, Chest)),
+                subject.bone_length(Bone::new(Chest, Neck)),
+            );
+            let share = lower / (lower + upper).max(1e-9);
+            vec![
+                (Bone::new(Pelvis, Chest), share),
+                (Bone::new(Chest, Neck), 1.0 - share),
+            ]
+        }
+        1 => vec![(Bone::new(Neck, HeadTop), 1.0)],
+        2 => both([LeftShoulder, RightShoulder], [LeftElbow, RightElbow]),
+        3 => both([LeftElbow, RightElbow], [LeftWrist, RightWrist]),
+        4 => both([LeftHip, RightHip], [LeftKnee, RightKnee]),
+        5 => both([LeftKnee, RightKnee], [LeftAnkle, RightAnkle]),
+        7 => vec![
+            (Bone::new(Pelvis, LeftHip), 0.5),
+            (Bone::new(Pelvis, RightHip), 0.5),
+        ],
+        _ => Vec::new(),
+    }
+}
+
+/// The index of the shoulder width in [`GROUPS`].
+const SHOULDER_GROUP: usize = 6;
+
+/// A group's length in `subject` (the mean of its two sides).
+fn group_length(g: usize, subject: &SubjectModel) -> f64 {
+    if g == SHOULDER_GROUP {
+        return subject.shoulder_width_m;
+    }
+    let bones = group_bones(g, subject);
+    match g {
+        0 | 7 => bones.iter().map(|(b, _)| subject.bone_length(*b)).sum(),
+        _ => {
+            bones
+                .iter()
+                .map(|(b, _)| subject.bone_length(*b))
+                .sum::<f64>()
+                / bones.len() as f64
+        }
+    }
+}
+
+/// A group's length as the user gave it, when every bone of it (or, for a pair of sides, either
+/// side: their mean) is known.
+fn known_group(g: usize, subject: &SubjectModel, known: &KnownLengths) -> Option<f64> {
+    if g == SHOULDER_GROUP {
+        return known.shoulder_width_m;
+    }
+    let bones = group_bones(g, subject);
+    let given: Vec<f64> = bones
+        .iter()
+        .filter_map(|(b, _)| known.bones.get(b).copied())
+        .collect();
+    match g {
+        0 | 7 => (given.len() == bones.len()).then(|| given.iter().sum()),
+        _ => (!given.is_empty()).then(|| given.iter().sum::<f64>() / given.len() as f64),
+    }
+}
+
+/// The image may show a known bone this much longer than its given length (perspective, the
+/// envelope's slack, the tracks' noise) before the length is called contradicted.
+pub const CONTRADICTION_FACTOR: f64 = 1.25;
+
+/// The whole-clip reading (see [`GROUPS`]): every group's envelope length in the first lift's
+/// unit; the metric scale from the lengths the user knows (the median of known ÷ measured over
+/// the measured groups they give), else from the stature stack at the stated height; each
+/// group not given held within [`LIMB_RANGE`] of the table; the chest's drop as [`fit`] reads
+/// it; and the known lengths exactly. `Ok(None)` when a group of the stature stack could not
+/// be measured (and nothing known sets the scale).
+fn fit_at_depth(
+    subject: &SubjectModel,
+    views: &[FrameView<'_>],
+    known: &KnownLengths,
+) -> Result<Option<(SubjectModel, SubjectFit)>, LiftError> {
+    use Joint::*;
+    let quantile = ENVELOPE_QUANTILE;
+    let measured: Vec<Option<f64>> = GROUPS
+        .iter()
+        .map(|(_, pairs, depth)| measure_at_depth(views, pairs, *depth, quantile))
+        .collect();
+    let given: Vec<Option<f64>> = (0..GROUPS.len())
+        .map(|g| known_group(g, subject, known))
+        .collect();
+    let stack_m = stature_stack(subject);
+    // Metres per unit: from what the user knows, else from the height.
+    let mut ratios: Vec<f64> = measured
+        .iter()
+        .zip(&given)
+        .filter_map(|(m, k)| Some(k.as_ref()? / m.as_ref()?))
+        .collect();
+    ratios.sort_by(f64::total_cmp);
+    let from_known = ratios.get(ratios.len() / 2).copied();
+    let scale = match from_known {
+        Some(s) => s,
+        None => {
+            let Some(stack_units) = [5, 4, 0, 1]
+                .iter()
+                .map(|&g| measured[g])
+                .sum::<Option<f64>>()
+            else {
+                return Ok(None);
+            };
+            stack_m / stack_units
+        }
+    };
+    // A known length the image shows far longer than it can be.
+    for (g, (m, k)) in measured.iter().zip(&given).enumerate() {
+        if let (Some(m), Some(k)) = (m, k)
+            && scale * m > CONTRADICTION_FACTOR * k
+        {
+            return Err(LiftError::LengthContradicted {
+                name: GROUPS[g].0,
+                given_m: *k,
+                seen_m: scale * m,
+            });
+        }
+    }
+    let factor: Vec<f64> = (0..GROUPS.len())
+        .map(|g| {
+            let t = group_length(g, subject);
+            match (given[g], measured[g]) {
+                (Some(k), _) => k / t,
+                // Below the range the clip never showed the part square (a side view's
+                // shoulders): the table's, not the range's end.
+                (None, Some(m)) if scale * m / t < LIMB_RANGE.0 => 1.0,
+                (None, Some(m)) => (scale * m / t).min(LIMB_RANGE.1),
+                (None, None) => 1.0,
+            }
+        })
+        .collect();
+    let mut out = subject.clone();
+    for (g, f) in factor.iter().enumerate() {
+        for (b, _) in group_bones(g, subject) {
+            out.bone_length_m[b.index()] = subject.bone_length(b) * f;
+        }
+    }
+    out.shoulder_width_m = subject.shoulder_width_m * factor[SHOULDER_GROUP];
+    // The chest's drop as the tracks show it, on the new trunk and shoulder line.
+    let trunk = out.trunk_m();
+    let mut chest_drop = None;
+    let chest = |j| Bone::new(Chest, j).index();
+    if let (Some((h, x)), Some((drop, frames))) = (model_triangle(subject), measure_drop(views)) {
+        let model = h / subject.trunk_m();
+        let measured = drop.clamp(model / MAX_DROP_FACTOR, model * MAX_DROP_FACTOR);
+        let h_new = measured * trunk;
+        let w = out.shoulder_width_m;
+        let x = x * factor[SHOULDER_GROUP];
+        out.bone_length_m[chest(LeftShoulder)] = (h_new * h_new + (x - w / 2.0).powi(2)).sqrt();
+        out.bone_length_m[chest(RightShoulder)] = (h_new * h_new + (x + w / 2.0).powi(2)).sqrt();
+        chest_drop = Some(ChestDrop {
+            measured,
+            model,
+            frames,
+        });
+    } else {
+        for j in [LeftShoulder, RightShoulder] {
+            out.bone_length_m[chest(j)] *= factor[SHOULDER_GROUP];
+        }
+    }
+    // The height holds the stature stack unless the user's lengths set the scale.
+    let restack = if from_known.is_some() {
+        1.0
+    } else {
+        stack_m / stature_stack(&out)
+    };
+    // The bones hung by a depth root (the step after eq. 9) and read, not given, are as
+    // uncertain as the reading: the lift leans them towards lying square to their rays.
+    for (k, b) in Bone::ALL.iter().enumerate() {
+        if ![Pelvis, Chest].contains(&b.parent) && !known.bones.contains_key(b) {
+            out.length_doubt[k] = LENGTH_MARGIN;
+        }
+    }
+    out.bone_length_m.iter_mut().for_each(|l| *l *= restack);
+    out.shoulder_width_m *= restack;
+    for (b, &l) in &known.bones {
+        out.bone_length_m[b.index()] = l;
+    }
+    if let Some(w) = known.shoulder_width_m {
+        out.shoulder_width_m = w;
+    }
+    let limbs = GROUPS
+        .iter()
+        .zip(&factor)
+        .zip(&measured)
+        .filter(|(_, m)| m.is_some())
+        .map(|(((name, _, _), f), _)| (*name, *f))
+        .collect();
+    let parts = (0..GROUPS.len())
+        .map(|g| PartLength {
+            name: GROUPS[g].0,
+            metres: group_length(g, &out),
+            origin: match (given[g], measured[g]) {
+                (Some(_), _) => LengthOrigin::Given,
+                (None, None) => LengthOrigin::Table,
+                (None, Some(m)) if scale * m / group_length(g, subject) < LIMB_RANGE.0 => {
+                    LengthOrigin::Unseen
+                }
+                (None, Some(_)) if factor[g] >= LIMB_RANGE.1 - 1e-12 => LengthOrigin::Held,
+                (None, Some(_)) => LengthOrigin::Read,
+            },
+        })
+        .collect();
+    Ok(Some((
+        out,
+        SubjectFit {
+            chest_drop,
+            limbs,
+            stature_scale: restack,
+            parts,
+            scale_from_given: from_known.is_some(),
+        },
+    )))
 }
 
 /// What a user who knows only the subject's height gets: the proportions table scaled to the
@@ -361,9 +724,10 @@ pub fn subject_from_height(
     tracks: &Tracks2d,
     camera: PinholeCamera,
     params: &LiftParams,
-) -> Result<(SubjectModel, SubjectFit), ProportionsError> {
+    known: &KnownLengths,
+) -> Result<(SubjectModel, SubjectFit), LiftError> {
     let subject = SubjectModel::from_height(height_m, Proportions::default())?;
-    Ok(fit_in_perspective(&subject, tracks, camera, params))
+    fit_in_perspective(&subject, tracks, camera, params, known)
 }
 
 #[cfg(test)]
@@ -521,7 +885,15 @@ mod tests {
         };
         let upper = [Bone::new(Joint::LeftShoulder, Joint::LeftElbow)];
         let flat = fit_to_tracks(&table, &tracks).0;
-        let deep = fit_in_perspective(&table, &tracks, camera, &LiftParams::default()).0;
+        let deep = fit_in_perspective(
+            &table,
+            &tracks,
+            camera,
+            &LiftParams::default(),
+            &KnownLengths::default(),
+        )
+        .unwrap()
+        .0;
         // Measured: upper arms 1.034 flat, 1.001 in perspective; the worst bone 3.4 % flat,
         // 2.2 % in perspective (the forearms: their parent, the elbow, sat 12° out of the image
         // plane in the first lift, where the arms were 2 % too long).
@@ -538,6 +910,43 @@ mod tests {
     }
 
     #[test]
+    fn a_clip_too_short_to_read_says_so_and_a_side_view_keeps_the_tables_shoulders() {
+        let table = SubjectModel::default();
+        let camera = PinholeCamera::centred(800.0, 640, 480);
+        let read = |frames: &[(f64, f64)]| {
+            fit_in_perspective(
+                &table,
+                &tracks_of(&table, frames, 1.0),
+                camera,
+                &LiftParams::default(),
+                &KnownLengths::default(),
+            )
+            .unwrap()
+        };
+        // Five frames: too few for an envelope; the table, and the user is told.
+        let (short, fit) = read(&[(0.3, 0.0); 5]);
+        assert!(fit.parts.is_empty());
+        assert!(fit.to_string().contains("proportions table"), "{fit}");
+        assert_eq!(short.shoulder_width_m, table.shoulder_width_m);
+        // Thirty frames side-on: the shoulders are never seen apart, so their width is the
+        // table's (not a width read off a side view), and said so.
+        let side: Vec<(f64, f64)> = (0..30)
+            .map(|t| (std::f64::consts::FRAC_PI_2, 0.02 * t as f64))
+            .collect();
+        let (s, fit) = read(&side);
+        let shoulders = fit
+            .parts
+            .iter()
+            .find(|p| p.name == "shoulders apart")
+            .unwrap();
+        assert_eq!(shoulders.origin, LengthOrigin::Unseen, "{fit}");
+        assert!(
+            (s.shoulder_width_m / table.shoulder_width_m - 1.0).abs() < 0.05,
+            "{fit}"
+        );
+    }
+
+    #[test]
     fn untrusted_or_implausible_marks_leave_the_table_or_are_held_to_it() {
         let table = SubjectModel::default();
         // Weak points only: nothing is measured and the subject is unchanged.
@@ -545,7 +954,8 @@ mod tests {
         let weak = tracks_of(&build(0.33, 0.8), &frames, 0.2);
         let (same, fit) = fit_to_tracks(&table, &weak);
         assert!(fit.chest_drop.is_none() && fit.limbs.is_empty());
-        assert_eq!(same, table);
+        assert_eq!(same.bone_length_m, table.bone_length_m);
+        assert_eq!(same.shoulder_width_m, table.shoulder_width_m);
         // A chest marked level with the shoulders: held to the plausible range.
         let flat = tracks_of(&build(0.02, 1.0), &[(0.0, 0.0)], 1.0);
         let d = fit_to_tracks(&table, &flat).1.chest_drop.unwrap();

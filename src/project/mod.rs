@@ -8,7 +8,8 @@ mod history;
 pub use history::History;
 
 use crate::formats::{
-    FORMAT_VERSION, FormatError, Skeleton3d, Tracks2d, parse_json, read_text, write_atomically,
+    FORMAT_VERSION, FormatError, LENGTH_RANGE_M, Skeleton3d, TapeLengths, Tracks2d, parse_json,
+    read_text, write_atomically,
 };
 use crate::lift::{DepthOverrides, LiftParams, Root};
 use crate::skeleton::{Bone, Joint};
@@ -37,6 +38,8 @@ pub struct Settings {
     pub height_m: f64,
     /// Lift settings, as in the command line's `--lift-settings` file.
     pub lift: LiftParams,
+    /// Lengths the user measured on the subject (as the command line's `--lengths` file).
+    pub lengths: TapeLengths,
 }
 
 impl Default for Settings {
@@ -46,6 +49,7 @@ impl Default for Settings {
             focal_px: None,
             height_m: DEFAULT_HEIGHT_M,
             lift: LiftParams::default(),
+            lengths: TapeLengths::default(),
         }
     }
 }
@@ -156,6 +160,17 @@ impl Project {
             return Err(invalid(format!(
                 "settings.height_m must be between 0.5 and 2.8 m (got {height})"
             )));
+        }
+        let mut tape = raw.settings.lengths;
+        for (name, value) in tape.fields_mut() {
+            if let Some(v) = *value
+                && !(v.is_finite() && (LENGTH_RANGE_M.0..=LENGTH_RANGE_M.1).contains(&v))
+            {
+                return Err(invalid(format!(
+                    "settings.lengths: the {name} must be between {} and {} m (got {v})",
+                    LENGTH_RANGE_M.0, LENGTH_RANGE_M.1
+                )));
+            }
         }
         if let Some(f) = raw.settings.focal_px
             && !(f.is_finite() && f > 0.0)

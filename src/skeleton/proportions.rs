@@ -190,6 +190,11 @@ pub struct SubjectModel {
     pub bone_length_m: [f64; BONE_COUNT],
     /// Distance between the shoulder joints in metres.
     pub shoulder_width_m: f64,
+    /// How uncertain each bone's length is, as a share of it (0: known exactly). The lift leans
+    /// an uncertain bone towards lying square to its viewing ray: it solves with the bone this
+    /// share shorter and gives it back its length along the direction found
+    /// ([`SubjectModel::leaning`]).
+    pub length_doubt: [f64; BONE_COUNT],
     /// The proportions the lengths were scaled from (for breadths).
     pub proportions: Proportions,
 }
@@ -204,6 +209,7 @@ impl SubjectModel {
             height_m,
             bone_length_m: proportions.bone_fraction.map(|f| f * height_m),
             shoulder_width_m: proportions.shoulder_width_fraction * height_m,
+            length_doubt: [0.0; BONE_COUNT],
             proportions,
         })
     }
@@ -254,6 +260,17 @@ impl SubjectModel {
         self.proportions.breadth_fraction(part.breadth()) * self.height_m
     }
 
+    /// The subject the lift solves with: every bone shorter by its [`SubjectModel::length_doubt`]
+    /// (and no doubt left).
+    pub fn leaning(&self) -> SubjectModel {
+        let mut out = self.clone();
+        for (l, d) in out.bone_length_m.iter_mut().zip(&self.length_doubt) {
+            *l *= 1.0 - d;
+        }
+        out.length_doubt = [0.0; BONE_COUNT];
+        out
+    }
+
     /// Bone lengths keyed `"parent-child"`, as written in skeleton3d files.
     pub fn bone_lengths_by_key(&self) -> BTreeMap<String, f64> {
         Bone::ALL
@@ -271,6 +288,7 @@ impl Default for SubjectModel {
             height_m: DEFAULT_HEIGHT_M,
             bone_length_m: proportions.bone_fraction.map(|f| f * DEFAULT_HEIGHT_M),
             shoulder_width_m: proportions.shoulder_width_fraction * DEFAULT_HEIGHT_M,
+            length_doubt: [0.0; BONE_COUNT],
             proportions,
         }
     }
