@@ -128,7 +128,7 @@ pub struct App {
     /// and redo, which bring back an earlier skeleton, find its choices).
     choices: Vec<(Arc<Skeleton3d>, Vec<[Root; BONE_COUNT]>)>,
     /// What the last lift read of the subject from the tracks (shown under the height).
-    subject_fit: Option<String>,
+    subject_fit: Option<videomocap::lift::subject_fit::SubjectFit>,
     world: Option<WorldSkeleton>,
     playing: bool,
     play_time: f64,
@@ -1004,7 +1004,7 @@ impl App {
                     self.status = "Lift finished for an older edit; result dropped".to_owned();
                     return;
                 }
-                self.subject_fit = Some(fit.to_string());
+                self.subject_fit = Some(fit);
                 let skeleton = Arc::new(out.skeleton);
                 self.choices.push((skeleton.clone(), out.choices));
                 if self.choices.len() > 16 {
@@ -1298,18 +1298,29 @@ impl App {
             .on_hover_text(format!("Focal length in pixels; default {default_f:.0} px"));
             settings.focal_px = given.then_some(f);
             ui.add(egui::Slider::new(&mut settings.height_m, 1.0..=2.3).text("subject height (m)"))
-                .on_hover_text("The subject's stature: scales every bone length (default 1.70 m). The 3D skeleton's size and depth follow it. The chest's place below the shoulders and the limbs' lengths are then read from the tracks.");
+                .on_hover_text("The subject's stature (default 1.70 m): every length is read from the video and this fixes their overall scale, so the 3D skeleton's size and depth follow it. Lengths you know (below) set the scale instead.");
             if let Some(fit) = &self.subject_fit {
-                ui.label(egui::RichText::new(fit).small().weak());
+                ui.label(egui::RichText::new(fit.to_string()).small().weak());
             }
+            let read = |name: &str| {
+                self.subject_fit
+                    .as_ref()
+                    .and_then(|f| f.parts.iter().find(|p| p.name == name))
+                    .map(|p| p.metres)
+            };
             ui.collapsing("Lengths you know", |ui| {
                 ui.label(egui::RichText::new("Measured on the person (joint centre to joint centre), each kept as given and setting the scale of the rest instead of the height.").small().weak());
                 egui::Grid::new("known lengths").num_columns(2).show(ui, |ui| {
                     for (name, value) in settings.lengths.fields_mut() {
                         let mut known = value.is_some();
                         ui.checkbox(&mut known, name);
-                        let mut v = value.unwrap_or(0.3);
-                        ui.add_enabled(known, egui::DragValue::new(&mut v).range(0.05..=1.0).speed(0.005).suffix(" m"));
+                        // Ticked, a part starts at what the last lift read.
+                        let mut v = value.or_else(|| read(name)).unwrap_or(0.3);
+                        if known {
+                            ui.add(egui::DragValue::new(&mut v).range(0.05..=1.0).speed(0.005).suffix(" m"));
+                        } else {
+                            ui.label(egui::RichText::new(read(name).map_or_else(|| "not read yet".to_owned(), |m| format!("read {m:.3} m"))).weak());
+                        }
                         *value = known.then_some(v);
                         ui.end_row();
                     }
@@ -2042,12 +2053,13 @@ mod tests {
                 .len(),
             60
         );
-        // The Parameters panel says what the lift read of the subject from the tracks.
+        // The Parameters panel says what lengths the lift used and where each came from.
         h.step();
         assert!(
-            h.query_by_label_contains("subject read from the tracks: the chest")
-                .is_some(),
-            "no subject line under the height"
+            h.query_by_label_contains("body lengths: trunk").is_some()
+                || h.query_by_label_contains("body: the proportions table")
+                    .is_some(),
+            "no lengths line under the height"
         );
 
         // Scrub.
@@ -2357,6 +2369,26 @@ mod tests {
         h.run();
         assert!(!h.state().project().unwrap().settings.tracker.chain_refine);
         assert!(disabled(&h));
+    }
+
+    /// A length ticked as known in the Parameters panel goes into the project's settings (and
+    /// from there to the lift), and unticked leaves it again.
+    #[test]
+    fn a_known_length_is_ticked_into_the_project() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut h = with_project(dir.path());
+        h.get_by_label("Lengths you know").click();
+        h.run();
+        assert_eq!(h.state().project().unwrap().settings.lengths.thigh, None);
+        h.get_by_label("thigh").click();
+        h.run();
+        let thigh = h.state().project().unwrap().settings.lengths.thigh;
+        assert!(thigh.is_some_and(|t| t > 0.0), "{thigh:?}");
+        let known = h.state().project().unwrap().settings.lengths.known();
+        assert_eq!(known.bones.len(), 2);
+        h.get_by_label("thigh").click();
+        h.run();
+        assert_eq!(h.state().project().unwrap().settings.lengths.thigh, None);
     }
 
     /// A slider drag changes the settings many times but is one undo step.

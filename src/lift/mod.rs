@@ -4,13 +4,15 @@
 //! Each joint's 2D track is first smoothed by the width its own noise calls for ([`smoothing`]).
 //! The key triangle (both shoulders and the chest) calibrates the camera on the best frame
 //! ([`calibrate`], eqs. 6–9) and is carried to the other frames by its constant side lengths
-//! ([`propagate`], eqs. 10–11), and its path is refitted over the whole clip ([`key_path`]);
+//! ([`propagate`], eqs. 10–11), its path is refitted over the whole clip ([`key_path`]), and
+//! each stretch where both facings fit takes the one that explains the whole clip better;
 //! every other joint is placed on its viewing ray at its bone's
 //! length from its parent ([`backproject`]); the two roots of each bone are chosen over the
 //! whole sequence ([`ambiguity`]); a global least-squares pass ([`refine`]) then adjusts all
 //! frames and the bone lengths together. [`focal`] estimates an unknown focal length;
-//! [`subject_fit`] fits the key triangle and the limbs to the tracks when only the subject's
-//! height is known.
+//! [`subject_fit`] reads every length from the whole clip when only the subject's height (or
+//! some lengths) are known, and marks read lengths as uncertain: the lift solves those bones
+//! shorter, leaning towards lying square to their rays, and gives their lengths back after.
 //! Its input is [`crate::formats::Tracks2d`], its output [`crate::formats::Skeleton3d`].
 
 pub mod ambiguity;

@@ -351,6 +351,24 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
                 fps,
             );
         }
+        // The facing decided stretch by stretch over the whole clip (see `facing_by_segments`).
+        {
+            let evaluate = |key: &[[Point3<f64>; 3]]| {
+                let resolved = resolve(
+                    key,
+                    &rays,
+                    &frame_index,
+                    &job.subject,
+                    &job.params.ambiguity,
+                    &job.overrides,
+                );
+                let miss: f64 = (0..n)
+                    .map(|t| miss_m(cam, &resolved.points[t], &images[t]))
+                    .sum();
+                fit_score(miss, &resolved.group_costs)
+            };
+            key = facing_by_segments(key, &per_frame, evaluate);
+        }
         let mut reports: Vec<FrameReport> = tracks
             .frames
             .iter()
@@ -578,6 +596,81 @@ fn key_candidates(
         return (out, false);
     }
     (out, converged)
+}
+
+/// The shoulders' depth difference (left minus right), metres: which way the body faces.
+fn facing_m(k: &[Point3<f64>; 3]) -> f64 {
+    k[0].z - k[1].z
+}
+
+/// A facing shows when the shoulders' depths differ by more than this, metres.
+const FACING_SHOWS_M: f64 = 0.05;
+
+/// The key path with each stretch of frames where the other facing also fits (a candidate pose
+/// of the frame with the shoulders in the other depth order) turned to it when that explains the
+/// whole clip better (`score`, lower is better: [`fit_score`] of the body built on the path).
+/// A turn through side-on splits the clip into such stretches, and each is decided by all its
+/// frames' evidence rather than by the chain's smoothness at the crossing.
+fn facing_by_segments(
+    mut key: Vec<[Point3<f64>; 3]>,
+    candidates: &[(Vec<[Point3<f64>; 3]>, bool)],
+    score: impl Fn(&[[Point3<f64>; 3]]) -> f64,
+) -> Vec<[Point3<f64>; 3]> {
+    let n = key.len();
+    // Each frame's other facing, when one fits: the candidate most like the chosen pose among
+    // those facing the other way.
+    let other: Vec<Option<[Point3<f64>; 3]>> = (0..n)
+        .map(|t| {
+            let f = facing_m(&key[t]);
+            if f.abs() < FACING_SHOWS_M {
+                return None;
+            }
+            candidates[t]
+                .0
+                .iter()
+                .filter(|c| facing_m(c) * f < 0.0 && facing_m(c).abs() >= FACING_SHOWS_M)
+                .min_by(|a, b| {
+                    let d = |c: &[Point3<f64>; 3]| {
+                        (0..3).map(|i| (c[i] - key[t][i]).norm()).sum::<f64>()
+                    };
+                    d(a).total_cmp(&d(b))
+                })
+                .copied()
+        })
+        .collect();
+    let mut segments = Vec::new();
+    let mut t = 0;
+    while t < n {
+        if other[t].is_some() {
+            let start = t;
+            while t < n && other[t].is_some() {
+                t += 1;
+            }
+            segments.push(start..t);
+        } else {
+            t += 1;
+        }
+    }
+    // Longest first; at most a handful, each one more whole-clip solve.
+    segments.sort_by_key(|s| std::cmp::Reverse(s.len()));
+    let mut best = score(&key);
+    for s in segments.into_iter().take(8) {
+        if s.len() < 3 {
+            continue;
+        }
+        let mut trial = key.clone();
+        for t in s.clone() {
+            if let Some(o) = other[t] {
+                trial[t] = o;
+            }
+        }
+        let v = score(&trial);
+        if v < best {
+            best = v;
+            key = trial;
+        }
+    }
+    key
 }
 
 /// Squared acceleration of the key joints over three frames.
@@ -873,6 +966,63 @@ mod tests {
         assert!((fit_score(right.0, &r) - fit_score(wrong.0, &w) - d).abs() < 1e-9);
         // A part that fits exactly counts at the floor, not as minus infinity.
         assert!(fit_score(0.0, &[0.0; GROUP_COUNT]).is_finite());
+    }
+
+    #[test]
+    fn each_stretch_takes_the_facing_that_explains_the_clip_better() {
+        // Twelve frames; on each the pose turned one way (+) and the other (−) both fit, except
+        // frames 4 and 8, side-on, where only one does. The chain took + everywhere; the
+        // truth is − on frames 5–7 only.
+        let pose = |facing: f64| {
+            [
+                Point3::new(0.18, 0.0, 3.0 + facing),
+                Point3::new(-0.18, 0.0, 3.0 - facing),
+                Point3::new(0.0, 0.15, 3.0),
+            ]
+        };
+        let candidates: Vec<(Vec<[Point3<f64>; 3]>, bool)> = (0..12)
+            .map(|t| {
+                if t == 4 || t == 8 {
+                    (vec![pose(0.0)], true)
+                } else {
+                    (vec![pose(0.1), pose(-0.1)], true)
+                }
+            })
+            .collect();
+        let chain: Vec<_> = (0..12)
+            .map(|t| {
+                if t == 4 || t == 8 {
+                    pose(0.0)
+                } else {
+                    pose(0.1)
+                }
+            })
+            .collect();
+        let truth = |t: usize| {
+            if (5..8).contains(&t) {
+                -0.1
+            } else if t == 4 || t == 8 {
+                0.0
+            } else {
+                0.1
+            }
+        };
+        // The score: how far each frame's facing is from the truth's.
+        let score = |key: &[[Point3<f64>; 3]]| {
+            key.iter()
+                .enumerate()
+                .map(|(t, k)| (facing_m(k) / 2.0 - truth(t)).abs())
+                .sum::<f64>()
+        };
+        let out = facing_by_segments(chain.clone(), &candidates, score);
+        for (t, k) in out.iter().enumerate() {
+            assert!((facing_m(k) / 2.0 - truth(t)).abs() < 1e-12, "frame {t}");
+        }
+        // A score that prefers the chain leaves it alone.
+        let keep = facing_by_segments(chain.clone(), &candidates, |k| {
+            k.iter().map(|k| -facing_m(k)).sum::<f64>()
+        });
+        assert_eq!(keep, chain);
     }
 
     #[test]
