@@ -351,24 +351,24 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
                 fps,
             );
         }
+        // The whole body built on a key path, and how well it explains the clip.
+        let build = |key: &[[Point3<f64>; 3]]| {
+            let resolved = resolve(
+                key,
+                &rays,
+                &frame_index,
+                &job.subject,
+                &job.params.ambiguity,
+                &job.overrides,
+            );
+            let miss: f64 = (0..n)
+                .map(|t| miss_m(cam, &resolved.points[t], &images[t]))
+                .sum();
+            let score = fit_score(miss, &resolved.group_costs);
+            (resolved, score)
+        };
         // The facing decided stretch by stretch over the whole clip (see `facing_by_segments`).
-        {
-            let evaluate = |key: &[[Point3<f64>; 3]]| {
-                let resolved = resolve(
-                    key,
-                    &rays,
-                    &frame_index,
-                    &job.subject,
-                    &job.params.ambiguity,
-                    &job.overrides,
-                );
-                let miss: f64 = (0..n)
-                    .map(|t| miss_m(cam, &resolved.points[t], &images[t]))
-                    .sum();
-                fit_score(miss, &resolved.group_costs)
-            };
-            key = facing_by_segments(key, &per_frame, evaluate);
-        }
+        key = facing_by_segments(key, &per_frame, |k| build(k).1);
         let mut reports: Vec<FrameReport> = tracks
             .frames
             .iter()
@@ -400,18 +400,7 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
                     .collect(),
             })
             .collect();
-        let resolved = resolve(
-            &key,
-            &rays,
-            &frame_index,
-            &job.subject,
-            &job.params.ambiguity,
-            &job.overrides,
-        );
-        let miss: f64 = (0..n)
-            .map(|t| miss_m(cam, &resolved.points[t], &images[t]))
-            .sum();
-        let score = fit_score(miss, &resolved.group_costs);
+        let (resolved, score) = build(&key);
         if best.as_ref().is_none_or(|b| score < b.0) {
             let all_noise_px = median_noise_px(tracks, &Joint::ALL);
             for (t, report) in reports.iter_mut().enumerate() {
