@@ -788,29 +788,18 @@ fn skeleton(
     }
 }
 
-/// Each frame's joints with every bone given back `lengths` along its direction, parents first
+/// One frame's joints with every bone given back `lengths` along its direction, parents first
 /// (the lift solved uncertain bones shorter: [`SubjectModel::leaning`]).
-fn with_lengths(
-    points: &[PerJoint<Point3<f64>>],
-    lengths: &[f64; BONE_COUNT],
-) -> Vec<PerJoint<Point3<f64>>> {
-    points
-        .iter()
-        .map(|p| {
-            let mut out = *p;
-            // Bone::ALL lists every parent's bone before its children's.
-            for (b, &length) in Bone::ALL.iter().zip(lengths) {
-                let d = p[b.child] - p[b.parent];
-                let n = d.norm();
-                out.0[b.child.index()] = if n > 0.0 {
-                    out[b.parent] + d * (length / n)
-                } else {
-                    out[b.parent] + (p[b.child] - p[b.parent])
-                };
-            }
-            out
-        })
-        .collect()
+fn with_lengths(p: &PerJoint<Point3<f64>>, lengths: &[f64; BONE_COUNT]) -> PerJoint<Point3<f64>> {
+    let mut out = *p;
+    // Bone::ALL lists every parent's bone before its children's.
+    for (b, &length) in Bone::ALL.iter().zip(lengths) {
+        // A bone of no length (child on its parent) keeps its child there.
+        let d = p[b.child] - p[b.parent];
+        let n = d.norm();
+        out.0[b.child.index()] = out[b.parent] + if n > 0.0 { d * (length / n) } else { d };
+    }
+    out
 }
 
 /// The whole lift: per frame, then (if enabled) the global refinement. Bones with a length
@@ -840,9 +829,8 @@ pub fn lift(
         };
         for s in [&mut out.skeleton, &mut out.per_frame] {
             let lengths = full(s);
-            let points: Vec<_> = s.frames.iter().map(|f| f.points).collect();
-            for (f, p) in s.frames.iter_mut().zip(with_lengths(&points, &lengths)) {
-                f.points = p;
+            for f in &mut s.frames {
+                f.points = with_lengths(&f.points, &lengths);
             }
             for (b, l) in Bone::ALL.iter().zip(lengths) {
                 s.bone_lengths_m.insert(b.key(), l);

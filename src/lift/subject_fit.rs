@@ -1,37 +1,27 @@
-//! Beyond the paper: the subject model fitted to the tracks when only the height is known.
+//! Beyond the paper: the subject's lengths read from the tracks when only the height (or some
+//! lengths) are known.
 //!
 //! Eqs. 6–11 need the key triangle's shape (both shoulders and the chest) in metres, and every
-//! limb's depth follows from its bone length. From the subject's height alone both come from
-//! the proportions table, and the lift is very sensitive to them: a key triangle seen nearly
-//! face on turns by several degrees for a 1 % error in a side, and every limb hangs from it.
-//! Two things the image shows well are read from it instead; both are ratios to the trunk (neck
-//! to pelvis) in the same frame, so the scale comes from the height as before.
+//! limb's depth follows from its bone length; the lift is very sensitive to both (a key
+//! triangle seen nearly face on turns by several degrees for a 1 % error in a side).
 //!
-//! - **The chest's drop** below the shoulder line: the chest's distance below the midpoint of
-//!   the shoulders, measured along the image trunk, over the trunk's image length. Turning about
-//!   the vertical foreshortens neither; leaning towards the camera foreshortens both alike. The
-//!   median over the frames. The table has 0.255; the real sample's reference 0.335 and the CMU
-//!   subjects of the synthetic suite 0.29–0.31 (where the shoulder joints sit is a matter of
-//!   definition as much as of build), and the median read them within 0.016 on every clip,
-//!   side views included.
-//! - **The limbs and the head**: a bone's image is never longer than the bone (but for
-//!   perspective), and most motions bring each limb square to the camera now and then, so
-//!   the 0.8 quantile over the frames of its image length over the trunk's, both sides of the
-//!   body pooled, measures it; held within [`LIMB_RANGE`] of the table, whose lengths are right
-//!   for most people (a limb that is never seen square would otherwise come out short).
-//!   Perspective makes a limb nearer the camera than the trunk look longer: in a side view the
-//!   near arm and leg are a shoulder's half-width nearer, several per cent at a few metres, and
-//!   the quantile picks them. When the camera is known ([`fit_in_perspective`]) a first lift
-//!   gives each frame's depths and every image length is scaled by its bone's parent depth
-//!   over the trunk's before the quantile.
+//! - **A first reading** ([`fit_to_tracks`]), with no depths: the chest's drop below the
+//!   shoulder line (its image distance along the trunk over the trunk's image length, the
+//!   median over the frames: turning about the vertical foreshortens neither) and each limb's
+//!   0.8 quantile of image length over the trunk's, held within [`LIMB_RANGE`] of the table,
+//!   then scaled back to the height. It sets up the first lift, and stands when the clip is
+//!   too short for the whole-clip reading.
+//! - **The whole-clip reading** ([`fit_in_perspective`]): a first lift gives every frame's
+//!   depths, and each part ([`GROUPS`]: trunk, head, limbs, both widths) is the
+//!   [`ENVELOPE_QUANTILE`] over the clip of its image length times its parent's depth. A bone's
+//!   image is never longer than the bone, and most motions bring each part square to the
+//!   camera now and then, so this upper envelope measures every part in one unit; one scale
+//!   makes the stature stack the height's, or comes from the lengths the user gave
+//!   ([`KnownLengths`]). A part whose envelope stays under [`LIMB_RANGE`] of the table was never
+//!   seen square and keeps the table's. Read lengths carry a doubt of [`LENGTH_MARGIN`]
+//!   ([`SubjectModel::length_doubt`]).
 //!
-//! Then every length is scaled so that the stature stack (shank, thigh, spine, neck, head) is
-//! the table's for the height again: the height is the user's measurement. The shoulder and hip
-//! widths are not read (only scaled with the rest): they vanish in a side view, and the shoulder
-//! width read like the limbs raised the suite's error from height, 58.3 → 70 mm.
-//!
-//! Read from exact 2D on the suite with height-based lengths: 82.0 → 58.3 mm MPJPE; the real
-//! sample 209.9 → 106.0 mm (`docs/method.md` and `bench lift` have the rest).
+//! `docs/method.md` ("3D reconstruction") and `bench lift` have the figures.
 
 use super::LiftError;
 use super::smoothing::{adaptive_sigmas, smoothed_images};
@@ -64,9 +54,9 @@ pub const ENVELOPE_QUANTILE: f64 = 0.95;
 
 /// The doubt ([`SubjectModel::length_doubt`]) of a length read from the clip: the lift solves
 /// the limbs and the head (every bone hung from a joint by one of its two depth roots) this
-/// share shorter than read, then gives them back their length along the direction found. The costs are lopsided: a bone modelled longer
-/// than it is tilts out of the image plane by √(L² − l²) to make up for it (5 % too long on a
-/// 0.45 m thigh square to the camera is 0.14 m of depth, and a wrong root doubles it), while one
+/// share shorter than read, then gives them back their length along the direction found. The
+/// costs are lopsided: a bone modelled longer than it is tilts out of the image plane by
+/// √(L² − l²) to make up for it (5 % too long on a 0.45 m thigh square to the camera is 0.14 m of depth, and a wrong root doubles it), while one
 /// modelled shorter misses its image by the difference and stays square to its ray. So when a
 /// length is uncertain by a few per cent, the answer leans to the bone lying flat. On the dev
 /// split from exact 2D and the stated height (quantile 0.95): margin 0 / 3 / 5 / 8 / 11 %:
@@ -371,7 +361,6 @@ fn measure_at_depth(
     views: &[FrameView<'_>],
     pairs: &[(Joint, Joint)],
     depth_of: Option<Joint>,
-    quantile: f64,
 ) -> Option<f64> {
     let mut lengths: Vec<f64> = views
         .iter()
@@ -390,7 +379,7 @@ fn measure_at_depth(
         return None;
     }
     lengths.sort_by(f64::total_cmp);
-    let k = ((lengths.len() - 1) as f64 * quantile).round() as usize;
+    let k = ((lengths.len() - 1) as f64 * ENVELOPE_QUANTILE).round() as usize;
     lengths.get(k).copied()
 }
 
@@ -445,21 +434,7 @@ fn fit(subject: &SubjectModel, views: &[FrameView<'_>]) -> (SubjectModel, Subjec
     if !(trunk.is_finite() && trunk > 0.0) {
         return (out, fit);
     }
-    if let (Some((h, x)), Some((drop, frames))) = (model_triangle(subject), measure_drop(views)) {
-        let model = h / trunk;
-        let measured = drop.clamp(model / MAX_DROP_FACTOR, model * MAX_DROP_FACTOR);
-        let h_new = measured * trunk;
-        let w = subject.shoulder_width_m;
-        out.bone_length_m[Bone::new(Joint::Chest, Joint::LeftShoulder).index()] =
-            (h_new * h_new + (x - w / 2.0).powi(2)).sqrt();
-        out.bone_length_m[Bone::new(Joint::Chest, Joint::RightShoulder).index()] =
-            (h_new * h_new + (x + w / 2.0).powi(2)).sqrt();
-        fit.chest_drop = Some(ChestDrop {
-            measured,
-            model,
-            frames,
-        });
-    }
+    fit.chest_drop = place_chest(&mut out, subject, views, 1.0);
     for (name, bones) in LIMBS {
         let Some(ratio) = measure_limb(views, bones) else {
             continue;
@@ -491,34 +466,52 @@ fn fit(subject: &SubjectModel, views: &[FrameView<'_>]) -> (SubjectModel, Subjec
     (out, fit)
 }
 
-/// The bones each group of [`GROUPS`] sets (both sides), and the share of the group's length
-/// each takes (the trunk's two bones split as the table splits it, the hips' width in halves).
-fn group_bones(g: usize, subject: &SubjectModel) -> Vec<(Bone, f64)> {
-    use Joint::*;
-    let both = |a: [Joint; 2], b: [Joint; 2]| {
-        vec![(Bone::new(a[0], b[0]), 1.0), (Bone::new(a[1], b[1]), 1.0)]
-    };
-    match g {
-        0 => {
-            let (lower, upper) = (
-                subject.bone_length(Bone::new(Pelvis, Chest)),
-                subject.bone_length(Bone::new(Chest, Neck)),
-            );
-            let share = lower / (lower + upper).max(1e-9);
-            vec![
-                (Bone::new(Pelvis, Chest), share),
-                (Bone::new(Chest, Neck), 1.0 - share),
-            ]
+/// Places the chest in `out` (its two chest–shoulder bones) at the drop below the shoulder line
+/// the tracks show (their median, held within [`MAX_DROP_FACTOR`] of `subject`'s), on `out`'s
+/// trunk and shoulder width, its offset along the line scaled by `width_factor` (`out`'s width
+/// over `subject`'s). Without a measurable drop the two bones are scaled by `width_factor`.
+fn place_chest(
+    out: &mut SubjectModel,
+    subject: &SubjectModel,
+    views: &[FrameView<'_>],
+    width_factor: f64,
+) -> Option<ChestDrop> {
+    let chest = |j| Bone::new(Joint::Chest, j).index();
+    let sides = [Joint::LeftShoulder, Joint::RightShoulder];
+    let (Some((h, x)), Some((drop, frames))) = (model_triangle(subject), measure_drop(views))
+    else {
+        for j in sides {
+            out.bone_length_m[chest(j)] *= width_factor;
         }
-        1 => vec![(Bone::new(Neck, HeadTop), 1.0)],
+        return None;
+    };
+    let model = h / subject.trunk_m();
+    let measured = drop.clamp(model / MAX_DROP_FACTOR, model * MAX_DROP_FACTOR);
+    let h_new = measured * out.trunk_m();
+    let (w, x) = (out.shoulder_width_m, x * width_factor);
+    out.bone_length_m[chest(sides[0])] = (h_new * h_new + (x - w / 2.0).powi(2)).sqrt();
+    out.bone_length_m[chest(sides[1])] = (h_new * h_new + (x + w / 2.0).powi(2)).sqrt();
+    Some(ChestDrop {
+        measured,
+        model,
+        frames,
+    })
+}
+
+/// The bones each group of [`GROUPS`] sets (both sides; none for the shoulder width, which is
+/// not a bone). The trunk's two bones and the hips' two halves add up to their group's length,
+/// the sides of a limb are each its length.
+fn group_bones(g: usize) -> Vec<Bone> {
+    use Joint::*;
+    let both = |a: [Joint; 2], b: [Joint; 2]| vec![Bone::new(a[0], b[0]), Bone::new(a[1], b[1])];
+    match g {
+        0 => vec![Bone::new(Pelvis, Chest), Bone::new(Chest, Neck)],
+        1 => vec![Bone::new(Neck, HeadTop)],
         2 => both([LeftShoulder, RightShoulder], [LeftElbow, RightElbow]),
         3 => both([LeftElbow, RightElbow], [LeftWrist, RightWrist]),
         4 => both([LeftHip, RightHip], [LeftKnee, RightKnee]),
         5 => both([LeftKnee, RightKnee], [LeftAnkle, RightAnkle]),
-        7 => vec![
-            (Bone::new(Pelvis, LeftHip), 0.5),
-            (Bone::new(Pelvis, RightHip), 0.5),
-        ],
+        7 => vec![Bone::new(Pelvis, LeftHip), Bone::new(Pelvis, RightHip)],
         _ => Vec::new(),
     }
 }
@@ -531,29 +524,24 @@ fn group_length(g: usize, subject: &SubjectModel) -> f64 {
     if g == SHOULDER_GROUP {
         return subject.shoulder_width_m;
     }
-    let bones = group_bones(g, subject);
+    let bones = group_bones(g);
+    let sum: f64 = bones.iter().map(|b| subject.bone_length(*b)).sum();
     match g {
-        0 | 7 => bones.iter().map(|(b, _)| subject.bone_length(*b)).sum(),
-        _ => {
-            bones
-                .iter()
-                .map(|(b, _)| subject.bone_length(*b))
-                .sum::<f64>()
-                / bones.len() as f64
-        }
+        0 | 7 => sum,
+        _ => sum / bones.len() as f64,
     }
 }
 
 /// A group's length as the user gave it, when every bone of it (or, for a pair of sides, either
 /// side: their mean) is known.
-fn known_group(g: usize, subject: &SubjectModel, known: &KnownLengths) -> Option<f64> {
+fn known_group(g: usize, known: &KnownLengths) -> Option<f64> {
     if g == SHOULDER_GROUP {
         return known.shoulder_width_m;
     }
-    let bones = group_bones(g, subject);
+    let bones = group_bones(g);
     let given: Vec<f64> = bones
         .iter()
-        .filter_map(|(b, _)| known.bones.get(b).copied())
+        .filter_map(|b| known.bones.get(b).copied())
         .collect();
     match g {
         0 | 7 => (given.len() == bones.len()).then(|| given.iter().sum()),
@@ -577,14 +565,11 @@ fn fit_at_depth(
     known: &KnownLengths,
 ) -> Result<Option<(SubjectModel, SubjectFit)>, LiftError> {
     use Joint::*;
-    let quantile = ENVELOPE_QUANTILE;
     let measured: Vec<Option<f64>> = GROUPS
         .iter()
-        .map(|(_, pairs, depth)| measure_at_depth(views, pairs, *depth, quantile))
+        .map(|(_, pairs, depth)| measure_at_depth(views, pairs, *depth))
         .collect();
-    let given: Vec<Option<f64>> = (0..GROUPS.len())
-        .map(|g| known_group(g, subject, known))
-        .collect();
+    let given: Vec<Option<f64>> = (0..GROUPS.len()).map(|g| known_group(g, known)).collect();
     let stack_m = stature_stack(subject);
     // Metres per unit: from what the user knows, else from the height.
     let mut ratios: Vec<f64> = measured
@@ -634,33 +619,12 @@ fn fit_at_depth(
         .collect();
     let mut out = subject.clone();
     for (g, f) in factor.iter().enumerate() {
-        for (b, _) in group_bones(g, subject) {
+        for b in group_bones(g) {
             out.bone_length_m[b.index()] = subject.bone_length(b) * f;
         }
     }
     out.shoulder_width_m = subject.shoulder_width_m * factor[SHOULDER_GROUP];
-    // The chest's drop as the tracks show it, on the new trunk and shoulder line.
-    let trunk = out.trunk_m();
-    let mut chest_drop = None;
-    let chest = |j| Bone::new(Chest, j).index();
-    if let (Some((h, x)), Some((drop, frames))) = (model_triangle(subject), measure_drop(views)) {
-        let model = h / subject.trunk_m();
-        let measured = drop.clamp(model / MAX_DROP_FACTOR, model * MAX_DROP_FACTOR);
-        let h_new = measured * trunk;
-        let w = out.shoulder_width_m;
-        let x = x * factor[SHOULDER_GROUP];
-        out.bone_length_m[chest(LeftShoulder)] = (h_new * h_new + (x - w / 2.0).powi(2)).sqrt();
-        out.bone_length_m[chest(RightShoulder)] = (h_new * h_new + (x + w / 2.0).powi(2)).sqrt();
-        chest_drop = Some(ChestDrop {
-            measured,
-            model,
-            frames,
-        });
-    } else {
-        for j in [LeftShoulder, RightShoulder] {
-            out.bone_length_m[chest(j)] *= factor[SHOULDER_GROUP];
-        }
-    }
+    let chest_drop = place_chest(&mut out, subject, views, factor[SHOULDER_GROUP]);
     // The height holds the stature stack unless the user's lengths set the scale.
     let restack = if from_known.is_some() {
         1.0
