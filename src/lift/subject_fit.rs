@@ -12,7 +12,7 @@
 //!   then scaled back to the height. It sets up the first lift, and stands when the clip is
 //!   too short for the whole-clip reading.
 //! - **The whole-clip reading** ([`fit_in_perspective`]): a first lift gives every frame's
-//!   depths, and each part ([`GROUPS`]: trunk, head, limbs, both widths) is the
+//!   depths, and each part (trunk, head, limbs, both widths) is the
 //!   [`ENVELOPE_QUANTILE`] over the clip of its image length times its parent's depth. A bone's
 //!   image is never longer than the bone, and most motions bring each part square to the
 //!   camera now and then, so this upper envelope measures every part in one unit; one scale
