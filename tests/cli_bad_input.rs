@@ -143,6 +143,54 @@ fn bad_marks_are_named_with_the_joint() {
     );
 }
 
+/// A keys file made from the sample's marks plus `extra` keys.
+fn keys_case(name: &str, extra: serde_json::Value) -> (tempfile::TempDir, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let marks: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(sample_dir().join("marks.json")).unwrap())
+            .unwrap();
+    let mut keys = vec![serde_json::json!({"frame": 0, "joints": marks["joints"]})];
+    keys.extend(extra.as_array().unwrap().iter().cloned());
+    let v = serde_json::json!({"format": "videomocap.keys", "version": 1, "keys": keys});
+    let p = dir.path().join(name);
+    std::fs::write(&p, v.to_string()).unwrap();
+    let s = p.to_str().unwrap().to_owned();
+    (dir, s)
+}
+
+#[test]
+fn bad_keys_are_named_with_the_frame_and_joint() {
+    let video = sample_dir().join("video.mp4");
+    let video = video.to_str().unwrap();
+    let key = |frame: usize, joint: &str, x: f64| serde_json::json!({"frame": frame, "joints": {joint: [x, 100.0]}});
+    let (_d, late) = keys_case("late.json", serde_json::json!([key(500, "neck", 10.0)]));
+    assert_bad(
+        &["track", video, "--keys", &late, "-o", "t.json"],
+        &[&late, "frame 500", "100 frames"],
+    );
+    let (_d, twice) = keys_case(
+        "twice.json",
+        serde_json::json!([key(40, "left_wrist", 10.0), key(40, "left_wrist", 90.0)]),
+    );
+    assert_bad(
+        &["track", video, "--keys", &twice, "-o", "t.json"],
+        &[&twice, "frame 40", "left_wrist", "placed twice"],
+    );
+    let (_d, outside) = keys_case("outside.json", serde_json::json!([key(3, "neck", 5000.0)]));
+    assert_bad(
+        &["track", video, "--keys", &outside, "-o", "t.json"],
+        &[&outside, "neck", "outside", "frame 3"],
+    );
+    let (_d, unknown) = keys_case("unknown.json", serde_json::json!([key(3, "nose", 5.0)]));
+    assert_bad(
+        &["track", video, "--keys", &unknown, "-o", "t.json"],
+        &[&unknown, "nose"],
+    );
+    let (_d, fine) = keys_case("fine.json", serde_json::json!([]));
+    assert_bad(&["track", video, "--keys", &fine], &["--output"]);
+    assert_bad(&["track", video, "-o", "t.json"], &["--marks", "--keys"]);
+}
+
 #[test]
 fn a_tracker_setting_out_of_its_range_is_named_with_its_file() {
     let dir = tempfile::tempdir().unwrap();

@@ -93,14 +93,19 @@ pub struct StressWriteArgs {
 /// `track`.
 #[derive(Debug, Args)]
 pub struct TrackArgs {
-    /// Video file or directory of images.
+    /// Video file or directory of images, or a saved project (`.json`: its video is re-tracked
+    /// from its keys and settings, and the tracks saved back into it).
     pub video: PathBuf,
     /// The 16 joints marked on one frame (marks.json).
+    #[arg(long, conflicts_with = "keys")]
+    pub marks: Option<PathBuf>,
+    /// Joints placed by hand on any frames (keys.json: the marks and every correction; see
+    /// docs/formats.md).
     #[arg(long)]
-    pub marks: PathBuf,
-    /// Where to write tracks2d.json.
+    pub keys: Option<PathBuf>,
+    /// Where to write tracks2d.json (needed unless re-tracking a project).
     #[arg(short, long)]
-    pub output: PathBuf,
+    pub output: Option<PathBuf>,
     /// Worker threads (default: all cores; 1 = decode and track on one thread).
     #[arg(long)]
     pub threads: Option<usize>,
@@ -179,8 +184,11 @@ pub struct RunArgs {
     /// Video file or directory of images.
     pub video: PathBuf,
     /// The 16 joints marked on one frame (marks.json).
+    #[arg(long, conflicts_with = "keys", required_unless_present = "keys")]
+    pub marks: Option<PathBuf>,
+    /// Joints placed by hand on any frames (keys.json; see docs/formats.md).
     #[arg(long)]
-    pub marks: PathBuf,
+    pub keys: Option<PathBuf>,
     /// Directory for tracks2d.json, skeleton3d.json, motion.bvh, joints3d.csv, tracks2d.csv and
     /// motion.trc.
     #[arg(long)]
@@ -336,6 +344,9 @@ pub struct BenchArgs {
     /// split and the real clips: the ones to tune on) or test (the synthetic test split).
     #[arg(long, default_value = "all")]
     pub split: String,
+    /// Only the clips whose name contains this (to look at one clip of the split).
+    #[arg(long)]
+    pub clip: Option<String>,
     /// `bench lift` only: leave out input (c), the tracker's output (tracking is most of the
     /// bench's time; for quick looks at the lift from true and noisy 2D).
     #[arg(long)]

@@ -188,7 +188,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         Some(p) => super::lift::load_settings(p)?,
         None => LiftParams::default(),
     };
-    let clips = bench_clips(&a.suite_dir, &a.split, global)?;
+    let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;
     let mut tally: Tally<Cases> = Tally::default();
     let mut per_clip = vec![format!(
         "{:<26} {:<5} {:<11} {:>8} {:>8} {:>8} {:>8} {:>8}",

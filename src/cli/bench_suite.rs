@@ -29,6 +29,7 @@ pub fn root() -> &'static Path {
 pub fn bench_clips(
     suite_dir: &Path,
     split: &str,
+    clip: Option<&str>,
     global: &GlobalArgs,
 ) -> Result<Vec<BenchClip>, ExitError> {
     let wanted = match split {
@@ -64,7 +65,7 @@ pub fn bench_clips(
         split: Split::Dev,
         dir: root().join(dir),
     }));
-    out.retain(|c| wanted.is_none_or(|w| c.split == w));
+    out.retain(|c| wanted.is_none_or(|w| c.split == w) && clip.is_none_or(|n| c.name.contains(n)));
     Ok(out)
 }
 

@@ -197,7 +197,7 @@ fn score_clip(
 /// Runs the accuracy and speed benchmark and prints its tables.
 pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let (threads, params) = threads_and_settings(a)?;
-    let clips = bench_clips(&a.suite_dir, &a.split, global)?;
+    let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;
     let mut tally: Tally<TrackScores> = Tally::default();
     let mut lines = vec![
         format!(

@@ -16,12 +16,13 @@ pub const TRC: &str = "motion.trc";
 /// `run`.
 pub fn run(a: &RunArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let (params, known) = super::lift::check_options(&a.options)?;
-    let (mut video, marks) = super::track::open_checked(&a.video, &a.marks)?;
+    let (mut video, keys) =
+        super::track::open_checked(&a.video, a.marks.as_deref(), a.keys.as_deref())?;
     std::fs::create_dir_all(&a.out_dir)
         .map_err(|e| ExitError::failed(anyhow!("{}: cannot create: {e}", a.out_dir.display())))?;
     let out = super::track::track_with_progress(
         &mut video,
-        &marks,
+        &keys,
         None,
         videomocap::track::TrackerParams::default(),
         global,

@@ -4,38 +4,53 @@ use super::args::{GlobalArgs, TrackArgs};
 use super::{ExitError, progress_bar, say};
 use anyhow::anyhow;
 use std::path::Path;
+use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use videomocap::eval::score_tracks;
-use videomocap::formats::Marks;
+use videomocap::formats::{KeyFrames, Marks};
+use videomocap::project::Project;
 use videomocap::synth::GroundTruth;
 use videomocap::track::{
     LimbPair, SpanKind, TrackError, TrackJob, TrackOutput, TrackerParams, track_video,
 };
 use videomocap::video::{OpenOptions, Video};
 
-/// Opens the video and marks and checks that they fit together.
-pub fn open_checked(video: &Path, marks: &Path) -> Result<(Video, Marks), ExitError> {
+/// Opens the video and the hand-placed joints (a marks file or a keys file) and checks that
+/// they fit together.
+pub fn open_checked(
+    video: &Path,
+    marks: Option<&Path>,
+    keys: Option<&Path>,
+) -> Result<(Video, KeyFrames), ExitError> {
+    let (path, keys) = match (marks, keys) {
+        (_, Some(k)) => (k, KeyFrames::load(k).map_err(ExitError::bad_input)?),
+        (Some(m), None) => (
+            m,
+            KeyFrames::from_marks(&Marks::load(m).map_err(ExitError::bad_input)?),
+        ),
+        (None, None) => {
+            return Err(ExitError::bad_input(anyhow!(
+                "give the joints placed by hand: --marks marks.json or --keys keys.json"
+            )));
+        }
+    };
     let v = Video::open(video, &OpenOptions::default()).map_err(ExitError::bad_input)?;
-    let m = Marks::load(marks).map_err(ExitError::bad_input)?;
-    let info = v.info();
-    if m.frame >= info.frame_count {
-        return Err(ExitError::bad_input(anyhow!(
-            "{}: marks are on frame {} but {} has {} frames",
-            marks.display(),
-            m.frame,
-            video.display(),
-            info.frame_count
-        )));
-    }
-    m.check_in_frame(marks, info.width, info.height)
-        .map_err(ExitError::bad_input)?;
-    Ok((v, m))
+    check_keys(&v, &keys, path)?;
+    Ok((v, keys))
+}
+
+/// Checks keys against the video (frames in range, points on the image, one full key); the
+/// error names the file the keys came from and the video.
+fn check_keys(video: &Video, keys: &KeyFrames, path: &Path) -> Result<(), ExitError> {
+    let info = video.info();
+    keys.check_in_video(path, info.width, info.height, info.frame_count)
+        .map_err(|e| ExitError::bad_input(anyhow!("{e} (video {})", info.path.display())))
 }
 
 /// Runs the tracker with a progress bar; shared by `track` and `run`.
 pub fn track_with_progress(
     video: &mut Video,
-    marks: &Marks,
+    keys: &KeyFrames,
     threads: Option<usize>,
     params: TrackerParams,
     global: &GlobalArgs,
@@ -50,7 +65,13 @@ pub fn track_with_progress(
             "--threads must be at least 1"
         )));
     }
-    let job = TrackJob::from_marks(marks, params, threads);
+    let job = TrackJob {
+        keys: keys.clone(),
+        params,
+        threads,
+        from: None,
+        previous: None,
+    };
     let bar = progress_bar(global, video.info().frame_count as u64, "tracking");
     let cancel = AtomicBool::new(false);
     let mut on_progress = |p: &videomocap::track::TrackProgress| {
@@ -161,26 +182,82 @@ pub fn report(out: &TrackOutput, global: &GlobalArgs) {
     }
 }
 
+/// Whether a `track` input is a saved project rather than a video.
+fn is_project(path: &Path) -> bool {
+    path.is_file()
+        && path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+}
+
+/// `track`.
 pub fn run(a: &TrackArgs, global: &GlobalArgs) -> Result<(), ExitError> {
-    let (mut video, marks) = open_checked(&a.video, &a.marks)?;
+    let mut project = if is_project(&a.video) {
+        if a.marks.is_some() || a.keys.is_some() {
+            return Err(ExitError::bad_input(anyhow!(
+                "{}: a project brings its own keys; leave out --marks and --keys",
+                a.video.display()
+            )));
+        }
+        Some(Project::load(&a.video).map_err(ExitError::bad_input)?)
+    } else {
+        None
+    };
+    let (mut video, keys, settings) = match &project {
+        Some(p) => {
+            // A relative video path is relative to the project's folder.
+            let video_path = match a.video.parent() {
+                Some(dir) if p.video.is_relative() => dir.join(&p.video),
+                _ => p.video.clone(),
+            };
+            let v =
+                Video::open(&video_path, &OpenOptions::default()).map_err(ExitError::bad_input)?;
+            check_keys(&v, &p.keys, &a.video)?;
+            (v, p.keys.clone(), Some(p.settings.tracker))
+        }
+        None => {
+            if a.output.is_none() {
+                return Err(ExitError::bad_input(anyhow!(
+                    "give --output tracks2d.json (only a project keeps its tracks itself)"
+                )));
+            }
+            let (v, k) = open_checked(&a.video, a.marks.as_deref(), a.keys.as_deref())?;
+            (v, k, None)
+        }
+    };
     let reference = match &a.reference {
         Some(p) => Some(GroundTruth::load(p).map_err(ExitError::bad_input)?),
         None => None,
     };
-    let params = match &a.tracker_settings {
-        Some(p) => load_settings(p)?,
-        None => TrackerParams::default(),
+    let params = match (&a.tracker_settings, settings) {
+        (Some(p), _) => load_settings(p)?,
+        (None, Some(s)) => s,
+        (None, None) => TrackerParams::default(),
     };
     let t0 = std::time::Instant::now();
-    let out = track_with_progress(&mut video, &marks, a.threads, params, global)?;
+    let out = track_with_progress(&mut video, &keys, a.threads, params, global)?;
     let seconds = t0.elapsed().as_secs_f64();
-    out.tracks.save(&a.output).map_err(ExitError::failed)?;
+    let mut written = Vec::new();
+    if let Some(output) = &a.output {
+        out.tracks.save(output).map_err(ExitError::failed)?;
+        written.push(output.display().to_string());
+    }
+    if let Some(p) = project.as_mut() {
+        // The new tracks replace the old, and the 3D lifted from the old ones goes.
+        p.tracks = Some(Arc::new(out.tracks.clone()));
+        p.skeleton = None;
+        p.save(&a.video).map_err(ExitError::failed)?;
+        written.push(format!(
+            "{} (its tracks; lift again for 3D)",
+            a.video.display()
+        ));
+    }
     report(&out, global);
     say(
         global,
         &format!(
             "wrote {} ({:.1} frames/s including decoding)",
-            a.output.display(),
+            written.join(" and "),
             out.tracks.frames.len() as f64 / seconds
         ),
     );
@@ -216,7 +293,7 @@ pub fn run(a: &TrackArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     }
     if global.json {
         let summary = serde_json::json!({
-            "output": a.output,
+            "output": a.output.as_ref().map_or_else(|| a.video.clone(), |o| o.clone()),
             "frames": out.tracks.frames.len(),
             "seconds": seconds,
             "shrink": out.shrink,

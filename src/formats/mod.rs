@@ -1,8 +1,9 @@
-//! The project's versioned JSON files (documented in `docs/formats.md`): marks, tracks2d and
-//! skeleton3d, with one error type that always names the file, and atomic saving.
+//! The project's versioned JSON files (documented in `docs/formats.md`): marks, keys, known
+//! lengths, tracks2d and skeleton3d, with one error type that always names the file, and atomic saving.
 
 mod atomic;
 mod error;
+mod keys;
 mod lengths;
 mod marks;
 mod skeleton3d;
@@ -10,6 +11,8 @@ mod tracks2d;
 
 pub use atomic::write_atomically;
 pub use error::FormatError;
+pub(crate) use keys::KeyEntry;
+pub use keys::{KEYS_FORMAT, KeyFrames};
 pub use lengths::{KnownLengths, LENGTH_RANGE_M, LENGTHS_FORMAT, SHOULDER_WIDTH_KEY, TapeLengths};
 pub use marks::{MARKS_FORMAT, Marks};
 pub use skeleton3d::{Frame3d, LOST_FLAG, OFF_FRAME_FLAG, SKELETON3D_FORMAT, Skeleton3d};

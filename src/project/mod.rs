@@ -8,15 +8,13 @@ mod history;
 pub use history::History;
 
 use crate::formats::{
-    FORMAT_VERSION, FormatError, LENGTH_RANGE_M, Skeleton3d, TapeLengths, Tracks2d, parse_json,
-    read_text, write_atomically,
+    FORMAT_VERSION, FormatError, KeyEntry, KeyFrames, LENGTH_RANGE_M, Skeleton3d, TapeLengths,
+    Tracks2d, parse_json, read_text, write_atomically,
 };
 use crate::lift::{DepthOverrides, LiftParams, Root};
-use crate::skeleton::{Bone, Joint};
-use crate::track::{KeyFrames, TrackerParams};
-use nalgebra::Point2;
+use crate::skeleton::Bone;
+use crate::track::TrackerParams;
 use serde::{Deserialize, Serialize};
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -87,13 +85,9 @@ impl Project {
 
     /// The first frame with all 16 joints placed (the marks), if any.
     pub fn marks(&self) -> Option<crate::formats::Marks> {
-        self.keys.frames.iter().find_map(|(&frame, joints)| {
-            let all: Option<Vec<Point2<f64>>> = joints.0.iter().copied().collect();
-            all.map(|v| crate::formats::Marks {
-                frame,
-                points: crate::skeleton::PerJoint::from_fn(|j| v[j.index()]),
-            })
-        })
+        self.keys
+            .first_full()
+            .map(|(frame, points)| crate::formats::Marks { frame, points })
     }
 
     /// Reads a project file.
@@ -122,23 +116,7 @@ impl Project {
                 supported: FORMAT_VERSION,
             });
         }
-        let mut keys = KeyFrames::default();
-        for k in raw.keys {
-            for (name, [x, y]) in k.joints {
-                let joint = Joint::from_name(&name).ok_or_else(|| FormatError::UnknownJoint {
-                    path: path.to_owned(),
-                    name: name.clone(),
-                })?;
-                if !(x.is_finite() && y.is_finite()) {
-                    return Err(FormatError::NonFinite {
-                        path: path.to_owned(),
-                        joint,
-                        frame: Some(k.frame),
-                    });
-                }
-                keys.set(k.frame, joint, Point2::new(x, y));
-            }
-        }
+        let keys = KeyFrames::from_entries(raw.keys, path)?;
         let mut overrides = DepthOverrides::default();
         for o in raw.depth_overrides {
             let bone = Bone::from_key(&o.bone).ok_or_else(|| {
@@ -212,18 +190,7 @@ impl Project {
             version: FORMAT_VERSION,
             video: self.video.clone(),
             settings: self.settings,
-            keys: self
-                .keys
-                .frames
-                .iter()
-                .map(|(&frame, joints)| KeyFile {
-                    frame,
-                    joints: joints
-                        .iter()
-                        .filter_map(|(j, p)| p.map(|p| (j.name().to_owned(), [p.x, p.y])))
-                        .collect(),
-                })
-                .collect(),
+            keys: self.keys.entries(),
             depth_overrides: self
                 .overrides
                 .iter()
@@ -261,20 +228,13 @@ struct ProjectFile {
     #[serde(default)]
     settings: Settings,
     #[serde(default)]
-    keys: Vec<KeyFile>,
+    keys: Vec<KeyEntry>,
     #[serde(default)]
     depth_overrides: Vec<OverrideFile>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     tracks: Option<serde_json::Value>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     skeleton: Option<serde_json::Value>,
-}
-
-#[derive(Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct KeyFile {
-    frame: usize,
-    joints: BTreeMap<String, [f64; 2]>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -288,6 +248,8 @@ struct OverrideFile {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::skeleton::Joint;
+    use nalgebra::Point2;
 
     #[test]
     fn a_project_round_trips_through_its_file() {

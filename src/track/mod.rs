@@ -14,15 +14,19 @@
 //! - [`gait`]: the hidden far limbs of a walk or run completed from the other side
 //! - [`side_trunk`]: a side-on walker's shoulders and hips in perspective
 //! - [`smooth`]: the finished tracks smoothed over time, weighted by reliability
-//! - [`run`]: passes over a video, key frames, re-tracking
+//! - [`run`]: tracking a video from its key frames, the order of the steps, re-tracking
+//! - `pass`: one pass over consecutive frames, forwards or backwards, re-started at key frames
+//! - `fuse`: the forward and backward passes made one, per joint between its key frames
 
 pub mod background;
 pub mod block;
 pub mod body;
+mod fuse;
 pub mod gait;
 pub mod head;
 pub mod occlusion;
 pub mod params;
+mod pass;
 pub mod run;
 pub mod search;
 pub mod side_trunk;

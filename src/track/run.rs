@@ -1,60 +1,33 @@
 //! Tracking a whole video: the passes over the frames, key frames, and the result.
 //!
-//! From the first key frame (the marks) a forward pass runs to the end and a backward pass to
-//! the start. Each later key frame (a frame where the user corrected joints) restarts the
-//! forward pass there with the corrected pose and fresh key-frame colour models, and a backward
-//! pass from it fills the weak frames before it, keeping for each joint and frame whichever pass
-//! is more reliable. A joint that ends up outside the image is off the frame (confidence 0, its
-//! position the tracker's estimate). Short weak runs are then interpolated with key frames as
-//! anchors ([`super::occlusion`]), never runs that leave the frame. Frames are decoded (and shrunk to the working scale) on a separate
-//! thread while the tracker works, unless one thread is asked for.
+//! One function shows the order ([`track_video`]): a forward pass from the first key frame (the
+//! marks) to the end, then a backward pass from the last key frame to the start, each re-started
+//! with the hand-placed joints at every key frame on the way (`pass`); the two made one
+//! per joint between its key frames (`fuse`); then twins merged, short weak runs
+//! interpolated with key frames as anchors ([`super::occlusion`]), never runs that leave the
+//! frame, hidden gait limbs completed ([`super::gait`]) and the tracks smoothed when asked. A
+//! joint that ends up outside the image is off the frame (confidence 0, its position the
+//! tracker's estimate). A re-track after a correction runs forwards from the corrected frame and
+//! backwards from the last key frame to the earliest frame the correction can change, keeping the
+//! earlier result elsewhere.
 
-use super::background::{self, Background};
-use super::body::{BodyTracker, JointResult, stature_px};
+use super::body::{JointResult, stature_px};
+use super::fuse::fuse;
 use super::gait::{GaitOutcome, complete_gaits};
 use super::occlusion::{WeakSpan, fill_weak_runs, weak_spans, weaken_merged_twins};
 use super::params::TrackerParams;
+use super::pass::{PassContext, Scale};
 use super::smooth::smooth_tracks;
 use crate::camera::point_in_frame;
+pub use crate::formats::KeyFrames;
 use crate::formats::{FrameTracks, PointSource, SourceInfo, TrackedPoint, Tracks2d};
-use crate::skeleton::{JOINT_COUNT, Joint, PerJoint, Proportions};
+use crate::skeleton::{Joint, PerJoint, Proportions};
 use crate::video::{Video, VideoError, VideoInfo};
-use image::RgbImage;
 use nalgebra::Point2;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-
-/// Hand-placed joints per frame: the marks, and every correction made since.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct KeyFrames {
-    /// Per frame index, the joints placed by hand there.
-    pub frames: BTreeMap<usize, PerJoint<Option<Point2<f64>>>>,
-}
-
-impl KeyFrames {
-    /// Key frames from marks (all 16 joints on one frame).
-    pub fn from_marks(marks: &crate::formats::Marks) -> KeyFrames {
-        let mut frames = BTreeMap::new();
-        frames.insert(marks.frame, marks.points.map(|_, p| Some(*p)));
-        KeyFrames { frames }
-    }
-
-    /// Places one joint by hand on a frame (that frame becomes a key frame for the joint).
-    pub fn set(&mut self, frame: usize, joint: Joint, pos: Point2<f64>) {
-        self.frames
-            .entry(frame)
-            .or_insert_with(|| PerJoint([None; JOINT_COUNT]))[joint] = Some(pos);
-    }
-
-    /// Whether a joint was placed by hand on a frame.
-    pub fn is_key(&self, frame: usize, joint: Joint) -> bool {
-        self.frames
-            .get(&frame)
-            .is_some_and(|joints| joints[joint].is_some())
-    }
-}
+use std::sync::atomic::AtomicBool;
 
 /// Tracking could not run.
 #[derive(Debug, thiserror::Error)]
@@ -153,40 +126,6 @@ pub struct TrackOutput {
     pub damaged: Vec<usize>,
 }
 
-/// Converts between video pixels and the working scale (pixel centres at integers).
-#[derive(Debug, Clone, Copy)]
-struct Scale {
-    sx: f64,
-    sy: f64,
-    width: u32,
-    height: u32,
-}
-
-impl Scale {
-    fn to_work(self, p: Point2<f64>) -> Point2<f64> {
-        Point2::new((p.x + 0.5) / self.sx - 0.5, (p.y + 0.5) / self.sy - 0.5)
-    }
-    fn to_video(self, p: Point2<f64>) -> Point2<f64> {
-        Point2::new((p.x + 0.5) * self.sx - 0.5, (p.y + 0.5) * self.sy - 0.5)
-    }
-    /// The frame at the working size: as it is when the decoder already shrank it, else
-    /// averaged over boxes (`fast_image_resize`: a 1080×1920 frame in 1.6 ms, against 15 ms
-    /// for `image`'s thumbnail, with the same pixels to a seventh of a level on average).
-    fn shrink(&self, image: Arc<RgbImage>) -> Arc<RgbImage> {
-        use fast_image_resize::{FilterType, ResizeAlg, ResizeOptions, Resizer};
-        if self.width == image.width() && self.height == image.height() {
-            return image;
-        }
-        let mut small = RgbImage::new(self.width, self.height);
-        let options = ResizeOptions::new().resize_alg(ResizeAlg::Convolution(FilterType::Box));
-        match Resizer::new().resize(&*image, &mut small, &options) {
-            Ok(()) => Arc::new(small),
-            // Not reached: both images are RGB8 and neither is empty.
-            Err(_) => Arc::new(image::imageops::thumbnail(&*image, self.width, self.height)),
-        }
-    }
-}
-
 /// Tracks the video from its key frames.
 ///
 /// When the person is taller than the working stature, `decoder_scaling` is on and the backend
@@ -206,14 +145,6 @@ pub fn track_video(
         video.output_size(Some((info.width, info.height)));
     }
     out
-}
-
-/// The first key frame with all 16 joints, and its pose.
-fn first_full_key(job: &TrackJob) -> Option<(usize, PerJoint<Point2<f64>>)> {
-    job.keys.frames.iter().find_map(|(f, joints)| {
-        let all: Option<Vec<Point2<f64>>> = joints.0.iter().copied().collect();
-        all.map(|v| (*f, PerJoint::from_fn(|j| v[j.index()])))
-    })
 }
 
 /// The shrink factor that brings the marked person to the working stature (1 when they are no
@@ -257,7 +188,7 @@ fn track_at_working_scale(
             frames: n,
         });
     }
-    let (first_key, first_pose) = first_full_key(job).ok_or(TrackError::NoFullKeyFrame)?;
+    let (first_key, first_pose) = job.keys.first_full().ok_or(TrackError::NoFullKeyFrame)?;
     let (shrink, (ww, wh)) = working_scale(job, &first_pose, info.width, info.height);
     let scale = Scale {
         sx: f64::from(info.width) / f64::from(ww),
@@ -279,8 +210,9 @@ fn track_at_working_scale(
         .build()
         .ok();
 
-    // Per frame, the raw result in video pixels (None = not tracked yet).
-    let mut raw: Vec<Option<PerJoint<JointResult>>> = vec![None; n];
+    // Per frame, the forward pass's result in video pixels (None = not tracked); a re-track
+    // keeps the earlier result before the corrected frame as the forward pass there.
+    let mut forward: Vec<Option<PerJoint<JointResult>>> = vec![None; n];
     let start = match job.from {
         Some(from) => {
             let prev = job
@@ -288,10 +220,8 @@ fn track_at_working_scale(
                 .as_ref()
                 .filter(|p| p.frames.len() == n && from < n)
                 .ok_or(TrackError::NoEarlierResult { frame: from })?;
-            // Up to and including the corrected frame: the re-track starts there from what the
-            // user saw, with their corrections put in (not from the first key frame's pose).
-            for f in &prev.frames[..=from] {
-                raw[f.index] = Some(f.points.map(|_, p| JointResult {
+            for f in &prev.frames {
+                forward[f.index] = Some(f.points.map(|_, p| JointResult {
                     pos: p.pos,
                     reliability: p.confidence,
                 }));
@@ -299,6 +229,36 @@ fn track_at_working_scale(
             from
         }
         None => first_key,
+    };
+    // The backward pass runs from the last key frame down to `low`: the start of the clip, or
+    // on a re-track the earliest frame whose result the correction can change (every joint's
+    // key before it).
+    let last_key = job
+        .keys
+        .frames
+        .keys()
+        .next_back()
+        .copied()
+        .unwrap_or(first_key);
+    let low = match job.from {
+        None => 0,
+        Some(from) => Joint::ALL
+            .iter()
+            .map(|&j| {
+                job.keys
+                    .frames
+                    .range(..from)
+                    .rev()
+                    .find(|(_, k)| k[j].is_some())
+                    .map_or(0, |(&f, _)| f)
+            })
+            .min()
+            .unwrap_or(0),
+    };
+    let backward_frames: Vec<usize> = if last_key > low {
+        (low..=last_key).rev().collect()
+    } else {
+        Vec::new()
     };
     let mut ctx = PassContext {
         video,
@@ -311,7 +271,7 @@ fn track_at_working_scale(
         threads: job.threads,
         damaged: Vec::new(),
         done: 0,
-        total: (n - start) + if job.from.is_none() { first_key } else { 0 },
+        total: (n - start) + backward_frames.len(),
         progress,
         cancel,
         background: None,
@@ -322,73 +282,77 @@ fn track_at_working_scale(
     } else {
         None
     };
-    let start_pose = |raw: &[Option<PerJoint<JointResult>>], f: usize| -> PerJoint<Point2<f64>> {
-        let base = raw[f].map(|r| r.map(|_, j| j.pos)).unwrap_or(first_pose);
-        keyed(&base, &job.keys, f)
-    };
-    let run = |ctx: &mut PassContext, raw: &mut Vec<Option<PerJoint<JointResult>>>| {
-        // Forward from the start to the end, re-keyed at every key frame on the way.
-        let pose = if job.from.is_some() {
-            start_pose(raw, start)
-        } else {
-            first_pose
-        };
-        let forward: Vec<usize> = (start..n).collect();
-        // The earlier result on the start frame: its joints that were not corrected keep
-        // their confidence (the pass vouches for its whole starting pose).
-        let before = raw[start];
-        let results = ctx.pass(&forward, &pose, true)?;
-        for (f, r) in forward.iter().zip(results) {
-            raw[*f] = Some(r);
-        }
-        if let (Some(before), Some(now)) = (before, raw[start].as_mut()) {
-            for j in Joint::ALL {
-                if !job.keys.is_key(start, j) {
-                    now[j].reliability = before[j].reliability;
-                }
-            }
-        }
-        // Backward from the first key frame to the start.
-        if job.from.is_none() && first_key > 0 {
-            let backward: Vec<usize> = (0..=first_key).rev().collect();
-            let results = ctx.pass(&backward, &first_pose, false)?;
-            for (f, r) in backward.iter().zip(results).skip(1) {
-                raw[*f] = Some(r);
-            }
-        }
-        // Backward gap passes from each later key frame over the weak frames before it.
-        let keys: Vec<usize> = job.keys.frames.keys().copied().collect();
-        for w in keys.windows(2) {
-            let (lo, hi) = (w[0], w[1]);
-            if hi <= start.max(lo) {
-                continue;
-            }
-            let weak_first = (lo + 1..hi).find(|&f| {
-                raw[f].is_some_and(|r| {
-                    r.0.iter()
-                        .any(|j| j.reliability < ctx.params.weak_reliability)
+    let mut backward: Vec<Option<PerJoint<JointResult>>> = vec![None; n];
+    // Where each pass arrived on the key frames it went through (a re-track's forward pass
+    // arrived on the corrected frame where the earlier result had it).
+    type Arrivals = BTreeMap<usize, PerJoint<JointResult>>;
+    let mut arrivals: (Arrivals, Arrivals) = Default::default();
+    if let Some(from) = job.from {
+        arrivals.0.extend(forward[from].map(|r| (from, r)));
+    }
+    let run = |ctx: &mut PassContext,
+               forward: &mut Vec<Option<PerJoint<JointResult>>>,
+               backward: &mut Vec<Option<PerJoint<JointResult>>>,
+               arrivals: &mut (Arrivals, Arrivals)| {
+        // A pass starts from the pose on its first frame with the hand-placed joints put in;
+        // the joints not placed there keep the reliability they had.
+        let starting = |results: &[Option<PerJoint<JointResult>>], f: usize| {
+            let base = results[f].unwrap_or_else(|| {
+                first_pose.map(|_, p| JointResult {
+                    pos: *p,
+                    reliability: 1.0,
                 })
             });
-            let Some(from) = weak_first else { continue };
-            let backward: Vec<usize> = (from..=hi).rev().collect();
-            ctx.total += backward.len();
-            let pose = start_pose(raw, hi);
-            let results = ctx.pass(&backward, &pose, false)?;
-            for (f, r) in backward.iter().zip(results).skip(1) {
-                if let Some(old) = raw[*f].as_mut() {
+            (keyed(&base.map(|_, r| r.pos), &job.keys, f), base)
+        };
+        let run_pass =
+            |ctx: &mut PassContext,
+             order: &[usize],
+             from: &[Option<PerJoint<JointResult>>],
+             into: &mut Vec<Option<PerJoint<JointResult>>>,
+             arrived: &mut BTreeMap<usize, PerJoint<JointResult>>| {
+                let (pose, before) = starting(from, order[0]);
+                let out = ctx.pass(order, &pose)?;
+                for (f, r) in order.iter().zip(out.results) {
+                    into[*f] = Some(r);
+                }
+                arrived.extend(out.arrivals);
+                if let Some(now) = into[order[0]].as_mut() {
                     for j in Joint::ALL {
-                        if r[j].reliability > old[j].reliability {
-                            old[j] = r[j];
+                        if !job.keys.is_key(order[0], j) {
+                            now[j].reliability = before[j].reliability;
                         }
                     }
                 }
-            }
+                Ok::<(), TrackError>(())
+            };
+        // Forwards from the start to the end, then backwards from the last key frame, each
+        // re-started at every key frame on the way.
+        let forward_frames: Vec<usize> = (start..n).collect();
+        let earlier = forward.clone();
+        run_pass(ctx, &forward_frames, &earlier, forward, &mut arrivals.0)?;
+        if !backward_frames.is_empty() {
+            run_pass(ctx, &backward_frames, forward, backward, &mut arrivals.1)?;
         }
         Ok::<(), TrackError>(())
     };
     match &pool {
-        Some(pool) => pool.install(|| run(&mut ctx, &mut raw))?,
-        None => run(&mut ctx, &mut raw)?,
+        Some(pool) => pool.install(|| run(&mut ctx, &mut forward, &mut backward, &mut arrivals))?,
+        None => run(&mut ctx, &mut forward, &mut backward, &mut arrivals)?,
+    }
+    // Each joint's frames from the pass that holds there (whole clip; a re-track from the
+    // earliest frame it can change, the earlier result before).
+    let torso_px = (first_pose[Joint::Neck] - first_pose[Joint::Pelvis]).norm();
+    let mut raw = forward.clone();
+    for (f, r) in (low..n).zip(fuse(
+        [&forward, &backward],
+        [&arrivals.0, &arrivals.1],
+        &job.keys,
+        low..n,
+        torso_px,
+        job.params.weak_reliability,
+    )) {
+        raw[f] = r;
     }
 
     let mut frames: Vec<FrameTracks> = raw
@@ -490,290 +454,6 @@ fn keyed(base: &PerJoint<Point2<f64>>, keys: &KeyFrames, f: usize) -> PerJoint<P
         Some(k) => base.map(|j, p| k[j].unwrap_or(*p)),
         None => *base,
     }
-}
-
-struct PassContext<'a, 'p> {
-    video: &'a mut Video,
-    scale: Scale,
-    params: TrackerParams,
-    keys: &'a KeyFrames,
-    path: PathBuf,
-    /// The size frames arrive at from the video (full or, when it scales, working size).
-    width: u32,
-    height: u32,
-    threads: usize,
-    /// Frames that could not be decoded so far.
-    damaged: Vec<usize>,
-    done: usize,
-    total: usize,
-    progress: &'p mut (dyn FnMut(&TrackProgress) + Send),
-    cancel: &'a AtomicBool,
-    /// The static camera's background at the working size, when there is one.
-    background: Option<Arc<Background>>,
-}
-
-impl PassContext<'_, '_> {
-    /// The static camera's background from [`background::SAMPLES`] frames spread over the
-    /// clip's `n` frames, at the working size ([`Background::estimate`]; `None` for a moving
-    /// camera). When the whole clip fits in the video's frame cache every frame is read, so
-    /// that the passes find them there and the clip is decoded once (reading only the samples
-    /// forwards decodes the frames between them all the same, and the first pass would then
-    /// decode them again).
-    fn estimate_background(
-        &mut self,
-        n: usize,
-        tau: f32,
-    ) -> Result<Option<Background>, TrackError> {
-        let samples = background::sample_indices(n, background::SAMPLES);
-        let read: Vec<usize> = if n <= self.video.cache_capacity_frames() {
-            (0..n).collect()
-        } else {
-            samples.clone()
-        };
-        let mut images = Vec::with_capacity(samples.len());
-        for index in read {
-            if self.cancel.load(Ordering::Relaxed) {
-                return Err(TrackError::Cancelled);
-            }
-            let Some(frame) = undamaged(self.video.frame(index))? else {
-                continue;
-            };
-            if samples.binary_search(&index).is_ok()
-                && (frame.image.width(), frame.image.height()) == (self.width, self.height)
-            {
-                images.push(self.scale.shrink(frame.image));
-            }
-        }
-        let refs: Vec<&RgbImage> = images.iter().map(|i| i.as_ref()).collect();
-        Ok(Background::estimate(&refs, tau))
-    }
-    /// Tracks over `order` (consecutive frames, forwards or backwards), starting from `pose` on
-    /// its first frame; returns the results in video pixels, one per frame of `order` (the
-    /// first is the starting pose). Forward passes re-key at key frames on the way.
-    fn pass(
-        &mut self,
-        order: &[usize],
-        pose: &PerJoint<Point2<f64>>,
-        rekey: bool,
-    ) -> Result<Vec<PerJoint<JointResult>>, TrackError> {
-        let scale = self.scale;
-        let params = self.params;
-        let background = self.background.clone();
-        let keys = self.keys;
-        let cancel = self.cancel;
-        let (path, width, height) = (self.path.clone(), self.width, self.height);
-        let to_video = |r: PerJoint<JointResult>| {
-            r.map(|_, j| JointResult {
-                pos: scale.to_video(j.pos),
-                reliability: j.reliability,
-            })
-        };
-        let mut out = Vec::with_capacity(order.len());
-        let mut tracker: Option<BodyTracker> = None;
-        let proportions = Proportions::default();
-        let check = |index: usize, image: &RgbImage| {
-            if image.width() != width || image.height() != height {
-                Err(TrackError::FrameSize {
-                    path: path.clone(),
-                    frame: index,
-                    got_w: image.width(),
-                    got_h: image.height(),
-                    width,
-                    height,
-                })
-            } else {
-                Ok(())
-            }
-        };
-        let mut handle = |ctx_done: &mut usize,
-                          index: usize,
-                          image: Option<Arc<RgbImage>>|
-         -> Result<PerJoint<JointResult>, TrackError> {
-            if cancel.load(Ordering::Relaxed) {
-                return Err(TrackError::Cancelled);
-            }
-            let Some(image) = image else {
-                // A damaged frame: the last pose, lost; the tracker waits for the next frame.
-                let t = tracker
-                    .as_ref()
-                    .ok_or_else(|| TrackError::StartFrameDamaged {
-                        path: path.clone(),
-                        frame: index,
-                    })?;
-                *ctx_done += 1;
-                return Ok(to_video(t.pose().map(|_, j| JointResult {
-                    pos: j.pos,
-                    reliability: 0.0,
-                })));
-            };
-            let result = match tracker.as_mut() {
-                None => {
-                    let work = pose.map(|_, p| scale.to_work(*p));
-                    let t =
-                        BodyTracker::new(&image, &work, &proportions, params, background.clone());
-                    let mut r = t.pose();
-                    for j in Joint::ALL {
-                        r[j].reliability = 1.0;
-                    }
-                    tracker = Some(t);
-                    r
-                }
-                Some(t) => {
-                    let mut r = t.step(&image);
-                    if rekey && keys.frames.contains_key(&index) {
-                        let tracked = r.map(|_, j| j.pos);
-                        let work_keys = keys.frames[&index].map(|_, k| k.map(|p| scale.to_work(p)));
-                        let fixed = tracked.map(|j, p| work_keys[j].unwrap_or(*p));
-                        *t = BodyTracker::new(
-                            &image,
-                            &fixed,
-                            &proportions,
-                            params,
-                            background.clone(),
-                        );
-                        for j in Joint::ALL {
-                            if work_keys[j].is_some() {
-                                r[j] = JointResult {
-                                    pos: fixed[j],
-                                    reliability: 1.0,
-                                };
-                            }
-                        }
-                    }
-                    r
-                }
-            };
-            *ctx_done += 1;
-            Ok(to_video(result))
-        };
-        let mut done = self.done;
-        let total = self.total;
-        let progress = &mut *self.progress;
-        let mut emit = |done: usize, index: usize, r: &PerJoint<JointResult>| {
-            progress(&TrackProgress {
-                done,
-                total,
-                frame: Some(FrameTracks {
-                    index,
-                    points: r.map(|_, j| TrackedPoint {
-                        pos: j.pos,
-                        confidence: j.reliability,
-                        source: PointSource::Tracked,
-                    }),
-                }),
-            });
-        };
-        let damaged = &mut self.damaged;
-        if self.threads <= 1 {
-            for &index in order {
-                let image = match undamaged(self.video.frame(index))? {
-                    Some(frame) => {
-                        check(index, &frame.image)?;
-                        Some(scale.shrink(frame.image))
-                    }
-                    None => {
-                        damaged.push(index);
-                        None
-                    }
-                };
-                let r = handle(&mut done, index, image)?;
-                emit(done, index, &r);
-                out.push(r);
-            }
-        } else {
-            // Decode (and shrink) ahead on another thread.
-            let video = &mut *self.video;
-            let order_owned = order.to_vec();
-            let stop_flag = AtomicBool::new(false);
-            let stop = &stop_flag;
-            std::thread::scope(|s| -> Result<(), TrackError> {
-                type Decoded = Result<(usize, Option<Arc<RgbImage>>), TrackError>;
-                let (tx, rx) = std::sync::mpsc::sync_channel::<Decoded>(6);
-                s.spawn(move || {
-                    for chunk in decode_order(&order_owned) {
-                        let mut images = Vec::with_capacity(chunk.decode.len());
-                        for &index in &chunk.decode {
-                            if stop.load(Ordering::Relaxed) {
-                                return;
-                            }
-                            let item = undamaged(video.frame(index)).and_then(|frame| {
-                                frame
-                                    .map(|frame| {
-                                        check(index, &frame.image)?;
-                                        Ok(scale.shrink(frame.image))
-                                    })
-                                    .transpose()
-                                    .map(|image| (index, image))
-                            });
-                            images.push(item);
-                        }
-                        if chunk.reverse {
-                            images.reverse();
-                        }
-                        for item in images {
-                            if tx.send(item).is_err() {
-                                return;
-                            }
-                        }
-                    }
-                });
-                let result = (|| {
-                    for _ in 0..order.len() {
-                        let (index, image) = rx.recv().map_err(|_| TrackError::Cancelled)??;
-                        if image.is_none() {
-                            damaged.push(index);
-                        }
-                        let r = handle(&mut done, index, image)?;
-                        emit(done, index, &r);
-                        out.push(r);
-                    }
-                    Ok(())
-                })();
-                stop.store(true, Ordering::Relaxed);
-                drop(rx);
-                result
-            })?;
-        }
-        self.done = done;
-        Ok(out)
-    }
-}
-
-/// A decoded frame, `None` when the file is damaged there (the decoder's error for that
-/// frame), or another error.
-fn undamaged(
-    frame: Result<crate::video::Frame, VideoError>,
-) -> Result<Option<crate::video::Frame>, TrackError> {
-    match frame {
-        Ok(f) => Ok(Some(f)),
-        Err(VideoError::Decode { .. }) => Ok(None),
-        Err(e) => Err(e.into()),
-    }
-}
-
-/// A run of frames the decoder reads forwards, sent in reverse for backward passes.
-struct DecodeChunk {
-    decode: Vec<usize>,
-    reverse: bool,
-}
-
-/// Splits a pass's frame order into decoder-friendly chunks (backward passes decode 32 frames
-/// forwards at a time and hand them over in reverse).
-fn decode_order(order: &[usize]) -> Vec<DecodeChunk> {
-    let backward = order.len() > 1 && order[1] < order[0];
-    if !backward {
-        return vec![DecodeChunk {
-            decode: order.to_vec(),
-            reverse: false,
-        }];
-    }
-    order
-        .chunks(32)
-        .map(|c| DecodeChunk {
-            decode: c.iter().rev().copied().collect(),
-            reverse: true,
-        })
-        .collect()
 }
 
 #[cfg(test)]
