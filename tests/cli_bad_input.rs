@@ -96,19 +96,29 @@ fn image_directories_with_no_images_or_mixed_sizes_are_named() {
     assert_bad(&["info", &ds], &["a1.png", "a2.png", "8×7"]);
 }
 
-fn marks_case(
-    name: &str,
-    edit: impl FnOnce(&mut serde_json::Value),
-) -> (tempfile::TempDir, String) {
+/// The sample's marks.json as JSON.
+fn sample_marks() -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(sample_dir().join("marks.json")).unwrap())
+        .unwrap()
+}
+
+/// Writes `v` to a file `name` in a new temporary folder; returns the folder and the path.
+fn written(name: &str, v: &serde_json::Value) -> (tempfile::TempDir, String) {
     let dir = tempfile::tempdir().unwrap();
-    let mut v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(sample_dir().join("marks.json")).unwrap())
-            .unwrap();
-    edit(&mut v);
     let p = dir.path().join(name);
     std::fs::write(&p, v.to_string()).unwrap();
     let s = p.to_str().unwrap().to_owned();
     (dir, s)
+}
+
+/// The sample's marks edited by `edit`, written to `name`.
+fn marks_case(
+    name: &str,
+    edit: impl FnOnce(&mut serde_json::Value),
+) -> (tempfile::TempDir, String) {
+    let mut v = sample_marks();
+    edit(&mut v);
+    written(name, &v)
 }
 
 #[test]
@@ -145,17 +155,12 @@ fn bad_marks_are_named_with_the_joint() {
 
 /// A keys file made from the sample's marks plus `extra` keys.
 fn keys_case(name: &str, extra: serde_json::Value) -> (tempfile::TempDir, String) {
-    let dir = tempfile::tempdir().unwrap();
-    let marks: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(sample_dir().join("marks.json")).unwrap())
-            .unwrap();
-    let mut keys = vec![serde_json::json!({"frame": 0, "joints": marks["joints"]})];
+    let mut keys = vec![serde_json::json!({"frame": 0, "joints": sample_marks()["joints"]})];
     keys.extend(extra.as_array().unwrap().iter().cloned());
-    let v = serde_json::json!({"format": "videomocap.keys", "version": 1, "keys": keys});
-    let p = dir.path().join(name);
-    std::fs::write(&p, v.to_string()).unwrap();
-    let s = p.to_str().unwrap().to_owned();
-    (dir, s)
+    written(
+        name,
+        &serde_json::json!({"format": "videomocap.keys", "version": 1, "keys": keys}),
+    )
 }
 
 #[test]

@@ -5,8 +5,9 @@
 //! the first key holding all 16 starts the track. A project file keeps its keys in the same
 //! shape (its `keys` field).
 
-use super::{FORMAT_VERSION, FormatError, Marks, check_header, parse_json, read_text};
-use crate::camera::point_in_frame;
+use super::{
+    FORMAT_VERSION, FormatError, Marks, check_header, check_on_image, parse_json, read_text,
+};
 use crate::skeleton::{JOINT_COUNT, Joint, PerJoint};
 use nalgebra::Point2;
 use serde::{Deserialize, Serialize};
@@ -161,18 +162,8 @@ impl KeyFrames {
                 });
             }
             for (joint, p) in joints.iter() {
-                if let Some(p) = p
-                    && !point_in_frame(p, width, height)
-                {
-                    return Err(FormatError::OutsideFrame {
-                        path: path.to_owned(),
-                        joint,
-                        x: p.x,
-                        y: p.y,
-                        width,
-                        height,
-                        frame: Some(frame),
-                    });
+                if let Some(p) = p {
+                    check_on_image(path, joint, p, (width, height), frame)?;
                 }
             }
         }

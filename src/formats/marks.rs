@@ -2,8 +2,10 @@
 //!
 //! `{"format":"videomocap.marks","version":1,"frame":0,"joints":{"head_top":[x,y],…}}`
 
-use super::{FORMAT_VERSION, FormatError, check_header, parse_json, read_text, write_atomically};
-use crate::camera::point_in_frame;
+use super::{
+    FORMAT_VERSION, FormatError, check_header, check_on_image, parse_json, read_text,
+    write_atomically,
+};
 use crate::skeleton::{JOINT_COUNT, Joint, PerJoint};
 use nalgebra::Point2;
 use serde::ser::SerializeMap;
@@ -99,17 +101,7 @@ impl Marks {
     /// Checks that every mark lies on a `width × height` frame; names the first one that does not.
     pub fn check_in_frame(&self, path: &Path, width: u32, height: u32) -> Result<(), FormatError> {
         for (joint, p) in self.points.iter() {
-            if !point_in_frame(p, width, height) {
-                return Err(FormatError::OutsideFrame {
-                    path: path.to_owned(),
-                    joint,
-                    x: p.x,
-                    y: p.y,
-                    width,
-                    height,
-                    frame: Some(self.frame),
-                });
-            }
+            check_on_image(path, joint, p, (width, height), self.frame)?;
         }
         Ok(())
     }

@@ -78,6 +78,28 @@ pub(crate) fn parse_json<T: for<'de> Deserialize<'de>>(
     })
 }
 
+/// Checks that a hand-placed point of `joint` on `frame` lies on a `width × height` image.
+pub(crate) fn check_on_image(
+    path: &Path,
+    joint: Joint,
+    p: &nalgebra::Point2<f64>,
+    (width, height): (u32, u32),
+    frame: usize,
+) -> Result<(), FormatError> {
+    if crate::camera::point_in_frame(p, width, height) {
+        return Ok(());
+    }
+    Err(FormatError::OutsideFrame {
+        path: path.to_owned(),
+        joint,
+        x: p.x,
+        y: p.y,
+        width,
+        height,
+        frame: Some(frame),
+    })
+}
+
 /// Checks the optional `format` and `version` fields of a file (version 1 only).
 pub(crate) fn check_header(
     path: &Path,

@@ -308,10 +308,9 @@ fn track_at_working_scale(
         let run_pass =
             |ctx: &mut PassContext,
              order: &[usize],
-             from: &[Option<PerJoint<JointResult>>],
+             (pose, before): (PerJoint<Point2<f64>>, PerJoint<JointResult>),
              into: &mut Vec<Option<PerJoint<JointResult>>>,
              arrived: &mut BTreeMap<usize, PerJoint<JointResult>>| {
-                let (pose, before) = starting(from, order[0]);
                 let out = ctx.pass(order, &pose)?;
                 for (f, r) in order.iter().zip(out.results) {
                     into[*f] = Some(r);
@@ -329,10 +328,11 @@ fn track_at_working_scale(
         // Forwards from the start to the end, then backwards from the last key frame, each
         // re-started at every key frame on the way.
         let forward_frames: Vec<usize> = (start..n).collect();
-        let earlier = forward.clone();
-        run_pass(ctx, &forward_frames, &earlier, forward, &mut arrivals.0)?;
-        if !backward_frames.is_empty() {
-            run_pass(ctx, &backward_frames, forward, backward, &mut arrivals.1)?;
+        let begin = starting(forward, start);
+        run_pass(ctx, &forward_frames, begin, forward, &mut arrivals.0)?;
+        if let Some(&last) = backward_frames.first() {
+            let begin = starting(forward, last);
+            run_pass(ctx, &backward_frames, begin, backward, &mut arrivals.1)?;
         }
         Ok::<(), TrackError>(())
     };
