@@ -1,17 +1,17 @@
 //! The desktop app (eframe/egui): the only place that uses egui and rfd. It calls the library
 //! and never the CLI: every computation (tracking, lifting, exports, projects) is a library call,
 //! heavy ones on worker threads.
+//!
+//! - `state`: what the app knows and does, in plain Rust (open, edit, track, lift, export,
+//!   save, quit), with the workers it owns (frame loader, jobs, autosave, file dialogs).
+//! - `views`: the menu bar, side panel, timeline, frame view, 3D view, status bar and windows;
+//!   each reads the state and returns `intent::Intent`s.
+//! - `app`: the frame loop joining the two.
 
 mod app;
-mod autosave;
-mod dialogs;
-mod frame_loader;
-mod frame_view;
-mod jobs;
-mod lift_settings;
-mod timeline;
-mod view3d;
-mod volume_view;
+mod intent;
+mod state;
+mod views;
 
 use std::path::PathBuf;
 
@@ -30,3 +30,6 @@ pub fn run(video: Option<PathBuf>) -> anyhow::Result<()> {
     )
     .map_err(|e| anyhow::anyhow!("the desktop app could not start: {e}"))
 }
+
+#[cfg(test)]
+mod tests;

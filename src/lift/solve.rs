@@ -161,6 +161,9 @@ pub struct LiftOutput {
     pub per_frame: Skeleton3d,
     /// The root taken by each bone (indexed like [`Bone::ALL`]) per frame, for flipping.
     pub choices: Vec<[Root; BONE_COUNT]>,
+    /// Per frame and bone (indexed like [`Bone::ALL`]), whether the bone's two roots were one
+    /// point (its 2D image too long for its length): flipping it there changes nothing.
+    pub single_root: Vec<[bool; BONE_COUNT]>,
     /// One report per frame.
     pub reports: Vec<FrameReport>,
     /// The frame the camera was calibrated on.
@@ -899,6 +902,7 @@ fn lift_leaning(
         skeleton: final_skeleton,
         per_frame,
         choices: per.resolved.choices,
+        single_root: per.resolved.too_long,
         reports: per.reports,
         calibration_frame: per.calibration_frame,
         refinement,

@@ -40,6 +40,19 @@ impl PointState {
         }
     }
 
+    /// The state in words (the timeline's hover).
+    pub fn word(self) -> &'static str {
+        match self {
+            PointState::Key => "placed by you (white)",
+            PointState::Tracked => "tracked (green)",
+            PointState::Weak => "weak: the tracker is unsure (orange)",
+            PointState::Interpolated => "filled in between sound frames (blue)",
+            PointState::OffFrame => "off the frame: an estimate (purple)",
+            PointState::Lost => "lost: a guess (red)",
+            PointState::Gait => "completed from the gait (pink)",
+        }
+    }
+
     /// Colour used in the frame view and the timeline.
     pub fn colour(self) -> Color32 {
         match self {
@@ -92,6 +105,16 @@ impl Transform {
     }
 }
 
+/// A joint held with the primary button: where it was pressed, where it is now, and whether
+/// the pointer has moved since (a drag starts at the first movement, however quick).
+#[derive(Debug, Clone, Copy)]
+struct Grab {
+    joint: Joint,
+    pressed_at: Pos2,
+    at: Point2<f64>,
+    moved: bool,
+}
+
 /// Zoom and pan of the frame view, and a joint being dragged.
 #[derive(Debug, Clone, Default)]
 pub struct FrameView {
@@ -99,12 +122,17 @@ pub struct FrameView {
     zoom: f32,
     /// Image point at the view's centre (`None` = the image centre).
     centre: Option<Vec2>,
-    dragging: Option<(Joint, Point2<f64>)>,
+    grab: Option<Grab>,
     last: Option<Transform>,
 }
 
 /// Pick radius for joints, screen points.
 const PICK_PX: f32 = 10.0;
+
+/// A held joint follows the pointer once it has moved this far (screen points), however soon
+/// after the press: a hand's jitter on a click stays below it, egui's own drag threshold (6
+/// points, or a long press) missed quick short corrections.
+const DRAG_START_PX: f32 = 2.0;
 
 impl FrameView {
     /// Back to fitting the whole frame.
@@ -189,34 +217,49 @@ impl FrameView {
                 .map(|(j, _)| j)
         };
         let mut event = None;
-        if !panning {
-            if response.drag_started_by(egui::PointerButton::Primary)
-                && let Some(pos) = response.interact_pointer_pos()
-                && let Some(j) = nearest(pos)
-            {
-                self.dragging = Some((j, t.to_image(pos)));
-            }
-            if let Some((j, _)) = self.dragging
-                && let Some(pos) = response.interact_pointer_pos()
-            {
-                self.dragging = Some((j, t.to_image(pos)));
-            }
-            if response.drag_stopped()
-                && let Some((j, p)) = self.dragging.take()
-            {
-                event = Some(ViewEvent::Moved(j, p));
-            }
-            if response.clicked()
-                && let Some(pos) = response.interact_pointer_pos()
-            {
-                event = Some(ViewEvent::Click(t.to_image(pos)));
+        let (pressed, down, released, pointer) = ui.input(|i| {
+            (
+                i.pointer.primary_pressed(),
+                i.pointer.primary_down(),
+                i.pointer.primary_released(),
+                i.pointer.interact_pos(),
+            )
+        });
+        if !panning && pressed && response.hovered() {
+            self.grab = pointer.and_then(|pos| {
+                nearest(pos).map(|joint| Grab {
+                    joint,
+                    pressed_at: pos,
+                    at: t.to_image(pos),
+                    moved: false,
+                })
+            });
+        }
+        if let (Some(g), Some(pos)) = (&mut self.grab, pointer)
+            && (down || released)
+            && (g.moved || pos.distance(g.pressed_at) >= DRAG_START_PX)
+        {
+            g.moved = true;
+            g.at = t.to_image(pos);
+        }
+        if released {
+            match self.grab.take() {
+                Some(g) if g.moved => event = Some(ViewEvent::Moved(g.joint, g.at)),
+                _ => {
+                    if !panning
+                        && response.clicked()
+                        && let Some(pos) = response.interact_pointer_pos()
+                    {
+                        event = Some(ViewEvent::Click(t.to_image(pos)));
+                    }
+                }
             }
         }
 
         // The skeleton: bones, then joints (the dragged one where it is being dragged).
         let at = |j: Joint| -> Option<(Point2<f64>, PointState)> {
-            match self.dragging {
-                Some((d, p)) if d == j => Some((p, PointState::Key)),
+            match self.grab {
+                Some(g) if g.joint == j && g.moved => Some((g.at, PointState::Key)),
                 _ => overlay.points[j],
             }
         };
@@ -270,5 +313,96 @@ pub fn side_colour(j: Joint) -> Color32 {
         Color32::from_rgb(255, 120, 40)
     } else {
         Color32::from_rgb(255, 220, 0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use egui_kittest::Harness;
+
+    /// The view over a 100×100 grey frame with the left wrist at (50, 50), and what it reported.
+    struct Bench {
+        view: FrameView,
+        texture: Option<egui::TextureHandle>,
+        events: Vec<ViewEvent>,
+    }
+
+    fn bench() -> Harness<'static, Bench> {
+        Harness::new_ui_state(
+            |ui, b: &mut Bench| {
+                let texture = b
+                    .texture
+                    .get_or_insert_with(|| {
+                        ui.ctx().load_texture(
+                            "frame",
+                            egui::ColorImage::new([100, 100], vec![Color32::GRAY; 100 * 100]),
+                            egui::TextureOptions::LINEAR,
+                        )
+                    })
+                    .clone();
+                let mut points = PerJoint::from_fn(|_| None);
+                points[Joint::LeftWrist] = Some((Point2::new(50.0, 50.0), PointState::Tracked));
+                let overlay = Overlay {
+                    points,
+                    asking: None,
+                };
+                if let Some(e) = b.view.show(ui, &texture, Vec2::new(100.0, 100.0), &overlay) {
+                    b.events.push(e);
+                }
+            },
+            Bench {
+                view: FrameView::default(),
+                texture: None,
+                events: Vec::new(),
+            },
+        )
+    }
+
+    /// A correction of a few points done at once (press, one small move, release on the next
+    /// frames) is a drag of the joint, not a click.
+    #[test]
+    fn a_quick_short_drag_moves_the_joint() {
+        let mut h = bench();
+        h.run();
+        let t = h.state().view.transform().expect("drawn");
+        let from = t.to_screen(Point2::new(50.0, 50.0));
+        h.hover_at(from);
+        h.step();
+        h.drag_at(from);
+        h.step();
+        h.hover_at(from + Vec2::new(3.0, 0.0));
+        h.step();
+        h.drop_at(from + Vec2::new(3.0, 0.0));
+        h.step();
+        let events = &h.state().events;
+        assert_eq!(events.len(), 1, "{events:?}");
+        let ViewEvent::Moved(j, p) = events[0] else {
+            panic!("not a move: {events:?}");
+        };
+        assert_eq!(j, Joint::LeftWrist);
+        let want = t.to_image(from + Vec2::new(3.0, 0.0));
+        assert!((p - want).norm() < 1e-6, "{p} vs {want}");
+    }
+
+    /// A press and release in place is a click, not a move.
+    #[test]
+    fn a_press_and_release_in_place_is_a_click() {
+        let mut h = bench();
+        h.run();
+        let t = h.state().view.transform().expect("drawn");
+        let at = t.to_screen(Point2::new(50.0, 50.0));
+        h.hover_at(at);
+        h.step();
+        h.drag_at(at);
+        h.step();
+        h.drop_at(at);
+        h.step();
+        h.step();
+        assert!(
+            matches!(h.state().events[..], [ViewEvent::Click(_)]),
+            "{:?}",
+            h.state().events
+        );
     }
 }

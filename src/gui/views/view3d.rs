@@ -10,6 +10,7 @@ use nalgebra::{Point3, Vector3};
 use videomocap::skeleton::{Bone, Joint, PerJoint};
 
 /// What the viewport shows.
+#[derive(Default)]
 pub struct Scene {
     /// The skeleton of the current frame, world metres.
     pub joints: Option<PerJoint<Point3<f64>>>,
@@ -21,7 +22,14 @@ pub struct Scene {
     pub cloud: Vec<(Point3<f64>, Color32)>,
     /// Extra line segments (skeleton curve, bodies), world metres.
     pub segments: Vec<(Point3<f64>, Point3<f64>, Stroke)>,
+    /// Bones the lift flagged on this frame (drawn red).
+    pub flagged: Vec<Bone>,
+    /// Lines written over the view's top-left corner (what the lift flagged, a stale view).
+    pub notes: Vec<String>,
 }
+
+/// Colour of a bone the lift flagged.
+const FLAGGED: Color32 = Color32::from_rgb(230, 60, 60);
 
 /// An orbiting view around a target point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -163,10 +171,15 @@ impl Orbit {
             let hovered = hover.and_then(near_bone);
             for b in Bone::ALL {
                 let width = if hovered == Some(b) { 5.0 } else { 2.5 };
+                let colour = if scene.flagged.contains(&b) {
+                    FLAGGED
+                } else {
+                    side_colour(b.child)
+                };
                 line(
                     &joints[b.parent],
                     &joints[b.child],
-                    Stroke::new(width, side_colour(b.child)),
+                    Stroke::new(width, colour),
                 );
             }
             for (_, p) in joints.iter() {
@@ -191,6 +204,15 @@ impl Orbit {
                 Color32::GRAY,
             );
         }
+        for (k, note) in scene.notes.iter().enumerate() {
+            painter.text(
+                rect.left_top() + Vec2::new(8.0, 8.0 + 16.0 * k as f32),
+                egui::Align2::LEFT_TOP,
+                note,
+                egui::FontId::proportional(13.0),
+                Color32::from_rgb(240, 170, 90),
+            );
+        }
         clicked
     }
 }
@@ -212,10 +234,7 @@ mod tests {
         joints[Joint::Pelvis] = Point3::new(x, 0.9, z);
         Scene {
             joints: Some(joints),
-            camera: None,
-            flippable: Vec::new(),
-            cloud: Vec::new(),
-            segments: Vec::new(),
+            ..Scene::default()
         }
     }
 
