@@ -381,7 +381,8 @@ impl State {
             }
             Picked::Cancelled => self.status = "Export cancelled: nothing written".to_owned(),
             Picked::Unavailable => {
-                self.ask_path(PathPurpose::Export(kind), "Export", folder.join(name));
+                let title = format!("Export {}", kind.label().trim_end_matches('…'));
+                self.ask_path(PathPurpose::Export(kind), &title, folder.join(name));
             }
         }
     }

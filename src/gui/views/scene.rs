@@ -69,20 +69,31 @@ pub fn scene(state: &State) -> Scene {
         .binary_search_by_key(&current, |f| f.index)
         .ok()
         .map(|k| &skeleton.frames[k].flags);
+    let mut too_long = Vec::new();
     for flag in flags.into_iter().flatten() {
-        scene.notes.push(format!("flagged: {}", plain_flag(flag)));
-        if let Some(bone) = flag.strip_prefix("too_long:").and_then(Bone::from_key) {
-            scene.flagged.push(bone);
+        match flag.strip_prefix("too_long:").and_then(Bone::from_key) {
+            Some(bone) => too_long.push(bone),
+            None => scene.notes.push(format!("flagged: {}", plain_flag(flag))),
         }
+    }
+    if !too_long.is_empty() {
+        let what = if too_long.len() == 1 {
+            "1 bone (red) looks".to_owned()
+        } else {
+            format!("{} bones (red) look", too_long.len())
+        };
+        scene.notes.insert(
+            0,
+            format!("flagged: {what} longer in the image than it can be"),
+        );
+        scene.flagged = too_long;
     }
     scene
 }
 
 /// A lift flag in words.
 fn plain_flag(flag: &str) -> String {
-    if let Some(bone) = flag.strip_prefix("too_long:") {
-        format!("{bone} looks longer than it is (off its ray)")
-    } else if flag == "key_triangle_not_converged" {
+    if flag == "key_triangle_not_converged" {
         "the trunk's pose did not fit its three points".to_owned()
     } else if let Some(j) = flag.strip_prefix(videomocap::formats::OFF_FRAME_FLAG) {
         format!("{j} off the frame")

@@ -30,13 +30,16 @@ fn progress(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
         out.push(Intent::Cancel);
     }
     let (share, per_s, left) = job.rate();
-    let text = match left {
-        Some(s) => format!(
-            "{} ({}) {}/{} · {per_s:.1}/s · {s:.0} s left",
-            job.what, job.stage, job.done, job.total
-        ),
-        None => format!("{} ({}) {}/{}", job.what, job.stage, job.done, job.total),
-    };
+    let mut text = job.what.to_owned();
+    if !job.stage.is_empty() {
+        text += &format!(" ({})", job.stage);
+    }
+    if job.total > 0 {
+        text += &format!(" {}/{}", job.done, job.total);
+    }
+    if let Some(s) = left {
+        text += &format!(" · {per_s:.1}/s · {s:.0} s left");
+    }
     ui.add(
         egui::ProgressBar::new(share)
             .desired_width(360.0)

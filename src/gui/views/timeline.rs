@@ -14,7 +14,7 @@ use videomocap::track::KeyFrames;
 /// Width of the joint names left of the strips, points.
 pub const LABEL_W: f32 = 44.0;
 /// Height of one joint's strip, points.
-const STRIP_H: f32 = 8.0;
+const STRIP_H: f32 = 9.0;
 /// Height of the rows of ticks above the strips (key frames, then flagged frames), points.
 const TICKS_H: f32 = 5.0;
 

@@ -9,6 +9,22 @@ use std::path::PathBuf;
 /// The user guide, built into the app.
 const GUIDE: &str = include_str!("../../../docs/guide.md");
 
+/// The guide as the window shows it: without its screenshot (the app draws no images) and
+/// with "▸", which egui's fonts lack, as ">".
+static GUIDE_SHOWN: std::sync::LazyLock<String> = std::sync::LazyLock::new(|| {
+    let mut text = GUIDE.replace('▸', ">");
+    while let Some(start) = text.find("![") {
+        let Some(end) = text[start..]
+            .find("](")
+            .and_then(|k| text[start + k..].find(')').map(|e| start + k + e + 1))
+        else {
+            break;
+        };
+        text.replace_range(start..end, "");
+    }
+    text
+});
+
 /// The keyboard and mouse shortcuts listed in the F1 window.
 pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Left / Right", "previous / next frame"),
@@ -69,7 +85,7 @@ pub fn show(
             .default_size([640.0, 560.0])
             .vscroll(true)
             .show(ctx, |ui| {
-                egui_commonmark::CommonMarkViewer::new().show(ui, guide, GUIDE);
+                egui_commonmark::CommonMarkViewer::new().show(ui, guide, &GUIDE_SHOWN);
             });
         if !open {
             out.push(Intent::Guide(false));
@@ -114,7 +130,7 @@ fn save_changes(ctx: &egui::Context, to: &Leave, out: &mut Vec<Intent>) {
             if ui.button("Don't save").clicked() {
                 out.push(Intent::AnswerSave(SaveAnswer::Discard));
             }
-            if ui.button("Cancel").clicked() {
+            if ui.button("Cancel").clicked() || ui.input(|i| i.key_pressed(egui::Key::Escape)) {
                 out.push(Intent::AnswerSave(SaveAnswer::Cancel));
             }
         });
@@ -134,6 +150,10 @@ fn path_field(ctx: &egui::Context, state: &State, out: &mut Vec<Intent>) {
                 .desired_width(520.0)
                 .id_salt("path field"),
         );
+        // The field holds the keyboard while the window is open: type, then Enter.
+        if !edit.has_focus() && !edit.lost_focus() {
+            edit.request_focus();
+        }
         if text != request.text {
             out.push(Intent::PathEdited(text.clone()));
         }
@@ -145,9 +165,21 @@ fn path_field(ctx: &egui::Context, state: &State, out: &mut Vec<Intent>) {
             if ui.button("OK").clicked() || enter {
                 out.push(Intent::PathChosen(Some(PathBuf::from(text.trim()))));
             }
-            if ui.button("Cancel").clicked() {
+            if ui.button("Cancel").clicked() || ui.input(|i| i.key_pressed(egui::Key::Escape)) {
                 out.push(Intent::PathChosen(None));
             }
         });
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_guide_is_shown_without_images_or_glyphs_the_fonts_lack() {
+        assert!(GUIDE.contains("![") && GUIDE.contains('▸'));
+        assert!(!GUIDE_SHOWN.contains("![") && !GUIDE_SHOWN.contains('▸'));
+        assert!(GUIDE_SHOWN.contains("Export to Blender"));
+    }
 }
