@@ -135,7 +135,7 @@ impl LengthOrigin {
             LengthOrigin::Read => "read",
             LengthOrigin::Table => "table",
             LengthOrigin::Held => "held to the table's range",
-            LengthOrigin::Unseen => "table: never seen square",
+            LengthOrigin::Unseen => "table: never seen face-on",
             LengthOrigin::Given => "given",
         }
     }

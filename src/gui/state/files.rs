@@ -1,77 +1,17 @@
 //! The state's file actions: open (video, image folder, project, point volumes, marks), the
-//! recent list, recovery of an autosaved session, save, export, and leaving (opening something
-//! else, quitting) with "save changes?" first. Every save and export ends with a status line
-//! naming the file written or saying why not; when no file dialog can be shown, the app's own
-//! path field asks instead.
+//! recent list, recovery of an autosaved session, save, and leaving (opening something else,
+//! quitting) with "save changes?" first. Every save ends with a status line naming the file
+//! written or saying why not; when no file dialog can be shown, the app's own path field asks
+//! instead (for exports too: `export`).
 
 use super::file_dialogs::Picked;
 use super::frame_loader::FrameLoader;
 use super::jobs::Job;
 use super::volume::VolumeSequence;
-use super::{Running, State};
+use super::{ExportKind, Running, State};
 use std::path::{Path, PathBuf};
-use videomocap::export;
 use videomocap::formats::Marks;
 use videomocap::project::Project;
-
-/// Things the export menu can write.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ExportKind {
-    /// The motion as BVH.
-    Bvh,
-    /// The 2D tracks (tracks2d.json).
-    TracksJson,
-    /// The 3D skeleton (skeleton3d.json).
-    SkeletonJson,
-    /// The 2D tracks as CSV.
-    TracksCsv,
-    /// The 3D joints as CSV.
-    JointsCsv,
-    /// OpenSim markers.
-    Trc,
-    /// The marks (marks.json).
-    Marks,
-}
-
-impl ExportKind {
-    /// Every export, in menu order.
-    pub const ALL: [ExportKind; 7] = [
-        ExportKind::Bvh,
-        ExportKind::TracksJson,
-        ExportKind::SkeletonJson,
-        ExportKind::TracksCsv,
-        ExportKind::JointsCsv,
-        ExportKind::Trc,
-        ExportKind::Marks,
-    ];
-
-    /// The menu entry.
-    pub fn label(self) -> &'static str {
-        match self {
-            ExportKind::Bvh => "BVH (Blender, motion builders)…",
-            ExportKind::TracksJson => "2D tracks (tracks2d.json)…",
-            ExportKind::SkeletonJson => "3D skeleton (skeleton3d.json)…",
-            ExportKind::TracksCsv => "2D tracks CSV…",
-            ExportKind::JointsCsv => "3D joints CSV…",
-            ExportKind::Trc => "OpenSim markers (.trc)…",
-            ExportKind::Marks => "Marks (marks.json)…",
-        }
-    }
-
-    /// The file name proposed, after the video's name.
-    fn file_name(self, stem: &str) -> String {
-        let suffix = match self {
-            ExportKind::Bvh => ".bvh",
-            ExportKind::TracksJson => ".tracks2d.json",
-            ExportKind::SkeletonJson => ".skeleton3d.json",
-            ExportKind::TracksCsv => ".tracks2d.csv",
-            ExportKind::JointsCsv => ".joints3d.csv",
-            ExportKind::Trc => ".trc",
-            ExportKind::Marks => ".marks.json",
-        };
-        format!("{stem}{suffix}")
-    }
-}
 
 /// What can be opened from the File menu.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -145,7 +85,7 @@ pub struct PathRequest {
 }
 
 /// The status line when no dialog could be shown.
-const NO_DIALOG: &str = "No file dialog could be shown on this desktop (no XDG portal, zenity or \
+pub(super) const NO_DIALOG: &str = "No file dialog could be shown on this desktop (no XDG portal, zenity or \
      kdialog): type the path in the window instead";
 
 impl State {
@@ -230,7 +170,7 @@ impl State {
     }
 
     /// The folder files are proposed in: the project's, else the video's.
-    fn default_folder(&self) -> PathBuf {
+    pub(super) fn default_folder(&self) -> PathBuf {
         self.project_path
             .as_deref()
             .or_else(|| self.project.as_ref().map(|p| p.video.as_path()))
@@ -241,14 +181,14 @@ impl State {
     }
 
     /// The video's name without its extension (names proposed for saves and exports).
-    fn video_stem(&self) -> String {
+    pub(super) fn video_stem(&self) -> String {
         self.project
             .as_ref()
             .and_then(|p| p.video.file_stem())
             .map_or_else(|| "motion".to_owned(), |s| s.to_string_lossy().into_owned())
     }
 
-    fn ask_path(&mut self, purpose: PathPurpose, title: &str, default: PathBuf) {
+    pub(super) fn ask_path(&mut self, purpose: PathPurpose, title: &str, default: PathBuf) {
         self.no_native_dialogs = true;
         self.status = NO_DIALOG.to_owned();
         self.path_request = Some(PathRequest {
@@ -362,86 +302,6 @@ impl State {
             }
             Err(e) => self.status = format!("Not saved: {e}"),
         }
-    }
-
-    /// Asks where to write an export, then writes it.
-    pub(super) fn export(&mut self, kind: ExportKind) {
-        let name = kind.file_name(&self.video_stem());
-        let folder = self.default_folder();
-        let picked = if self.no_native_dialogs {
-            Picked::Unavailable
-        } else {
-            self.config
-                .dialogs
-                .save_file("Export", Some(&folder), &name)
-        };
-        match picked {
-            Picked::Path(path) => {
-                let _ = self.export_to(kind, &path);
-            }
-            Picked::Cancelled => self.status = "Export cancelled: nothing written".to_owned(),
-            Picked::Unavailable => {
-                let title = format!("Export {}", kind.label().trim_end_matches('…'));
-                self.ask_path(PathPurpose::Export(kind), &title, folder.join(name));
-            }
-        }
-    }
-
-    /// Writes one export to `path`; the status line names the file or the reason.
-    pub(super) fn export_to(&mut self, kind: ExportKind, path: &Path) -> Result<(), String> {
-        let result = self.write_export(kind, path).map_err(|e| e.to_string());
-        self.status = match &result {
-            Ok(()) => format!("Wrote {}", path.display()),
-            Err(e) => format!("Nothing written to {}: {e}", path.display()),
-        };
-        result
-    }
-
-    fn write_export(&self, kind: ExportKind, path: &Path) -> anyhow::Result<()> {
-        let p = self
-            .project
-            .as_ref()
-            .ok_or_else(|| anyhow::anyhow!("no video open"))?;
-        let need_tracks = || {
-            p.tracks
-                .as_deref()
-                .ok_or_else(|| anyhow::anyhow!("nothing tracked yet (Track > Track and lift)"))
-        };
-        let need_world = || {
-            self.world
-                .as_ref()
-                .map(|(w, _)| w)
-                .ok_or_else(|| anyhow::anyhow!("no 3D skeleton yet (Track > Track and lift)"))
-        };
-        match kind {
-            ExportKind::Bvh => {
-                let b = export::bvh(need_world()?)?;
-                export::save_text(path, &b.text)?;
-            }
-            ExportKind::TracksJson => need_tracks()?.save(path)?,
-            ExportKind::SkeletonJson => p
-                .skeleton
-                .as_deref()
-                .ok_or_else(|| anyhow::anyhow!("no 3D skeleton yet (Track > Track and lift)"))?
-                .save(path)?,
-            ExportKind::TracksCsv => {
-                export::save_text(path, &export::tracks_csv(need_tracks()?))?;
-            }
-            ExportKind::JointsCsv => {
-                export::save_text(path, &export::skeleton_csv(need_world()?))?;
-            }
-            ExportKind::Trc => {
-                let name = path
-                    .file_name()
-                    .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-                export::save_text(path, &export::trc(need_world()?, &name))?;
-            }
-            ExportKind::Marks => p
-                .marks()
-                .ok_or_else(|| anyhow::anyhow!("not all 16 joints are marked on one frame"))?
-                .save(path)?,
-        }
-        Ok(())
     }
 
     /// Accepts or declines the recovery offered at start.

@@ -3,13 +3,14 @@
 //! what is derived from the results (reliability strips, weak spans, the 3D world). The views
 //! read it and return [`Intent`]s; [`State::apply`] carries them out.
 //!
-//! The actions live by subject: `files` (open, save, export, quit, the path field), `edit`
+//! The actions live by subject: `files` (open, save, quit, the path field), `export`, `edit`
 //! (marks, corrections, settings, flips, undo), `work` (tracking and lifting jobs, decoded
 //! frames arriving). The workers it owns: [`frame_loader`], [`jobs`], [`autosave`], and the
 //! desktop's [`file_dialogs`].
 
 pub mod autosave;
 mod edit;
+mod export;
 pub mod file_dialogs;
 mod files;
 pub mod frame_loader;
@@ -17,7 +18,8 @@ pub mod jobs;
 pub mod volume;
 mod work;
 
-pub use files::{Choose, ExportKind, Leave, PathRequest, SaveAnswer};
+pub use export::ExportKind;
+pub use files::{Choose, Leave, PathPurpose, PathRequest, SaveAnswer};
 
 use crate::gui::intent::Intent;
 use crate::gui::views::frame_view::PointState;

@@ -21,6 +21,25 @@ fn with_sample(dialogs: &PreparedDialogs, state: &Path) -> Harness<'static, App>
     h
 }
 
+/// The path field's request (it must be showing).
+fn path_field(h: &Harness<'_, App>) -> crate::gui::state::PathRequest {
+    h.state()
+        .state()
+        .path_request()
+        .cloned()
+        .expect("the path field")
+}
+
+/// Types `path` into the path field and presses OK.
+fn answer_path(h: &mut Harness<'_, App>, path: &Path) {
+    h.state_mut()
+        .state_mut()
+        .apply(Intent::PathEdited(path.display().to_string()));
+    h.run_steps(2);
+    h.get_by_label("OK").click();
+    h.run_steps(3);
+}
+
 /// On a desktop where no file dialog can be shown, Export and Save open the app's own path
 /// field with the folder and name filled in; a path that cannot be written keeps the window
 /// open saying why; a good one writes the file and the status line names it.
@@ -35,12 +54,7 @@ fn without_a_file_dialog_the_path_field_asks_and_the_status_names_the_file() {
     h.run_steps(3);
     h.get_by_label("Marks (marks.json)…").click();
     h.run_steps(3);
-    let request = h
-        .state()
-        .state()
-        .path_request()
-        .cloned()
-        .expect("the path field");
+    let request = path_field(&h);
     let proposed = sample_clip().with_file_name("video.marks.json");
     assert_eq!(request.text, proposed.display().to_string());
     assert!(
@@ -52,12 +66,7 @@ fn without_a_file_dialog_the_path_field_asks_and_the_status_names_the_file() {
 
     // A folder that does not exist: the window stays and says why.
     let bad = dir.path().join("missing/folder/marks.json");
-    h.state_mut()
-        .state_mut()
-        .apply(Intent::PathEdited(bad.display().to_string()));
-    h.run_steps(2);
-    h.get_by_label("OK").click();
-    h.run_steps(3);
+    answer_path(&mut h, &bad);
     let request = h.state().state().path_request().cloned();
     assert!(
         request.as_ref().and_then(|r| r.error.as_ref()).is_some(),
@@ -66,12 +75,7 @@ fn without_a_file_dialog_the_path_field_asks_and_the_status_names_the_file() {
     assert!(!bad.exists());
 
     let good = dir.path().join("marks.json");
-    h.state_mut()
-        .state_mut()
-        .apply(Intent::PathEdited(good.display().to_string()));
-    h.run_steps(2);
-    h.get_by_label("OK").click();
-    h.run_steps(3);
+    answer_path(&mut h, &good);
     assert!(h.state().state().path_request().is_none());
     assert!(good.is_file());
     assert_eq!(
@@ -82,12 +86,7 @@ fn without_a_file_dialog_the_path_field_asks_and_the_status_names_the_file() {
     // Save goes straight to the path field now (the dialog is known to be missing).
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
     h.run_steps(3);
-    let request = h
-        .state()
-        .state()
-        .path_request()
-        .cloned()
-        .expect("the path field");
+    let request = path_field(&h);
     assert_eq!(
         request.text,
         sample_clip()
@@ -96,12 +95,7 @@ fn without_a_file_dialog_the_path_field_asks_and_the_status_names_the_file() {
             .to_string()
     );
     let project = dir.path().join("p.videomocap.json");
-    h.state_mut()
-        .state_mut()
-        .apply(Intent::PathEdited(project.display().to_string()));
-    h.run_steps(2);
-    h.get_by_label("OK").click();
-    h.run_steps(3);
+    answer_path(&mut h, &project);
     assert!(project.is_file(), "{}", h.state().state().status());
     assert_eq!(
         h.state().state().status(),
