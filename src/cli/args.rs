@@ -341,10 +341,12 @@ pub struct BenchArgs {
     #[arg(long)]
     pub lift_settings: Option<PathBuf>,
     /// Which clips `bench track`, `lift` and `correct` measure: all, dev (the synthetic dev
-    /// split and the real clips: the ones to tune on) or test (the synthetic test split).
+    /// split and the real clips: the ones to tune on) or test (the synthetic test split);
+    /// `bench volume` with dev or test measures only the suite's takes of that split.
     #[arg(long, default_value = "all")]
     pub split: String,
-    /// Only the clips whose name contains this (to look at one clip of the split).
+    /// Only the clips (for `bench volume`, the takes) whose name contains this (to look at one
+    /// clip of the split).
     #[arg(long)]
     pub clip: Option<String>,
     /// `bench lift` only: leave out input (c), the tracker's output (tracking is most of the

@@ -2,7 +2,8 @@
 //! topology (share of frames whose skeleton curve had five limbs), joint position error in
 //! millimetres with left and right matched once per sequence (the paper labels limbs arm1/arm2,
 //! leg1/leg2, never left/right), the same per frame, and limb-label consistency (share of frames
-//! whose best per-frame matching equals the sequence's).
+//! whose best per-frame matching equals the sequence's); and, as a user gets them, the error with
+//! left and right as reported (nothing forgiven) and the share of frames whose sides are right.
 
 use crate::formats::Skeleton3d;
 use crate::skeleton::{Joint, PerJoint};
@@ -16,12 +17,17 @@ pub struct VolumeScore {
     pub frames: usize,
     /// Frames whose skeleton curve had the right five-limb topology.
     pub topology_ok: usize,
+
     /// Joint samples scored (16 per output frame).
     pub samples: usize,
     /// Sum of joint errors with one left/right matching for the sequence, metres.
     pub sum_m: f64,
     /// Sum of joint errors with the best matching per frame, metres.
     pub sum_frame_matched_m: f64,
+    /// Sum of joint errors with left and right as reported, metres.
+    pub sum_reported_m: f64,
+    /// Output frames whose reported sides are the best matching (arms and legs).
+    pub sides_right: usize,
     /// Output frames whose best per-frame matching equals the sequence's.
     pub consistent: usize,
     /// Output frames scored.
@@ -33,9 +39,12 @@ impl VolumeScore {
     pub fn merge(&mut self, o: &VolumeScore) {
         self.frames += o.frames;
         self.topology_ok += o.topology_ok;
+
         self.samples += o.samples;
         self.sum_m += o.sum_m;
         self.sum_frame_matched_m += o.sum_frame_matched_m;
+        self.sum_reported_m += o.sum_reported_m;
+        self.sides_right += o.sides_right;
         self.consistent += o.consistent;
         self.scored_frames += o.scored_frames;
     }
@@ -50,6 +59,14 @@ impl VolumeScore {
     /// Mean joint error, millimetres (per-frame matching).
     pub fn mean_frame_matched_mm(&self) -> f64 {
         1000.0 * self.sum_frame_matched_m / self.samples.max(1) as f64
+    }
+    /// Mean joint error with left and right as reported, millimetres.
+    pub fn mean_reported_mm(&self) -> f64 {
+        1000.0 * self.sum_reported_m / self.samples.max(1) as f64
+    }
+    /// Share of output frames whose reported left and right are the best matching.
+    pub fn sides_right_share(&self) -> f64 {
+        self.sides_right as f64 / self.scored_frames.max(1) as f64
     }
     /// Share of frames whose labels agree with the sequence's matching.
     pub fn consistency(&self) -> f64 {
@@ -134,6 +151,10 @@ pub fn score_volume(truth: &Skeleton3d, result: &Skeleton3d, topology_ok: usize)
         let best = [plain[0].min(both[0]), plain[1].min(both[1])];
         s.sum_m += seq[0] + seq[1];
         s.sum_frame_matched_m += best[0] + best[1];
+        s.sum_reported_m += plain[0] + plain[1];
+        if plain[0] <= both[0] && plain[1] <= both[1] {
+            s.sides_right += 1;
+        }
         s.samples += 16;
         s.scored_frames += 1;
         let agrees = (swap_arms == (both[0] < plain[0])) && (swap_legs == (both[1] < plain[1]));
