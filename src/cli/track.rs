@@ -10,9 +10,7 @@ use videomocap::eval::score_tracks;
 use videomocap::formats::{KeyFrames, Marks};
 use videomocap::project::Project;
 use videomocap::synth::GroundTruth;
-use videomocap::track::{
-    LimbPair, SpanKind, TrackError, TrackJob, TrackOutput, TrackerParams, track_video,
-};
+use videomocap::track::{SpanKind, TrackError, TrackJob, TrackOutput, TrackerParams, track_video};
 use videomocap::video::{OpenOptions, Video};
 
 /// Opens the video and the hand-placed joints (a marks file or a keys file) and checks that
@@ -115,41 +113,14 @@ pub fn report(out: &TrackOutput, global: &GlobalArgs) {
     say(
         global,
         &format!(
-            "{} frames tracked (working scale 1/{:.2}); {} short weak runs interpolated, {} weak spans left for review ({} of them off the frame, {} completed from the gait)",
+            "{} frames tracked (working scale 1/{:.2}); {} short weak runs interpolated, {} weak spans left for review ({} of them off the frame)",
             out.tracks.frames.len(),
             out.shrink,
             interpolated,
             weak.len(),
             count(SpanKind::OffFrame),
-            count(SpanKind::Gait),
         ),
     );
-    if let Some(t) = out.gait.trunk.as_ref().filter(|t| t.frames > 0) {
-        say(
-            global,
-            &format!(
-                "  gait: shoulders and hips of {} frames set to the perspective of a side-on trunk (heading {:.0}°)",
-                t.frames, t.heading_deg
-            ),
-        );
-    }
-    for g in out.gait.limbs.iter().filter(|g| g.completed > 0) {
-        say(
-            global,
-            &format!(
-                "  gait: {} joint-frames of the {} {} completed from the {} side's stride (period {:.2} s, median disagreement {:.2} torso)",
-                g.completed,
-                g.far(),
-                match g.limbs {
-                    LimbPair::Arms => "arm",
-                    LimbPair::Legs => "leg",
-                },
-                g.donor,
-                g.period_s.unwrap_or(0.0),
-                g.disagreement.unwrap_or(0.0),
-            ),
-        );
-    }
     if let (Some(first), Some(last)) = (out.damaged.first(), out.damaged.last()) {
         let place = if first == last {
             format!("frame {first}")

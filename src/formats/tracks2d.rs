@@ -48,8 +48,9 @@ pub enum PointSource {
     /// In a weak run too long to interpolate (or at an end of the video): the position is the
     /// tracker's guess, to be checked (a long occlusion, or a lost joint).
     Lost,
-    /// Completed from the gait (beyond the paper, [`crate::track::gait`]): a far limb hidden
-    /// in a side view, put where the other side's limb was half a stride earlier and later.
+    /// Completed from the gait: a far limb hidden in a side view, put where the other side's
+    /// limb was half a stride earlier and later (written by versions before 2026-11-28; read
+    /// and shown as it is).
     Gait,
 }
 

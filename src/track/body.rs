@@ -13,8 +13,8 @@ use super::block::{MorphBlock, wrap_angle};
 use super::head::HeadPredictor;
 use super::params::TrackerParams;
 use super::search::{
-    AngularParams, ChainRoot, ChainSegment, Found, Prior, SpiralParams, angular, angular_below,
-    refine_chain, spiral,
+    AngularParams, ChainRoot, ChainSegment, Found, Prior, SpiralParams, angular, refine_chain,
+    spiral,
 };
 use super::similarity::{Extent, FloatFrame, FrameView, Template};
 use crate::camera::point_in_frame;
@@ -68,8 +68,7 @@ struct Part {
     /// How far along its bone the part is sampled.
     extent: Extent,
     /// What the block pays per unit of ln(full length / length) when shorter than its full
-    /// length: [`TrackerParams::short_penalty`] for the legs, the upper arms' own
-    /// [`TrackerParams::upper_arm_short_penalty`], the forearms' own
+    /// length: [`TrackerParams::short_penalty`] for the legs and upper arms, the forearms' own
     /// [`TrackerParams::forearm_short_penalty`], 0 for the head, trunk and hip patch.
     short_penalty: f32,
 }
@@ -169,8 +168,6 @@ pub struct BodyTracker {
     predictor: HeadPredictor,
     /// The head block's length on the marked frame, pixels.
     marked_head_m: f64,
-    /// The trunk block's length on the marked frame, pixels.
-    marked_trunk_m: f64,
     /// The static camera's background, when there is one: the fourth lane of every frame.
     background: Option<Arc<Background>>,
     /// The head's zoom since the marking (never below 1): every length limit is multiplied by
@@ -182,16 +179,6 @@ pub struct BodyTracker {
     prev: FloatFrame,
     /// A spare buffer the next frame is converted into (reused: no allocation per frame).
     spare: FloatFrame,
-}
-
-/// The highest cost a match may have and still be sound (its reliability at least
-/// `weak_reliability`): the inverse of [`reliability`].
-fn sound_cost(p: &TrackerParams) -> f32 {
-    if p.weak_reliability > 0.0 {
-        p.reliability_c0 * (1.0 / p.weak_reliability - 1.0)
-    } else {
-        f32::INFINITY
-    }
 }
 
 fn reliability(cost: f32, c0: f32) -> f32 {
@@ -239,9 +226,6 @@ impl BodyTracker {
                 extent: extent(kind),
                 short_penalty: match kind {
                     BodyPart::Head | BodyPart::Trunk => 0.0,
-                    BodyPart::LeftUpperArm | BodyPart::RightUpperArm => {
-                        params.upper_arm_short_penalty
-                    }
                     BodyPart::LeftForearm | BodyPart::RightForearm => params.forearm_short_penalty,
                     _ => params.short_penalty,
                 },
@@ -310,7 +294,6 @@ impl BodyTracker {
             root_shift: [(0.0, 0.0); 4],
             predictor: HeadPredictor::default(),
             marked_head_m: pose_head_m,
-            marked_trunk_m: trunk_block.m,
             background,
             zoom: 1.0,
             head_velocity: nalgebra::Vector2::zeros(),
@@ -400,7 +383,7 @@ impl BodyTracker {
             d_theta: p.head_d_theta_deg.to_radians(),
             d_m: p.head_d_m,
             max_rings: p.head_max_rings,
-            m_bounds: (self.shortest_head(), f64::INFINITY),
+            m_bounds: (0.0, f64::INFINITY),
         };
         let starts = [
             motion.displacement,
@@ -489,46 +472,28 @@ impl BodyTracker {
             let (u, v) = self.trunk_points[k];
             self.trunk.block.to_image(u, v)
         });
-        // The legs as they were, for their second look.
-        let before =
-            (p.twin_guard_torso > 0.0).then(|| [LEGS.0, LEGS.1].map(|c| self.limbs[c].clone()));
         let chain_root = |k: usize| ChainRoot {
             at: roots[k],
             spring: shoulder_spring(k, &p).map(|s| (rigid[k], s)),
         };
-        let track_chain = |parts: &mut [Part; 2], k: usize, second_look: Option<Bars>| {
-            track_limb(
-                parts,
-                chain_root(k),
-                trunk_angles,
-                frame,
-                &p,
-                zoom,
-                Look {
-                    second: second_look,
-                    rescue: p.arm_rescue && k != LEGS.0 && k != LEGS.1,
-                },
-            )
+        let track_chain = |parts: &mut [Part; 2], k: usize| {
+            track_limb(parts, chain_root(k), trunk_angles, frame, &p, zoom)
         };
         let [a, b, c, d] = &mut self.limbs;
-        let free = None;
-        let mut new_roots = if p.parallel {
+        let new_roots = if p.parallel {
             let ((ra, rb), (rc, rd)) = rayon::join(
-                || rayon::join(|| track_chain(a, 0, free), || track_chain(b, 1, free)),
-                || rayon::join(|| track_chain(c, 2, free), || track_chain(d, 3, free)),
+                || rayon::join(|| track_chain(a, 0), || track_chain(b, 1)),
+                || rayon::join(|| track_chain(c, 2), || track_chain(d, 3)),
             );
             [ra, rb, rc, rd]
         } else {
             [
-                track_chain(a, 0, free),
-                track_chain(b, 1, free),
-                track_chain(c, 2, free),
-                track_chain(d, 3, free),
+                track_chain(a, 0),
+                track_chain(b, 1),
+                track_chain(c, 2),
+                track_chain(d, 3),
             ]
         };
-        if let Some(before) = before {
-            self.reacquire_legs(&before, &mut new_roots, &track_chain, &p);
-        }
         for (c, r) in new_roots.iter().enumerate() {
             if shoulder_spring(c, &p).is_some() {
                 let (u, v) = self.trunk.block.to_block(*r);
@@ -556,83 +521,6 @@ fn hip_patch(pelvis: Point2<f64>, theta: f64, trunk_m: f64, trunk_n: f64) -> Mor
 }
 
 impl BodyTracker {
-    /// Beyond the paper: a second look at the legs when their knees or ankles were tracked
-    /// onto one spot, within [`TrackerParams::twin_guard_torso`] of the torso's length. In a
-    /// side view the far leg's blocks slide onto the near leg (the same trousers) and stay
-    /// there with a good score while the far leg runs on in plain view. Each leg is searched
-    /// again from where it was a frame earlier (`before`, left then right), over the wide
-    /// range, without the angle prior (its prediction rode on the other leg) and with the
-    /// other leg's joints barred within [`TWIN_BAR`] times that distance; when a leg matches
-    /// there at least as well as it did on the shared spot (the sum of its two segments'
-    /// reliabilities), it moves, the better of the two if both do. Legs truly together (feet
-    /// side by side) find nothing as good elsewhere and stay. Arms are left alone: the same
-    /// second look for them never moved one on the suite or the real sample, and in side
-    /// views, where the arms overlap all the time, it doubled the tracking time. `track`
-    /// tracks chain `k` (with bars: its second look) and returns its root.
-    ///
-    /// What is left: on walk_across_side and run_side both legs' blocks settle on the stance
-    /// leg for most of each swing (PCK@0.2 0.82 and 0.77). The second look finds the swing leg
-    /// on nearly every such frame, but matching it scores 0.1 to 0.3 lower (summed
-    /// reliabilities) than the shared spot, so neither leg moves. Measured on `bench track`'s
-    /// suite and not kept (suite PCK@0.2 0.911 then, before the upper arms' own pull): moving a
-    /// leg whenever both its joints share the spot, whatever it loses, 0.885 (it often moves
-    /// the stance leg's own blocks); choosing which leg moves by how near the found swing leg
-    /// lies to each leg's ankle extrapolated from the last frames they were apart, 0.912; that
-    /// and barring the moved leg from the other for the next frames, 0.898; the angle prior
-    /// three or ten times as strong while the knees are close, 0.907 or 0.897. Measured later
-    /// (against 0.903): comparing the two places by the key-frame colours alone (the adaptive
-    /// model has learnt the shared spot), 0.898; a backward pass from the first frame after
-    /// each run of merged legs, taking its legs where they are apart, 0.904 (walk_across_side
-    /// 0.816 → 0.819): going backwards the legs merge as well (of 35 merged frames, 4 came
-    /// apart), the static stance leg capturing the swinging leg's blocks in either direction;
-    /// blurring every frame (`image`'s fast_blur, σ 0.8–1.5 or 3, against the moving leg's
-    /// compression artefacts), 0.894 / 0.876; thighs and shanks sampled only to their far
-    /// joint (a bent swing knee puts background where a straight leg's template has the
-    /// shank), 0.896.
-    fn reacquire_legs(
-        &mut self,
-        before: &[[Part; 2]; 2],
-        roots: &mut [Point2<f64>; 4],
-        track: &TrackChain,
-        p: &TrackerParams,
-    ) {
-        let (a, b) = LEGS;
-        let near = p.twin_guard_torso * self.trunk.block.m;
-        let end = |c: usize, k: usize| self.limbs[c][k].block.end();
-        let close = [0, 1].map(|k| (end(a, k) - end(b, k)).norm() <= near);
-        if !close.contains(&true) {
-            return;
-        }
-        let reliability = |parts: &[Part; 2]| parts[0].reliability + parts[1].reliability;
-        let mut best: Option<(f32, usize, [Part; 2], Point2<f64>)> = None;
-        for (i, (c, other)) in [(a, b), (b, a)].into_iter().enumerate() {
-            let bars = [0, 1].map(|k| close[k].then(|| (end(other, k), TWIN_BAR * near)));
-            let mut trial = before[i].clone();
-            let root = track(&mut trial, c, Some(bars));
-            let gain = reliability(&trial) - reliability(&self.limbs[c]);
-            let sound = trial.iter().all(|t| t.reliability >= p.weak_reliability);
-            if sound && gain >= 0.0 && best.as_ref().is_none_or(|(g, ..)| gain > *g) {
-                best = Some((gain, c, trial, root));
-            }
-        }
-        if let Some((_, c, trial, root)) = best {
-            self.limbs[c] = trial;
-            roots[c] = root;
-        }
-    }
-
-    /// The shortest the head block may become, pixels: [`TrackerParams::head_min_share`] of
-    /// its marked length, times the trunk's shrink since the marking when it has shrunk (a
-    /// person walking away, or bowing). A head turning away from the camera loses the
-    /// contrast between face and hair that held its length, and the spiral's zoom then
-    /// shrank it frame by frame: on dance_turns_frontal to 8 px from the marked 61 as the
-    /// body turned side-on, the neck 0.2–0.3 torso above its place and the trunk and legs
-    /// hanging from it.
-    fn shortest_head(&self) -> f64 {
-        let shrink = (self.trunk.block.m / self.marked_trunk_m.max(f64::EPSILON)).min(1.0);
-        self.params.head_min_share * self.marked_head_m * shrink
-    }
-
     /// The hip patch searched by the head's spiral from where it was (for [`Self::hips_hold`]).
     fn hips_spiral(&self, frame: FrameView, p: &TrackerParams) -> Found {
         spiral(
@@ -730,7 +618,6 @@ fn prior(part: &Part, pred: &MorphBlock, p: &TrackerParams, zoom: f64) -> Prior 
         m_full: part.max_len * zoom / LENGTH_SLACK,
         m_min: 0.2 * part.max_len * zoom,
         m_max: part.max_len * zoom,
-        avoid: None,
     }
 }
 
@@ -765,16 +652,6 @@ fn off_image(q: Point2<f64>, frame: FrameView) -> bool {
     !point_in_frame(&q, frame.width() as u32, frame.height() as u32)
 }
 
-/// The two leg chains of [`CHAINS`] (left, right).
-const LEGS: (usize, usize) = (2, 3);
-
-/// How far [`BodyTracker::reacquire_legs`] bars the other leg's joints, in multiples of the
-/// closeness that calls it (`twin_guard_torso`). On `bench track`'s suite (measured with the
-/// angle prior kept at 0.3 of its weight) PCK@0.2 was 0.908 at 1.5, 0.911 at 2 and 0.904 at 3:
-/// a small bar leaves the leg on the rim, still on the other leg; a large one bars legs that
-/// are truly close.
-const TWIN_BAR: f64 = 2.0;
-
 /// First step of a limb chain's joint refinement, tracker pixels (see [`refine_chain`]).
 const CHAIN_STEP_PX: f64 = 1.0;
 /// Steps of a limb chain's joint refinement: 1, ½ and ¼ px. Measured on the suite and the real
@@ -802,22 +679,11 @@ fn widened(search: AngularParams, p: &TrackerParams) -> AngularParams {
     }
 }
 
-/// How [`track_limb`] looks for a chain beyond its own search.
-#[derive(Clone, Copy)]
-struct Look {
-    /// A leg's second look: its bars ([`BodyTracker::reacquire_legs`]).
-    second: Option<Bars>,
-    /// Whether a lost forearm may call [`rescue_arm`] (arms only, which never have a second
-    /// look: `arm_rescue`).
-    rescue: bool,
-}
-
 /// One limb chain: the upper block anchored at the root, the lower at the found middle joint.
 /// A weak result from the narrow search around the prediction is searched again over the wide
 /// range (fast limbs), unless the prediction has left the image: then the part is held at its
 /// angle to its parent, reliability 0, until its prediction comes back. An arm whose forearm
-/// is still weak is looked for again as one chain ([`rescue_arm`]). When both segments moved,
-/// the chain is refined as one figure ([`refine_chain`], `chain_refine`) before either learns
+/// When both segments moved, the chain is refined as one figure ([`refine_chain`], `chain_refine`) before either learns
 /// its new appearance. Returns the root joint, moved when it has a spring.
 fn track_limb(
     parts: &mut [Part; 2],
@@ -826,29 +692,17 @@ fn track_limb(
     frame: FrameView,
     p: &TrackerParams,
     zoom: f64,
-    look: Look,
 ) -> Point2<f64> {
-    let second_look = look.second;
     let mut parent = trunk_angles;
     let mut anchor = root.at;
     // The segments moved this frame (not held), with their priors; they learn their new
     // appearance once the chain is settled.
     let mut moved: [Option<Prior>; 2] = [None, None];
-    // The moved segments' predictions and found costs (prior included), for the rescue.
-    let mut searched: [Option<(MorphBlock, f32)>; 2] = [None, None];
     for (k, part) in parts.iter_mut().enumerate() {
         let before = (part.block.theta, part.prev_theta);
         let pred = predict_anchored(part, anchor, Some(parent), p.velocity_damping);
         let narrow = limb_search(p);
-        let free = prior(part, &pred, p, zoom);
-        let prior = match second_look {
-            Some(bars) => Prior {
-                avoid: bars[k],
-                per_degree: 0.0,
-                ..free
-            },
-            None => free,
-        };
+        let prior = prior(part, &pred, p, zoom);
         let predicted_off = off_image(pred.end(), frame);
         let narrow = if off_image(pred.to_image(part.extent.end, 0.0), frame) {
             // The far end of the sampled part is cut off by the image's edge, so its length
@@ -872,7 +726,7 @@ fn track_limb(
             // The joint left the frame: nothing to match until its prediction is back.
             hold(part, anchor, parent);
         } else {
-            if weak || second_look.is_some() || folded(&found.block) {
+            if weak || folded(&found.block) {
                 let wide = widened(narrow, p);
                 let again = angular(&part.template, frame, &pred, &wide, &prior);
                 if again.cost < found.cost && !folded(&again.block) || folded(&found.block) {
@@ -884,20 +738,10 @@ fn track_limb(
             } else {
                 move_to(part, found.block);
                 moved[k] = Some(prior);
-                searched[k] = Some((pred, found.cost));
             }
         }
         parent = [part.block.theta, before.0, before.1];
         anchor = part.block.end();
-    }
-    if let ([Some(upper), Some(lower)], [Some(up), Some(low)]) = (&moved, searched)
-        && look.rescue
-        && reliability(low.1, p.reliability_c0) < p.weak_reliability
-        && let Some(rescued) = rescue_arm(parts, [up, low], [upper, lower], frame, p)
-    {
-        parts[0].block = rescued.upper;
-        parts[1].block = rescued.lower;
-        moved[1] = Some(rescued.lower_prior);
     }
     if let [Some(upper), Some(lower)] = &moved
         && p.chain_refine
@@ -909,14 +753,7 @@ fn track_limb(
                 ChainSegment {
                     template: &parts[0].template,
                     n: parts[0].block.n,
-                    // The upper arm's stronger pull towards full length stays out of the
-                    // chain's joint refinement, which also moves the shoulder: there it pulled
-                    // the suite's shoulders about a pixel off (the lift from the tracker's
-                    // output 93.9 → 112.4 mm), here the limbs' ordinary pull.
-                    prior: &Prior {
-                        per_log_short: upper.per_log_short.min(p.short_penalty),
-                        ..*upper
-                    },
+                    prior: upper,
                 },
                 ChainSegment {
                     template: &parts[1].template,
@@ -941,100 +778,6 @@ fn track_limb(
     // was (a found or held upper segment keeps its anchor).
     parts[0].block.origin
 }
-
-/// How far from where the search left it [`rescue_arm`] turns the upper arm at least, degrees:
-/// nearer angles were the search's own ground (and its chain refinement's). With every angle
-/// (`bench track`'s suite and real sample PCK@0.2 0.947 / 0.781 against 0.936 / 0.805) the
-/// real sample's bare upper arm, on a bare trunk, was shortened towards the shoulder frame
-/// after frame; from 10° 0.942 / 0.805.
-const RESCUE_DISTINCT_DEG: f64 = 10.0;
-
-/// An arm found again by [`rescue_arm`].
-struct Rescued {
-    upper: MorphBlock,
-    lower: MorphBlock,
-    /// The forearm's motion prior around its prediction from the new elbow.
-    lower_prior: Prior,
-}
-
-/// Beyond the paper: an arm whose forearm stayed weak after its search (`arm_rescue`). The
-/// upper arm is swept over the wide range at its predicted length (`[upper, lower]`: each
-/// segment's prediction and found cost; `priors`: their motion priors), and from each elbow
-/// the forearm is searched over the wide range, predicted at the angle to the upper arm it had
-/// in the search. The pair costing least moves the arm, when its forearm is sound (reliable
-/// with its prior) and the pair costs less than the pair the search found.
-fn rescue_arm(
-    parts: &[Part; 2],
-    [upper, lower]: [(MorphBlock, f32); 2],
-    priors: [&Prior; 2],
-    frame: FrameView,
-    p: &TrackerParams,
-) -> Option<Rescued> {
-    let found_upper = parts[0].block.theta;
-    // The forearm's predicted angle to the upper arm the search found.
-    let bend = lower.0.theta - found_upper;
-    let wide = widened(limb_search(p), p);
-    let step = wide.step_theta;
-    let steps = (wide.range_theta / step).ceil() as i64;
-    let mut best: Option<(f32, Rescued)> = None;
-    for k in -steps..=steps {
-        let block = MorphBlock {
-            theta: upper.0.theta + k as f64 * step,
-            ..upper.0
-        };
-        if wrap_angle(block.theta - found_upper).abs() < RESCUE_DISTINCT_DEG.to_radians() {
-            continue;
-        }
-        let bound = best.as_ref().map_or(upper.1 + lower.1, |b| b.0);
-        let penalty = priors[0].penalty(&block);
-        if penalty >= bound {
-            continue;
-        }
-        let cost = parts[0]
-            .template
-            .cost(frame, &block, false, bound - penalty)
-            + penalty;
-        if cost >= bound {
-            continue;
-        }
-        let pred = MorphBlock {
-            origin: block.end(),
-            theta: block.theta + bend,
-            ..lower.0
-        };
-        let lower_prior = Prior {
-            theta: pred.theta,
-            ..*priors[1]
-        };
-        // Only a forearm both sound and making the pair cheaper is of use.
-        let cap = (bound - cost).min(sound_cost(p));
-        let found = angular_below(&parts[1].template, frame, &pred, &wide, &lower_prior, cap);
-        let total = cost + found.cost;
-        if total < bound
-            && reliability(found.cost, p.reliability_c0) >= p.weak_reliability
-            && !folded_back(block.theta, found.block.theta, p)
-        {
-            best = Some((
-                total,
-                Rescued {
-                    upper: block,
-                    lower: found.block,
-                    lower_prior,
-                },
-            ));
-        }
-    }
-    best.map(|(_, r)| r)
-}
-
-/// Tracks limb chain `k` (its two parts) into the frame, as a second look when given bars;
-/// returns its root.
-type TrackChain<'a> = dyn Fn(&mut [Part; 2], usize, Option<Bars>) -> Point2<f64> + 'a;
-
-/// A chain's second look ([`BodyTracker::reacquire_legs`]): per joint (middle, end), a disc
-/// (centre, radius in pixels) it may not end in. With bars, [`track_limb`] also searches the
-/// wide range and drops the angle prior.
-type Bars = [Option<(Point2<f64>, f64)>; 2];
 
 /// Whether a lower segment at image angle `lower` is folded back onto its upper segment at
 /// `upper` further than `fold_limit_deg` (elbows and knees flex to about 150°).

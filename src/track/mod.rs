@@ -11,8 +11,6 @@
 //! - [`search`]: the spiral search path (Fig. 6) and the anchored angular search
 //! - [`body`]: the top-down tracker (head → trunk → limbs)
 //! - [`occlusion`]: interpolation over weak runs, the weak-span report
-//! - [`gait`]: the hidden far limbs of a walk or run completed from the other side
-//! - [`side_trunk`]: a side-on walker's shoulders and hips in perspective
 //! - [`smooth`]: the finished tracks smoothed over time, weighted by reliability
 //! - [`run`]: tracking a video from its key frames, the order of the steps, re-tracking
 //! - `pass`: one pass over consecutive frames, forwards or backwards, re-started at key frames
@@ -22,18 +20,15 @@ pub mod background;
 pub mod block;
 pub mod body;
 mod fuse;
-pub mod gait;
 pub mod head;
 pub mod occlusion;
 pub mod params;
 mod pass;
 pub mod run;
 pub mod search;
-pub mod side_trunk;
 pub mod similarity;
 pub mod smooth;
 
-pub use gait::{GaitOutcome, GaitReport, LimbPair};
 pub use occlusion::{SpanKind, WeakSpan, weak_spans};
 pub use params::TrackerParams;
 pub use run::{KeyFrames, TrackError, TrackJob, TrackOutput, TrackProgress, track_video};

@@ -24,7 +24,7 @@ pub enum SpanKind {
     Weak,
     /// The joint is off the frame somewhere in the run: left as the tracker estimated it.
     OffFrame,
-    /// Completed from the gait somewhere in the run (a hidden far limb, [`super::gait`]),
+    /// Completed from the gait somewhere in the run (tracks from versions before 2026-11-28),
     /// nowhere lost or left weak.
     Gait,
 }
@@ -132,88 +132,6 @@ fn moves_with_its_anchors(
     };
     let limit = KEEP_STEP_FACTOR * before.max(after).max(floor);
     (start - 1..=end).all(|i| step(i) <= limit)
-}
-
-/// Twin joints closer than this, in torso lengths (neck to pelvis, median over the clip), are
-/// on one spot for [`weaken_merged_twins`]. On treadmill_raised each knee is hidden behind the
-/// other leg for part of every stride, and its track rides on the other knee a median 0.10
-/// torso off it (0.08 at the lower quartile), which 0.05 did not catch. The suite of `bench
-/// track` at 0.05 / 0.1 / 0.12 / 0.13 / 0.15 / 0.17 / 0.2 / 0.25: 1609 / 1578 / 1546 / 1546 /
-/// 1556 / 1740 / 1764 / 2041 misses at PCK@0.2 (of 24208 joint-frames), treadmill_raised
-/// 0.893 → 0.925 at 0.12; from 0.17 run_side's swinging legs, which pass close by each other,
-/// lose their tracked crossings (0.908 → 0.846).
-pub const MERGE_TORSO: f64 = 0.12;
-
-/// Frames before and after a merge begins over which each twin's velocity is measured.
-const FOLLOW_FRAMES: usize = 3;
-
-/// The least change of velocity, torso lengths per frame, that marks a twin as the follower:
-/// two joints resting together (a side view's feet side by side) change nothing. At 0.02 the
-/// suite lost 2.16 % of joint-frames unflagged, at 0.01 1.94 %.
-pub const FOLLOW_FLOOR_TORSO: f64 = 0.01;
-
-/// The left joints whose right twins ([`Joint::mirrored`]) a tracker can confuse with them
-/// where the limbs overlap.
-const TWINS: [Joint; 4] = [
-    Joint::LeftElbow,
-    Joint::LeftWrist,
-    Joint::LeftKnee,
-    Joint::LeftAnkle,
-];
-
-/// Beyond the paper: a block that followed its twin. Twin joints (left and right elbows,
-/// wrists, knees, ankles) tracked within [`MERGE_TORSO`] of each other for at least
-/// `min_frames` consecutive frames: limbs cross in a few frames, so a longer merge means one
-/// block rides on the other (a side view's far leg on the near one), confidently wrong. The
-/// twin whose velocity changed more when they met (by at least [`FOLLOW_FLOOR_TORSO`]) is the
-/// follower; its confidence is capped at half of `weak` over the merge, so that
-/// [`fill_weak_runs`] interpolates or reports it. Merges present from the first frame (the
-/// marks put the joints together) and frames with a key or an off-frame twin are left alone,
-/// and so are frames before `fresh` (a re-track keeps them as the user saw them, though a
-/// merge that runs on past the corrected frame is found over all of it).
-pub fn weaken_merged_twins(
-    frames: &mut [FrameTracks],
-    weak: f32,
-    min_frames: usize,
-    fresh: usize,
-    is_key: &dyn Fn(usize, Joint) -> bool,
-) {
-    let torso = median_torso(frames);
-    for (a, b) in TWINS.map(|j| (j, j.mirrored())) {
-        let merged: Vec<bool> = frames
-            .iter()
-            .enumerate()
-            .map(|(i, f)| {
-                let (p, q) = (f.points[a], f.points[b]);
-                !is_key(i, a)
-                    && !is_key(i, b)
-                    && p.source == PointSource::Tracked
-                    && q.source == PointSource::Tracked
-                    && (p.pos - q.pos).norm() <= MERGE_TORSO * torso
-            })
-            .collect();
-        for (start, end) in runs(frames.len(), |i| !merged[i]) {
-            let k = FOLLOW_FRAMES.min(start).min(end - start);
-            if end + 1 - start < min_frames || k == 0 {
-                continue;
-            }
-            let turn = |j: Joint| {
-                let pos = |i: usize| frames[i].points[j].pos;
-                let before = (pos(start) - pos(start - k)) / k as f64;
-                let inside = (pos(start + k) - pos(start)) / k as f64;
-                (inside - before).norm()
-            };
-            let (ta, tb) = (turn(a), turn(b));
-            if ta.max(tb) < FOLLOW_FLOOR_TORSO * torso {
-                continue;
-            }
-            let follower = if ta >= tb { a } else { b };
-            for f in frames[..=end].iter_mut().skip(start.max(fresh)) {
-                let c = &mut f.points[follower].confidence;
-                *c = c.min(weak * 0.5);
-            }
-        }
-    }
 }
 
 /// Fills short weak runs by interpolation (keeping those that move like the joint around
@@ -433,94 +351,5 @@ mod tests {
                 .iter()
                 .all(|s| s.kind == SpanKind::Interpolated && s.end == 1)
         );
-    }
-
-    /// Frames with a torso of 100 px (neck at 0, pelvis at 100) and the ankles at the given x.
-    fn ankles(left: &[f64], right: &[f64]) -> Vec<FrameTracks> {
-        let mut f = frames(&vec![0.9; left.len()]);
-        for (f, (&l, &r)) in f.iter_mut().zip(left.iter().zip(right)) {
-            for j in Joint::ALL {
-                f.points[j].pos = Point2::new(0.0, 0.0);
-            }
-            f.points[Joint::Pelvis].pos.y = 100.0;
-            f.points[Joint::LeftAnkle].pos.x = l;
-            f.points[Joint::RightAnkle].pos.x = r;
-        }
-        f
-    }
-
-    fn confidences(f: &[FrameTracks], j: Joint) -> Vec<f32> {
-        f.iter().map(|f| f.points[j].confidence).collect()
-    }
-
-    /// The left ankle walks on at 10 px a frame; the right one comes the other way, meets it
-    /// at frame 4 and, lost, rides along with it, `beside` px off, for six frames.
-    fn riding(beside: f64) -> (Vec<f64>, Vec<f64>) {
-        let left: Vec<f64> = (0..10).map(|i| 10.0 * i as f64).collect();
-        let right = (0..10)
-            .map(|i| {
-                if i < 4 {
-                    80.0 - 10.0 * i as f64
-                } else {
-                    left[i] + beside
-                }
-            })
-            .collect();
-        (left, right)
-    }
-
-    #[test]
-    fn a_joint_riding_on_its_twin_is_made_weak_and_a_crossing_is_not() {
-        let (left, right) = riding(0.0);
-        let mut f = ankles(&left, &right);
-        weaken_merged_twins(&mut f, 0.5, 4, 0, &|_, _| false);
-        assert!(confidences(&f, Joint::LeftAnkle).iter().all(|&c| c == 0.9));
-        let right_conf = confidences(&f, Joint::RightAnkle);
-        assert!(right_conf[..4].iter().all(|&c| c == 0.9), "{right_conf:?}");
-        assert!(right_conf[4..].iter().all(|&c| c == 0.25), "{right_conf:?}");
-        // Shorter than four frames together: a crossing, left alone.
-        let mut f = ankles(&left[..7], &right[..7]);
-        weaken_merged_twins(&mut f, 0.5, 4, 0, &|_, _| false);
-        assert!(confidences(&f, Joint::RightAnkle).iter().all(|&c| c == 0.9));
-        // A key frame inside the merge splits it into runs too short to count.
-        let mut f = ankles(&left, &right);
-        weaken_merged_twins(&mut f, 0.5, 4, 0, &|i, _| i == 6);
-        assert!(confidences(&f, Joint::RightAnkle).iter().all(|&c| c == 0.9));
-        // A re-track from frame 5 keeps frames 0 to 5 as they were; the merge is still found.
-        let mut f = ankles(&left, &right);
-        weaken_merged_twins(&mut f, 0.5, 4, 6, &|_, _| false);
-        let right_conf = confidences(&f, Joint::RightAnkle);
-        assert!(right_conf[..6].iter().all(|&c| c == 0.9), "{right_conf:?}");
-        assert!(right_conf[6..].iter().all(|&c| c == 0.25), "{right_conf:?}");
-    }
-
-    #[test]
-    fn a_joint_riding_beside_its_twin_is_made_weak() {
-        // The lost right ankle rides 10 px (a tenth of the torso) beside the left one: it
-        // follows it, though never onto the same spot.
-        let (left, right) = riding(10.0);
-        let mut f = ankles(&left, &right);
-        weaken_merged_twins(&mut f, 0.5, 4, 0, &|_, _| false);
-        let right_conf = confidences(&f, Joint::RightAnkle);
-        assert!(right_conf[4..].iter().all(|&c| c == 0.25), "{right_conf:?}");
-        assert!(confidences(&f, Joint::LeftAnkle).iter().all(|&c| c == 0.9));
-    }
-
-    #[test]
-    fn twins_resting_together_are_left_alone() {
-        // Feet side by side from the marks on, or still when they meet: nothing followed.
-        let still = [50.0; 10];
-        let mut f = ankles(&still, &still);
-        weaken_merged_twins(&mut f, 0.5, 4, 0, &|_, _| false);
-        let mut g = ankles(
-            &still,
-            &[52.0, 52.0, 60.0, 60.0, 51.0, 51.0, 51.0, 51.0, 51.0, 51.0],
-        );
-        weaken_merged_twins(&mut g, 0.5, 4, 0, &|_, _| false);
-        for f in [&f, &g] {
-            for j in [Joint::LeftAnkle, Joint::RightAnkle] {
-                assert!(confidences(f, j).iter().all(|&c| c == 0.9));
-            }
-        }
     }
 }

@@ -6,6 +6,19 @@ use super::similarity::SimilarityWeights;
 use crate::setting_range::Range;
 use serde::{Deserialize, Serialize};
 
+/// A setting removed from the tracker (its special case gave no gain on the benchmark's test
+/// split, `docs/method.md`): older project and settings files that hold it still load, the
+/// value is ignored, and it is no longer written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Retired;
+
+impl<'de> Deserialize<'de> for Retired {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Retired, D::Error> {
+        serde::de::IgnoredAny::deserialize(d)?;
+        Ok(Retired)
+    }
+}
+
 /// Settings of the VBA tracker. Serialised as JSON (`--tracker-settings`); missing keys take
 /// their defaults.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -21,14 +34,9 @@ pub struct TrackerParams {
     pub head_d_m: f64,
     /// Most rings of the spiral path. Default 12.
     pub head_max_rings: usize,
-    /// Beyond the paper: the shortest the head block may become, as a share of its marked
-    /// length (times the trunk's shrink since the marking, when the trunk has shrunk: a person
-    /// walking away or bowing). 0 = no floor. Default 0.7: on dance_turns_frontal the head
-    /// turning side-on otherwise shrank to 8 px of its marked 61. `bench track`'s suite misses
-    /// at PCK@0.2 (of 24208) with 0 / 0.5 / 0.7 / 0.8 / 0.9: 1318 / 1315 / 1301 / 1317 / 1325
-    /// (dance_turns_frontal 319 / 316 / 302 / 307 / 305), the real sample 0.805 / 0.805 / 0.805
-    /// / 0.794 / 0.819 (before the arms' foreground lane).
-    pub head_min_share: f64,
+    /// Retired 2026-11-28: read from older files and ignored (see [`Retired`]).
+    #[serde(skip_serializing)]
+    pub head_min_share: Retired,
     /// Half-range of the trunk's angle search around its prediction, degrees. Default 20.
     pub trunk_range_deg: f64,
     /// Half-range of the trunk's length search, fraction. Default 0.15.
@@ -70,21 +78,12 @@ pub struct TrackerParams {
     /// Longest run of weak frames filled by interpolation, seconds; longer runs are reported
     /// and left as tracked. Default 0.5.
     pub max_gap_s: f64,
-    /// Twin joints (left and right elbows, wrists, knees, ankles) tracked onto one spot for
-    /// at least this long, seconds, are taken as one block riding on its twin: the one that
-    /// changed its motion on meeting the other is made weak there (reported, interpolated when
-    /// short). 0 turns it off. Default 0.2: limbs cross in a few frames. On `bench track`'s
-    /// suite the share of joint-frames lost without being flagged weak fell 2.59 → 1.94 %
-    /// (lost 4.04 → 3.85 %, PCK@0.2 0.905 → 0.904); of the joint-frames it made weak, 57 % lay
-    /// more than 0.2 torso from the truth.
-    pub twin_merge_s: f64,
-    /// Beyond the paper: legs whose knees or ankles are tracked within this fraction of the
-    /// torso's length of each other get a second look each frame: each leg is searched again
-    /// with the other's joints barred, and moves where it matches at least as well (a side
-    /// view's far leg that slid onto the near one). 0 turns it off. Default 0.15. On `bench
-    /// track`'s suite PCK@0.2 0.904 → 0.911, lost 3.85 → 3.72 % (run_side 0.746 → 0.772,
-    /// treadmill_raised 0.879 → 0.912, no clip worse); real sample unchanged.
-    pub twin_guard_torso: f64,
+    /// Retired 2026-11-28: read from older files and ignored (see [`Retired`]).
+    #[serde(skip_serializing)]
+    pub twin_merge_s: Retired,
+    /// Retired 2026-11-28: read from older files and ignored (see [`Retired`]).
+    #[serde(skip_serializing)]
+    pub twin_guard_torso: Retired,
     /// The tracker works on frames shrunk so that the marked person is at most this tall,
     /// pixels (speed on large videos; the sampling grids are capped anyway). Default 300: on
     /// the 1080×1920 sample (a person of 840 px) the tracker runs 1.2–1.5 times as fast as at
@@ -119,27 +118,9 @@ pub struct TrackerParams {
     /// the head's zoom. Default 8 (0 turns it off); it also resists true foreshortening, which
     /// costs a frontal seated knee.
     pub short_penalty: f32,
-    /// The upper arms' own `short_penalty` (beyond the paper). On real video a bare or
-    /// plain-sleeved upper arm looks the same along its length, so its block shrinks towards
-    /// the shoulder a little every frame, the colour model learns the shorter arm, and the
-    /// elbow and wrist end up a bone too high (the real sample's left arm). An upper arm
-    /// pointing at the camera is rarer than a seated thigh. The chain refinement, which also
-    /// moves the shoulder, keeps the ordinary pull. Measured with `bench track`'s suite and the
-    /// real sample (PCK@0.2) at 8 / 24 / 28 / 32 / 33 / 34 / 35 / 36 / 40 / 60: suite 0.911 /
-    /// 0.911 / 0.903 / 0.910 / 0.906 / 0.911 / 0.903 / 0.902 / 0.900 / 0.892, real sample 0.757
-    /// / 0.787 / 0.789 / 0.795 / 0.801 / 0.826 / 0.805 / 0.827 / 0.827 / 0.749. At 34, 36 and 40
-    /// the lift of the real sample from the tracker's output turns to the mirror image of the
-    /// trunk for the whole clip (172 → 269 mm; a near tie between two calibrations); at 35 it
-    /// is 156 mm. With the stronger pull in the chain refinement too, all limbs at 24 cost the
-    /// suite's seated and raised-camera legs (0.878), the forearms too its swinging arms (0.900).
-    /// Also tried: the upper arm keeping only the ordinary pull while its forearm was shorter
-    /// than a share of its full length on the frame before (an arm pointing at the camera:
-    /// dribble_oblique's right arm is lost from frame 40). At shares 0.6 / 0.65 / 0.7 / 0.75 /
-    /// 0.9 the suite was 0.903 / 0.903 / 0.906 / 0.906 / 0.906 and the real sample 0.825 /
-    /// 0.828 / 0.791 / 0.791 / 0.763: dribble_oblique came right (0.939 → 0.99) only where the
-    /// real sample fell below 0.80.
-    /// Default 35.
-    pub upper_arm_short_penalty: f32,
+    /// Retired 2026-11-28: read from older files and ignored (see [`Retired`]).
+    #[serde(skip_serializing)]
+    pub upper_arm_short_penalty: Retired,
     /// Beyond the paper: the forearms' own pull towards full length (as
     /// [`TrackerParams::short_penalty`], for the forearms' blocks only). A forearm crossing the
     /// trunk, or in a sleeve of its colour, shrinks towards the elbow with the ordinary pull and
@@ -152,7 +133,7 @@ pub struct TrackerParams {
     /// ordinary 8 because the lift from those better tracks came out worse: at 10 to 14 the
     /// real sample lifted with its true bone lengths takes the trunk's mirror image for the
     /// whole clip (156 → 249–271 mm; a near tie between two calibrations, as
-    /// `upper_arm_short_penalty` found at 34), and at 12 the suite lifted from the height went
+    /// the retired upper arms' own pull found at 34), and at 12 the suite lifted from the height went
     /// 94.9 → 101.0 mm (dance_turns_frontal 92.7 → 120.8). Raise it (12) for real video whose
     /// wrists fall short, and check the 3D view. Default 8.
     pub forearm_short_penalty: f32,
@@ -161,18 +142,9 @@ pub struct TrackerParams {
     /// segments' costs falls, so a middle joint the upper segment put a pixel off no longer
     /// leaves the lower segment anchored wrongly. Default true.
     pub chain_refine: bool,
-    /// Beyond the paper: when an arm's forearm is weak after its search, look for the whole
-    /// arm again as one chain (see `track::body`'s `rescue_arm`): the upper arm is swept over
-    /// the wide range, at least 10° from where the search left it, with the forearm searched
-    /// from each elbow, and the arm moves there when the forearm matches soundly and the pair
-    /// costs less than before. An upper arm whose sleeve is the shirt's colour matches the
-    /// trunk as well as itself, and the search, which places the upper arm first, then leaves
-    /// it on the trunk with the forearm lost; the forearm's skin tells the two apart. Default
-    /// true. On `bench track`'s suite PCK@0.2 0.936 → 0.942 (dribble_oblique 0.921 → 0.973,
-    /// treadmill_oblique 0.970 → 1.000); the real sample unchanged. Legs have their own second
-    /// look (`twin_guard_torso`); the same rescue for them broke run_side's crossing legs
-    /// (0.910 → 0.785).
-    pub arm_rescue: bool,
+    /// Retired 2026-11-28: read from older files and ignored (see [`Retired`]).
+    #[serde(skip_serializing)]
+    pub arm_rescue: Retired,
     /// Beyond the paper: in the chain refinement each shoulder may leave the place the rigid
     /// trunk block gives it (a shoulder rises with a raised arm, and sinks as the body bends
     /// sideways), paying this cost (8-bit levels) per square tracker pixel of the shift; the
@@ -199,12 +171,9 @@ pub struct TrackerParams {
     /// 0.805 at 0.2. Four mirrored frames, the largest moving the left shoulder about 11 px
     /// outwards, were enough (left elbow 0.78 → 0.12).
     pub shoulder_spring: f32,
-    /// Beyond the paper: complete a walk's or run's hidden far arm and leg from the other
-    /// side's stride half a period away ([`super::gait`]), marking those points as completed
-    /// from the gait, after setting the side-on trunk's shoulders and hips to their perspective
-    /// ([`super::side_trunk`]). Default true. On `bench track`'s suite PCK@0.2 0.903 → 0.934,
-    /// lost 3.55 → 1.86 %; the real sample (no gait) unchanged.
-    pub gait_completion: bool,
+    /// Retired 2026-11-28: read from older files and ignored (see [`Retired`]).
+    #[serde(skip_serializing)]
+    pub gait_completion: Retired,
     /// Beyond the paper: weight of the foreground lane in the arms' blocks (upper arms and
     /// forearms), against the colours' (each 8-bit level of foreground difference counts this
     /// much against a level of colour difference). The lane is each pixel's difference from the
@@ -247,7 +216,7 @@ impl Default for TrackerParams {
             head_d_theta_deg: 6.0,
             head_d_m: 0.06,
             head_max_rings: 12,
-            head_min_share: 0.7,
+            head_min_share: Retired,
             trunk_range_deg: 20.0,
             trunk_range_m: 0.15,
             limb_range_deg: 30.0,
@@ -262,8 +231,8 @@ impl Default for TrackerParams {
             reliability_c0: 20.0,
             weak_reliability: 0.45,
             max_gap_s: 0.5,
-            twin_merge_s: 0.2,
-            twin_guard_torso: 0.15,
+            twin_merge_s: Retired,
+            twin_guard_torso: Retired,
             working_stature_px: 300.0,
             decoder_scaling: true,
             block_width_scale: 1.0,
@@ -272,12 +241,12 @@ impl Default for TrackerParams {
             hip_margin: 3.0,
             fold_limit_deg: 165.0,
             short_penalty: 8.0,
-            upper_arm_short_penalty: 35.0,
+            upper_arm_short_penalty: Retired,
             forearm_short_penalty: 8.0,
             chain_refine: true,
-            arm_rescue: true,
+            arm_rescue: Retired,
             shoulder_spring: 0.05,
-            gait_completion: true,
+            gait_completion: Retired,
             arm_foreground: 0.2,
             foreground_tau: 20.0,
             smooth_s: 0.0,
@@ -350,7 +319,7 @@ impl TrackerParams {
             head_d_theta_deg,
             head_d_m,
             head_max_rings: _,
-            head_min_share,
+            head_min_share: _,
             trunk_range_deg,
             trunk_range_m,
             limb_range_deg,
@@ -365,8 +334,8 @@ impl TrackerParams {
             reliability_c0,
             weak_reliability,
             max_gap_s,
-            twin_merge_s,
-            twin_guard_torso,
+            twin_merge_s: _,
+            twin_guard_torso: _,
             working_stature_px,
             decoder_scaling: _,
             block_width_scale,
@@ -375,7 +344,7 @@ impl TrackerParams {
             hip_margin,
             fold_limit_deg,
             short_penalty,
-            upper_arm_short_penalty,
+            upper_arm_short_penalty: _,
             forearm_short_penalty,
             chain_refine: _,
             arm_rescue: _,
@@ -386,7 +355,7 @@ impl TrackerParams {
             smooth_s,
         } = *self;
         weights.validate()?;
-        let checks: [(&'static str, f64, Range); 31] = [
+        let checks: [(&'static str, f64, Range); 27] = [
             ("head_step_px", head_step_px, Positive),
             ("head_d_theta_deg", head_d_theta_deg, NonNegative),
             ("head_d_m", head_d_m, Fraction),
@@ -405,25 +374,17 @@ impl TrackerParams {
             ("weak_reliability", weak_reliability.into(), Unit),
             ("max_gap_s", max_gap_s, NonNegative),
             ("smooth_s", smooth_s, NonNegative),
-            ("twin_merge_s", twin_merge_s, NonNegative),
-            ("twin_guard_torso", twin_guard_torso, NonNegative),
             ("working_stature_px", working_stature_px, NonNegative),
             ("block_width_scale", block_width_scale, Positive),
             ("hip_margin", hip_margin.into(), NonNegative),
             ("fold_limit_deg", fold_limit_deg, HalfTurn),
             ("short_penalty", short_penalty.into(), NonNegative),
             (
-                "upper_arm_short_penalty",
-                upper_arm_short_penalty.into(),
-                NonNegative,
-            ),
-            (
                 "forearm_short_penalty",
                 forearm_short_penalty.into(),
                 NonNegative,
             ),
             ("shoulder_spring", shoulder_spring.into(), NonNegative),
-            ("head_min_share", head_min_share, Unit),
             ("arm_foreground", arm_foreground.into(), NonNegative),
             ("foreground_tau", foreground_tau.into(), Positive),
         ];
@@ -436,6 +397,27 @@ impl TrackerParams {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn retired_settings_in_older_files_are_read_and_dropped() {
+        let old = r#"{"twin_merge_s": 0.2, "twin_guard_torso": 0.15, "arm_rescue": true,
+            "upper_arm_short_penalty": 35.0, "gait_completion": true, "head_min_share": 0.7,
+            "max_gap_s": 0.4}"#;
+        let read: TrackerParams = serde_json::from_str(old).unwrap();
+        assert_eq!(read.max_gap_s, 0.4);
+        let written = serde_json::to_string(&read).unwrap();
+        for key in [
+            "twin_merge_s",
+            "twin_guard_torso",
+            "arm_rescue",
+            "upper_arm_short_penalty",
+            "gait_completion",
+            "head_min_share",
+        ] {
+            assert!(!written.contains(key), "{key} written");
+        }
+        assert!(serde_json::from_str::<TrackerParams>(r#"{"arm_rescu": true}"#).is_err());
+    }
 
     #[test]
     fn the_defaults_are_valid() {
@@ -496,8 +478,8 @@ mod tests {
                 with(|p| p.forearm_short_penalty = -0.5),
             ),
             (
-                "upper_arm_short_penalty",
-                with(|p| p.upper_arm_short_penalty = f32::NAN),
+                "forearm_short_penalty",
+                with(|p| p.forearm_short_penalty = f32::NAN),
             ),
             ("limb_range_m", with(|p| p.limb_range_m = 1.0)),
             ("coarse_step_deg", with(|p| p.coarse_step_deg = 0.0)),

@@ -3,9 +3,9 @@
 //! One function shows the order ([`track_video`]): a forward pass from the first key frame (the
 //! marks) to the end, then a backward pass from the last key frame to the start, each re-started
 //! with the hand-placed joints at every key frame on the way (`pass`); the two made one
-//! per joint between its key frames (`fuse`); then twins merged, short weak runs
-//! interpolated with key frames as anchors ([`super::occlusion`]), never runs that leave the
-//! frame, hidden gait limbs completed ([`super::gait`]) and the tracks smoothed when asked. A
+//! per joint between its key frames (`fuse`); then short weak runs interpolated with key
+//! frames as anchors ([`super::occlusion`]), never runs that leave the frame, and the tracks
+//! smoothed when asked. A
 //! joint that ends up outside the image is off the frame (confidence 0, its position the
 //! tracker's estimate). A re-track after a correction runs forwards from the corrected frame and
 //! backwards from the last key frame to the earliest frame the correction can change, keeping the
@@ -13,8 +13,7 @@
 
 use super::body::{JointResult, stature_px};
 use super::fuse::fuse;
-use super::gait::{GaitOutcome, complete_gaits};
-use super::occlusion::{WeakSpan, fill_weak_runs, weak_spans, weaken_merged_twins};
+use super::occlusion::{WeakSpan, fill_weak_runs};
 use super::params::TrackerParams;
 use super::pass::{PassContext, Scale};
 use super::smooth::smooth_tracks;
@@ -115,10 +114,8 @@ pub struct TrackProgress {
 pub struct TrackOutput {
     /// Tracks of every frame.
     pub tracks: Tracks2d,
-    /// Every run of weak frames per joint, interpolated, completed from the gait or left weak.
+    /// Every run of weak frames per joint, interpolated or left weak.
     pub spans: Vec<WeakSpan>,
-    /// What gait completion found and did (nothing when it is off).
-    pub gait: GaitOutcome,
     /// The shrink factor of the working scale: video pixels per tracker pixel (1 = full size).
     pub shrink: f64,
     /// Frames the decoder could not read (damaged or cut-short files), ascending. They are
@@ -393,17 +390,8 @@ fn track_at_working_scale(
         })
         .collect();
     let max_gap = (job.params.max_gap_s * info.fps).round().max(1.0) as usize;
-    if job.params.twin_merge_s > 0.0 {
-        weaken_merged_twins(
-            &mut frames,
-            job.params.weak_reliability,
-            (job.params.twin_merge_s * info.fps).round().max(2.0) as usize,
-            job.from.map_or(0, |f| f + 1),
-            &|i, j| job.keys.is_key(i, j),
-        );
-    }
     let is_key = |i: usize, j: Joint| job.keys.is_key(i, j);
-    let mut spans = fill_weak_runs(&mut frames, job.params.weak_reliability, max_gap, &is_key);
+    let spans = fill_weak_runs(&mut frames, job.params.weak_reliability, max_gap, &is_key);
     let source = SourceInfo {
         path: info.path.clone(),
         width: info.width,
@@ -411,22 +399,11 @@ fn track_at_working_scale(
         fps: info.fps,
         frame_count: n,
     };
-    let gait = if job.params.gait_completion {
-        complete_gaits(&mut frames, &source, &is_key)
-    } else {
-        GaitOutcome::default()
-    };
-    // Points completed from the gait change the weak runs they lay in.
-    if gait.limbs.iter().any(|g| g.completed > 0) {
-        spans = weak_spans(&frames, job.params.weak_reliability, &is_key);
-    }
-    // Smoothed last (when asked for): the filled runs and the gait's copies are smoothed with
-    // the rest. A re-track smooths what it tracked; the earlier result before it was smoothed
+    // Smoothed last (when asked for): the filled runs are smoothed with the rest. A re-track smooths what it tracked; the earlier result before it was smoothed
     // already.
     let first = job.from.map_or(0, |f| f + 1);
     smooth_tracks(&mut frames, job.params.smooth_s * info.fps, first, &is_key);
-    // The corrected frame's reliable joints stay as the user saw them: the side-on trunk's
-    // shoulders and hips, set again above, would otherwise lose their smoothing there. (The
+    // The corrected frame's reliable joints stay as the user saw them. (The
     // earlier result covers every frame and `from` lies in it: checked before tracking.)
     if let (Some(from), Some(prev)) = (job.from, job.previous.as_ref()) {
         for j in Joint::ALL {
@@ -443,7 +420,6 @@ fn track_at_working_scale(
         damaged,
         tracks: Tracks2d { source, frames },
         spans,
-        gait,
         shrink,
     })
 }

@@ -40,9 +40,6 @@ pub struct Prior {
     pub m_min: f64,
     /// Longest allowed length, pixels.
     pub m_max: f64,
-    /// A disc the block's end may not lie in (centre, radius in pixels): where the other leg's
-    /// joint is, in a leg's second look (`BodyTracker::reacquire_legs`).
-    pub avoid: Option<(Point2<f64>, f64)>,
 }
 
 impl Prior {
@@ -56,17 +53,11 @@ impl Prior {
         m_full: 0.0,
         m_min: 0.0,
         m_max: f64::INFINITY,
-        avoid: None,
     };
 
     /// The penalty of a candidate (infinite outside the length bounds).
     pub fn penalty(&self, b: &MorphBlock) -> f32 {
         if b.m < self.m_min || b.m > self.m_max {
-            return f32::INFINITY;
-        }
-        if let Some((centre, radius)) = self.avoid
-            && (b.end() - centre).norm() < radius
-        {
             return f32::INFINITY;
         }
         let mut p = 0.0f32;
@@ -579,18 +570,6 @@ mod tests {
     use super::*;
     use crate::track::similarity::{Extent, FloatFrame, SimilarityWeights};
     use image::{Rgb, RgbImage};
-
-    #[test]
-    fn a_barred_disc_refuses_blocks_that_end_in_it_and_only_those() {
-        let prior = Prior {
-            avoid: Some((Point2::new(20.0, 0.0), 5.0)),
-            ..Prior::NONE
-        };
-        let to = |x: f64, y: f64| MorphBlock::along(Point2::origin(), Point2::new(x, y), 4.0);
-        assert_eq!(prior.penalty(&to(22.0, 3.0)), f32::INFINITY);
-        assert_eq!(prior.penalty(&to(20.0, 6.0)), 0.0);
-        assert_eq!(Prior::NONE.penalty(&to(20.0, 0.0)), 0.0);
-    }
 
     /// A textured bar from `a` to `b` over a differently textured background.
     fn bar(a: Point2<f64>, b: Point2<f64>, width: f64) -> RgbImage {

@@ -21,15 +21,14 @@ fn with_tracker_panel(dir: &Path) -> Harness<'static, App> {
     h
 }
 
-/// The pull of short limbs back to full length, and the upper arms' and the forearms' own,
-/// are each set from the Parameters panel on its own (the others stay), and each is an
+/// The pull of short limbs back to full length, and the forearms' own, are each set from the
+/// Parameters panel on its own (the others stay), and each is an
 /// undoable project setting.
 #[test]
 fn the_short_limb_pulls_are_set_in_the_tracker_settings() {
     type Get = fn(&TrackerParams) -> f32;
-    let pulls: [(&str, Get); 3] = [
+    let pulls: [(&str, Get); 2] = [
         ("keep limbs long", |t| t.short_penalty),
-        ("keep upper arms long", |t| t.upper_arm_short_penalty),
         ("keep forearms long", |t| t.forearm_short_penalty),
     ];
     let dir = tempfile::tempdir().unwrap();
@@ -76,43 +75,41 @@ fn the_track_smoothing_is_an_undoable_tracker_setting() {
     assert_eq!(now(&h), TrackerParams::default().smooth_s);
 }
 
-/// The arms' foreground weight and the head's shortest share are set from the Parameters
-/// panel, each on its own and undoable.
+/// The arms' foreground weight is set from the Parameters panel, an undoable setting.
 #[test]
-fn the_background_and_head_floor_are_undoable_tracker_settings() {
+fn the_background_weight_is_an_undoable_tracker_setting() {
     let dir = tempfile::tempdir().unwrap();
     let mut h = with_tracker_panel(dir.path());
     let now = |h: &Harness<'static, App>| {
-        let t = h.state().state().project().unwrap().settings.tracker;
-        (t.arm_foreground, t.head_min_share)
+        h.state()
+            .state()
+            .project()
+            .unwrap()
+            .settings
+            .tracker
+            .arm_foreground
     };
     let d = TrackerParams::default();
-    assert_eq!(now(&h), (d.arm_foreground, d.head_min_share));
+    assert_eq!(now(&h), d.arm_foreground);
     h.get_by_role_and_label(
         egui::accesskit::Role::Slider,
         "arms stand out from the background",
     )
     .set_value_accesskit(0.0);
     h.run();
-    assert_eq!(now(&h), (0.0, d.head_min_share), "the weight on its own");
-    h.get_by_role_and_label(egui::accesskit::Role::Slider, "shortest head")
-        .set_value_accesskit(0.5);
-    h.run();
-    assert_eq!(now(&h), (0.0, 0.5));
+    assert_eq!(now(&h), 0.0);
     h.state_mut().state_mut().apply(Intent::Undo);
-    h.state_mut().state_mut().apply(Intent::Undo);
-    assert_eq!(now(&h), (d.arm_foreground, d.head_min_share), "both undone");
+    assert_eq!(now(&h), d.arm_foreground, "undone");
 }
 
-/// The tracker's switches (gait completion, the hip patch, the arms' second look) can each
-/// be turned off from the Parameters panel, and each is an undoable project setting.
+/// The tracker's switches (the hip patch, the chain refinement) can each be turned off from the
+/// Parameters panel, and each is an undoable project setting.
 #[test]
 fn each_tracker_switch_is_an_undoable_setting() {
     type Get = fn(&TrackerParams) -> bool;
-    let switches: [(&str, Get); 3] = [
-        ("complete hidden limbs from the gait", |t| t.gait_completion),
+    let switches: [(&str, Get); 2] = [
         ("hold the hips when the back bends", |t| t.hip_patch),
-        ("look again for lost arms", |t| t.arm_rescue),
+        ("refine each limb as one chain", |t| t.chain_refine),
     ];
     for (label, get) in switches {
         let dir = tempfile::tempdir().unwrap();

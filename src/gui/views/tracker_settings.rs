@@ -20,10 +20,6 @@ pub fn tracker_settings_ui(ui: &mut egui::Ui, t: &mut TrackerParams) {
         ));
     ui.add(egui::Slider::new(&mut t.smooth_s, 0.0..=0.1).fixed_decimals(3).text("smooth tracks (s)"))
         .on_hover_text(format!("The finished tracks are smoothed over time by a window this wide (standard deviation), each frame counting as much as it is reliable, so a weak frame between sound ones moves most; your own marks stay put. For 2D work: the lift smooths by the jitter it finds and gets less on smoothed tracks (0 = off); default {} s", d.smooth_s));
-    ui.add(egui::Slider::new(&mut t.twin_merge_s, 0.0..=1.0).text("twins merged after (s)"))
-        .on_hover_text(format!("Left and right elbows, wrists, knees or ankles tracked onto one spot this long: the one that followed the other is made weak (0 = off); default {} s", d.twin_merge_s));
-    ui.add(egui::Slider::new(&mut t.twin_guard_torso, 0.0..=0.5).text("legs second look (torso)"))
-        .on_hover_text(format!("Legs whose knees or ankles are tracked this close (fraction of the torso) are each searched again away from the other, and one moves where it matches as well (0 = off); default {}", d.twin_guard_torso));
     ui.add(egui::Slider::new(&mut t.working_stature_px, 100.0..=800.0).text("working size (px)"))
         .on_hover_text(format!("Frames are shrunk so the person is about this tall while tracking (faster, smoother); default {} px", d.working_stature_px));
     ui.add(egui::Slider::new(&mut t.limb_range_deg, 5.0..=90.0).text("limb search (°)"))
@@ -33,8 +29,6 @@ pub fn tracker_settings_ui(ui: &mut egui::Ui, t: &mut TrackerParams) {
         ));
     ui.add(egui::Slider::new(&mut t.short_penalty, 0.0..=20.0).text("keep limbs long"))
         .on_hover_text(format!("How strongly a limb is pulled back to its full length when it looks shorter (legs crossing); lower it for limbs pointing at the camera, such as a seated person's thighs seen from the front; default {}", d.short_penalty));
-    ui.add(egui::Slider::new(&mut t.upper_arm_short_penalty, 0.0..=60.0).text("keep upper arms long"))
-        .on_hover_text(format!("The same pull for the upper arms, stronger: a bare or plain-sleeved upper arm looks alike along its length and otherwise shrinks towards the shoulder; lower it for an arm pointing at the camera; default {}", d.upper_arm_short_penalty));
     ui.add(egui::Slider::new(&mut t.forearm_short_penalty, 0.0..=40.0).text("keep forearms long"))
         .on_hover_text(format!("The same pull for the forearms: raise it (12) when a forearm crossing the body, or a sleeve of its colour, shrinks towards the elbow and the wrist falls short; check the 3D view after; default {}", d.forearm_short_penalty));
     ui.checkbox(&mut t.hip_patch, "hold the hips when the back bends")
@@ -44,14 +38,8 @@ pub fn tracker_settings_ui(ui: &mut egui::Ui, t: &mut TrackerParams) {
     // The spring is part of the chain refinement: greyed out without it.
     ui.add_enabled(t.chain_refine, egui::Slider::new(&mut t.shoulder_spring, 0.0..=0.5).text("shoulder spring"))
         .on_hover_text(format!("Cost per square pixel that a shoulder pays for leaving the place the rigid trunk gives it, so it can rise with a raised arm (part of the chain refinement); higher holds it closer; 0 holds it on the trunk; default {}", d.shoulder_spring));
-    ui.checkbox(&mut t.arm_rescue, "look again for lost arms")
-        .on_hover_text(format!("When a forearm is lost, the whole arm is looked for again as one piece, so a sleeve the colour of the shirt no longer holds the arm on the body; default {}", on_off(d.arm_rescue)));
     ui.add(egui::Slider::new(&mut t.arm_foreground, 0.0..=1.0).text("arms stand out from the background"))
         .on_hover_text(format!("With a camera that stands still, the background is the median of 25 frames, and an arm's blocks must stand out from it where they did on the marked frame, so a forearm no longer settles on a wall of its colour; ignored when the camera moves (0 = off); default {}", d.arm_foreground));
-    ui.add(egui::Slider::new(&mut t.head_min_share, 0.0..=1.0).text("shortest head"))
-        .on_hover_text(format!("The head's length may not fall below this share of its marked length (less when the whole body has shrunk), so a head turning away keeps the neck in its place (0 = no floor); default {}", d.head_min_share));
-    ui.checkbox(&mut t.gait_completion, "complete hidden limbs from the gait")
-        .on_hover_text(format!("In a walk or run seen from the side, the far arm's and leg's joints that are weak, or far from where the near limb was half a stride earlier and later, are put there (pink) for you to check; default {}", on_off(d.gait_completion)));
     if ui.button("Defaults").clicked() {
         *t = d;
     }
