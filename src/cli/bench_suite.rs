@@ -25,6 +25,18 @@ pub fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// `--split`: all (`None`), dev or test.
+pub fn parse_split(split: &str) -> Result<Option<Split>, ExitError> {
+    match split {
+        "all" => Ok(None),
+        "dev" => Ok(Some(Split::Dev)),
+        "test" => Ok(Some(Split::Test)),
+        other => Err(ExitError::bad_input(anyhow::anyhow!(
+            "--split {other}: expected all, dev or test"
+        ))),
+    }
+}
+
 /// The suite's clips, rendered into `suite_dir` when missing, then the real clips.
 pub fn bench_clips(
     suite_dir: &Path,
@@ -32,16 +44,7 @@ pub fn bench_clips(
     clip: Option<&str>,
     global: &GlobalArgs,
 ) -> Result<Vec<BenchClip>, ExitError> {
-    let wanted = match split {
-        "all" => None,
-        "dev" => Some(Split::Dev),
-        "test" => Some(Split::Test),
-        other => {
-            return Err(ExitError::bad_input(anyhow::anyhow!(
-                "--split {other}: expected all, dev or test"
-            )));
-        }
-    };
+    let wanted = parse_split(split)?;
     let suite = Suite::load(root()).map_err(ExitError::failed)?;
     let dirs = suite
         .ensure_rendered(suite_dir, &mut |name| {

@@ -5,7 +5,7 @@
 //! N = 3k, 10k and 30k points on one core with Isomap's share.
 
 use super::args::{BenchArgs, GlobalArgs};
-use super::bench_suite::{BenchClip, Tally, root};
+use super::bench_suite::{BenchClip, Tally, parse_split, root};
 use super::{ExitError, say};
 use rayon::prelude::*;
 use std::path::Path;
@@ -221,27 +221,11 @@ fn suite_takes(
 pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let params = VolumeParams::default();
     // One split: only the suite's takes (the other tables have no split).
-    let split = match a.split.as_str() {
-        "all" => None,
-        "dev" => Some(Split::Dev),
-        "test" => Some(Split::Test),
-        other => {
-            return Err(ExitError::bad_input(anyhow::anyhow!(
-                "--split {other}: expected all, dev or test"
-            )));
-        }
-    };
+    let split = parse_split(&a.split)?;
     if split.is_some() {
         let mut lines = Vec::new();
         let suite_json = suite_takes(&params, split, a.clip.as_deref(), global, &mut lines)?;
-        if global.json {
-            println!(
-                "{}",
-                serde_json::json!({"suite": suite_json, "table": lines})
-            );
-        } else {
-            println!("{}", lines.join("\n"));
-        }
+        print_tables(global, suite_json, &lines);
         return Ok(());
     }
     let motions = motions()?;
@@ -390,6 +374,12 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             clouds.len()
         ));
     }
+    print_tables(global, suite_json, &lines);
+    Ok(())
+}
+
+/// Prints the tables, or with `--json` the suite's figures and the tables as JSON.
+fn print_tables(global: &GlobalArgs, suite_json: serde_json::Value, lines: &[String]) {
     if global.json {
         println!(
             "{}",
@@ -398,5 +388,4 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     } else {
         println!("{}", lines.join("\n"));
     }
-    Ok(())
 }
