@@ -17,7 +17,7 @@ use videomocap::synth::{
     Motion, ProceduralMotion, SynthParams, VoxelParams, from_bvh, load_motion, procedural,
     stature_of, subject_stature, volume_truth, voxelise,
 };
-use videomocap::volume::{VolumeParams, assemble, process_frame};
+use videomocap::volume::{VolumeParams, assemble, five_limb_frames, process_frame};
 
 /// Frames per sequence (the paper's sequences had about 50).
 const FRAMES: usize = 50;
@@ -87,7 +87,7 @@ fn run_sequence(
         .collect();
     let names: Vec<String> = (0..results.len()).map(|i| format!("frame {i}")).collect();
     let assembled = assemble(&results, &names, motion.fps);
-    let ok = results.iter().filter(|r| r.is_ok()).count();
+    let ok = five_limb_frames(&results);
     let score = score_volume(&volume_truth(motion), &assembled.skeleton, ok);
     Row {
         name: name.to_owned(),

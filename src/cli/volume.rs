@@ -49,7 +49,7 @@ pub fn run(a: &VolumeArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let skeleton_path = a.out_dir.join("skeleton3d.json");
     let skeleton = &processed.assembled.skeleton;
     skeleton.save(&skeleton_path).map_err(ExitError::failed)?;
-    let ok = processed.results.iter().filter(|r| r.is_ok()).count();
+    let (five, ok) = (processed.five_limb_frames(), processed.posed_frames());
     let (iso, rest) = processed
         .results
         .iter()
@@ -58,9 +58,10 @@ pub fn run(a: &VolumeArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     say(
         global,
         &format!(
-            "{} of {} frames gave a five-limb skeleton curve; left/right from the {:?}; {:.1} ms per frame on one core ({:.0}% Isomap)",
-            ok,
+            "{} of {} frames gave a five-limb skeleton curve, {} a pose (arms against the trunk placed from other frames); left/right from the {:?}; {:.1} ms per frame on one core ({:.0}% Isomap)",
+            five,
             processed.files.len(),
+            ok,
             processed.assembled.sides_from,
             1000.0 * (iso + rest) / ok.max(1) as f64,
             100.0 * iso / (iso + rest).max(1e-12),

@@ -109,8 +109,8 @@ fn frame_errors(a: &PerJoint<Point3<f64>>, b: &PerJoint<Point3<f64>>) -> [f64; 2
     e
 }
 
-/// Scores `result` (the pipeline's skeleton) against `truth`; `topology_ok` counts frames that
-/// had a pose.
+/// Scores `result` (the pipeline's skeleton) against `truth`; `topology_ok` counts frames whose
+/// skeleton curve showed all five limbs.
 pub fn score_volume(truth: &Skeleton3d, result: &Skeleton3d, topology_ok: usize) -> VolumeScore {
     let mut s = VolumeScore {
         frames: truth.frames.len(),
@@ -185,7 +185,7 @@ pub fn carve_and_score(
     let never = AtomicBool::new(false);
     let counts = carve_sequence(&setup, voxel_m, None, &grids, &|_, _| {}, &never)?;
     let p = process_directory(&grids, params, motion.fps, &|_, _| {}, &never)?;
-    let ok = p.results.iter().filter(|r| r.is_ok()).count();
+    let ok = p.five_limb_frames();
     let voxels = counts.iter().sum::<usize>() as f64 / counts.len().max(1) as f64;
     Ok((
         score_volume(

@@ -77,8 +77,9 @@ pub struct BodyFit {
     pub chest: Point3<f64>,
     /// See `chest`.
     pub pelvis: Point3<f64>,
-    /// arm1, arm2, leg1, leg2.
-    pub limbs: [LimbFit; 4],
+    /// arm1, arm2, leg1, leg2; `None` for an arm the skeleton curve does not show (it lies
+    /// against the trunk; see [`SkeletonCurve::arms`]).
+    pub limbs: [Option<LimbFit>; 4],
     /// Part of each point (same indexing as the input).
     pub parts: Vec<Part>,
 }
@@ -234,8 +235,11 @@ pub fn fit(
     for &i in &head_points {
         parts[i] = Part::Head;
     }
-    let limbs: [LimbFit; 4] = std::array::from_fn(|k| {
+    let limbs: [Option<LimbFit>; 4] = std::array::from_fn(|k| {
         let (chain, attach) = limb_chains[k];
+        if chain.is_empty() {
+            return None;
+        }
         let mut path = vec![curve.points[attach]];
         path.extend(chain.iter().map(|&n| curve.points[n]));
         // The limb root is where the curve leaves the torso cylinder: between the last curve
@@ -354,12 +358,12 @@ pub fn fit(
         // The leaf sits inside the end cap; the wrist or ankle is one radius in from the tip.
         let tip = tip.max((leaf - knee).dot(&d_low));
         let end = knee + d_low * (tip - radii[1]).max((leaf - knee).dot(&d_low) * 0.5);
-        LimbFit {
+        Some(LimbFit {
             root,
             split,
             end,
             radii,
-        }
+        })
     });
     // Reassociation: points inside the head sphere belong to the head, inside the torso
     // cylinder to the torso, whatever they were before.

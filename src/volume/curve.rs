@@ -35,7 +35,9 @@ pub struct SkeletonCurve {
     pub root: usize,
     /// The five limbs: curve points from the first one after the branch node out to the leaf.
     pub head: Vec<usize>,
-    /// The two arms (arm1, arm2 in the order found; labels are made consistent later).
+    /// The two arms (arm1, arm2 in the order found; labels are made consistent later). An
+    /// empty chain is an arm the curve does not show: it lies against the trunk and its voxels
+    /// joined the trunk's (the sequence places it from the neighbouring frames).
     pub arms: [Vec<usize>; 2],
     /// The two legs.
     pub legs: [Vec<usize>; 2],
@@ -50,9 +52,21 @@ pub struct SkeletonCurve {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CurveProblem {
     #[error(
-        "the skeleton curve has {0} leaves after refinement; a body has 5 (head, 2 arms, 2 legs)"
+        "the skeleton curve has {0} leaves after refinement; a body has 5 (head, 2 arms, 2 legs), and 3 or 4 when arms lie against the trunk"
     )]
     WrongLeafCount(usize),
+}
+
+/// Leaf counts a frame can be named from: five limbs, or the head and the legs with one or
+/// both arms lying against the trunk (their voxels joined it, so the curve has no branch for
+/// them).
+const LEAF_COUNTS: std::ops::RangeInclusive<usize> = 3..=5;
+
+impl SkeletonCurve {
+    /// Arms the curve does not show (0, 1 or 2).
+    pub fn arms_unseen(&self) -> usize {
+        self.arms.iter().filter(|a| a.is_empty()).count()
+    }
 }
 
 fn depth(t: &ShellTree, k: usize) -> usize {
@@ -271,7 +285,7 @@ pub fn head_tip_guess(tree: &ShellTree, input: &[Point3<f64>]) -> Option<Point3<
 /// limbs leaving one node when there is such a node (a raised arm can be shorter than the legs
 /// but a leg is not), else the shortest; the arms are the limbs leaving the head's node first,
 /// then those nearest the head.
-fn name_limbs(limbs: &[(Vec<usize>, usize)], length: &[f64], points: &[Point3<f64>]) -> [usize; 5] {
+fn name_limbs(limbs: &[(Vec<usize>, usize)], length: &[f64], points: &[Point3<f64>]) -> Named {
     let tip = |k: usize| points[*limbs[k].0.last().unwrap_or(&limbs[k].1)];
     let mut nodes: Vec<usize> = limbs.iter().map(|l| l.1).collect();
     nodes.sort_unstable();
@@ -315,9 +329,11 @@ fn name_limbs(limbs: &[(Vec<usize>, usize)], length: &[f64], points: &[Point3<f6
             .chain(&pelvis[2..])
             .copied()
             .filter(|&k| k != head);
-        if let (Some(a1), Some(a2)) = (arms.next(), arms.next()) {
-            return [head, a1, a2, pelvis[0], pelvis[1]];
-        }
+        return Named {
+            head,
+            arms: [arms.next(), arms.next()],
+            legs: [pelvis[0], pelvis[1]],
+        };
     }
     let shortest = |among: &[usize]| {
         among
@@ -343,7 +359,25 @@ fn name_limbs(limbs: &[(Vec<usize>, usize)], length: &[f64], points: &[Point3<f6
         let (ra, rb) = (rank(a), rank(b));
         ra.0.cmp(&rb.0).then(ra.1.total_cmp(&rb.1))
     });
-    [head, rest[0], rest[1], rest[2], rest[3]]
+    // The last two are the legs; the ones before them (none, one or two) the arms seen.
+    let n = rest.len();
+    Named {
+        head,
+        arms: [
+            rest.get(..n - 2).and_then(|a| a.first()).copied(),
+            rest.get(..n - 2).and_then(|a| a.get(1)).copied(),
+        ],
+        legs: [rest[n - 2], rest[n - 1]],
+    }
+}
+
+/// The limbs named by [`name_limbs`] (indices into its `limbs`); an arm is `None` when the curve
+/// does not show it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Named {
+    head: usize,
+    arms: [Option<usize>; 2],
+    legs: [usize; 2],
 }
 
 /// Names the limbs of `tree` (refined by [`adjust_tree_nodes`]). `coords` are the embedded
@@ -354,7 +388,7 @@ pub fn skeleton_curve(
     input: &[Point3<f64>],
 ) -> Result<SkeletonCurve, CurveProblem> {
     let leaves = live_leaves(tree);
-    if leaves != 5 {
+    if !LEAF_COUNTS.contains(&leaves) {
         return Err(CurveProblem::WrongLeafCount(leaves));
     }
     // Live nodes → curve points.
@@ -409,19 +443,20 @@ pub fn skeleton_curve(
     };
     // §4: the shortest branch is the head and the two nearest it the arms. Beyond the paper:
     // see `name_limbs`.
-    if limbs.len() != 5 {
+    if !LEAF_COUNTS.contains(&limbs.len()) {
         return Err(CurveProblem::WrongLeafCount(limbs.len()));
     }
     let lengths: Vec<f64> = limbs.iter().map(length).collect();
-    let [h, a1, a2, l1, l2] = name_limbs(&limbs, &lengths, &points);
+    let named = name_limbs(&limbs, &lengths, &points);
     let mut take = |k: usize| std::mem::take(&mut limbs[k]);
-    let (head, arm1, arm2, leg1, leg2) = (take(h), take(a1), take(a2), take(l1), take(l2));
+    let (head, leg1, leg2) = (take(named.head), take(named.legs[0]), take(named.legs[1]));
+    let arms = named.arms.map(|a| a.map(|k| take(k).0).unwrap_or_default());
     Ok(SkeletonCurve {
         root: index[tree.root],
         chest: head.1,
         pelvis: leg1.1,
         head: head.0,
-        arms: [arm1.0, arm2.0],
+        arms,
         legs: [leg1.0, leg2.0],
         points,
         parents,
@@ -444,7 +479,15 @@ mod tests {
             limbs.push((vec![points.len() - 1], attach));
             lengths.push((points[points.len() - 1] - points[attach]).norm());
         }
-        name_limbs(&limbs, &lengths, &points)
+        let n = name_limbs(&limbs, &lengths, &points);
+        let none = usize::MAX;
+        [
+            n.head,
+            n.arms[0].unwrap_or(none),
+            n.arms[1].unwrap_or(none),
+            n.legs[0],
+            n.legs[1],
+        ]
     }
 
     fn sorted(mut v: [usize; 2]) -> [usize; 2] {

@@ -140,7 +140,7 @@ pub fn point_spacing(points: &[Point3<f64>]) -> f64 {
 /// The volume-to-posture procedure on one frame. Beyond the paper, when a limb touches the body
 /// (a hand on the hip) and so closes a loop, the loop is opened where it touches, as seen from
 /// the head the first pass found, and the frame is done again; the second result is kept when
-/// it gives a pose.
+/// it gives a pose that shows as many arms as the first.
 pub fn process_frame(
     points: &[Point3<f64>],
     params: &VolumeParams,
@@ -166,7 +166,11 @@ pub fn process_frame(
         // A second pass that fails keeps the first one's answer.
         if let Ok(second) = embed_and_fit(&graph, &iso, params) {
             isomap_s += second.isomap_s;
-            if second.result.is_ok() {
+            // Kept unless it shows fewer arms than the first.
+            let unseen = |r: &Result<FrameResult, FrameProblem>| {
+                r.as_ref().map_or(usize::MAX, |f| f.curve.arms_unseen())
+            };
+            if second.result.is_ok() && unseen(&second.result) <= unseen(&result) {
                 result = second.result;
             }
         }
@@ -242,6 +246,27 @@ pub struct Processed {
     pub results: Vec<Result<FrameResult, FrameProblem>>,
     /// Labels, sides and the 16-joint skeleton.
     pub assembled: Assembled,
+}
+
+impl Processed {
+    /// Frames whose skeleton curve showed all five limbs.
+    pub fn five_limb_frames(&self) -> usize {
+        five_limb_frames(&self.results)
+    }
+    /// Frames with a pose of their own (five limbs, or arms against the trunk placed from
+    /// other frames); the rest are interpolated or left out.
+    pub fn posed_frames(&self) -> usize {
+        self.results.iter().filter(|r| r.is_ok()).count()
+    }
+}
+
+/// Frames of `results` whose skeleton curve showed all five limbs.
+pub fn five_limb_frames(results: &[Result<FrameResult, FrameProblem>]) -> usize {
+    results
+        .iter()
+        .flatten()
+        .filter(|f| f.curve.arms_unseen() == 0)
+        .count()
 }
 
 /// Why a whole sequence gave nothing.

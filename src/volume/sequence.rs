@@ -31,8 +31,9 @@ pub struct Assembled {
     /// The 16 joints per frame, in the volume's own coordinates (see `docs/formats.md`).
     pub skeleton: Skeleton3d,
     /// Per input frame, which fitted limb went to each slot (left arm, right arm, left leg,
-    /// right leg); `None` for frames without a pose.
-    pub slots: Vec<Option<[usize; 4]>>,
+    /// right leg); `None` for frames without a pose, and a slot's `None` for an arm the
+    /// skeleton curve did not show (placed from other frames; see the warnings).
+    pub slots: Vec<Option<[Option<usize>; 4]>>,
     /// One sentence per frame that had a problem.
     pub warnings: Vec<String>,
     /// How left and right were decided.
@@ -65,40 +66,83 @@ pub fn assemble(
     fps: f64,
 ) -> Assembled {
     let mut warnings = Vec::new();
+    let name = |i: usize| names.get(i).map_or("?", String::as_str);
     for (i, r) in results.iter().enumerate() {
         if let Err(e) = r {
-            let name = names.get(i).map_or("?", String::as_str);
-            warnings.push(format!("frame {i} ({name}): {e}; interpolated or left out"));
+            warnings.push(format!(
+                "frame {i} ({}): {e}; interpolated or left out",
+                name(i)
+            ));
         }
     }
-    // 1. Consistent labels: limb k of each frame keeps the label of the nearest limb (least sum
-    //    of squared distances) of the previous frame with a pose.
-    let mut order: Vec<Option<[usize; 4]>> = vec![None; results.len()];
-    let mut previous: Option<[Limb; 4]> = None;
-    for (i, r) in results.iter().enumerate() {
-        let Ok(f) = r else { continue };
-        let l = &f.fit.limbs;
-        let mut o = [0, 1, 2, 3];
-        if let Some(p) = &previous {
-            if limb_distance(&l[1], &p[0]) + limb_distance(&l[0], &p[1])
-                < limb_distance(&l[0], &p[0]) + limb_distance(&l[1], &p[1])
+    // 0. The clip's up: the mean trunk direction (pelvis → neck) of the frames whose curve
+    //    showed all five limbs (of every frame with a pose when none did). A frame whose trunk
+    //    points more than a right angle away from it was named upside down (a leg taken for
+    //    the head when an arm lies against the trunk): it is left out like a frame without a
+    //    pose.
+    let trunk = |f: &FrameResult| (f.fit.torso.b - f.fit.pelvis).try_normalize(1e-9);
+    let mean_up = |five: bool| -> Option<Vector3<f64>> {
+        results
+            .iter()
+            .flatten()
+            .filter(|f| !five || f.curve.arms_unseen() == 0)
+            .filter_map(trunk)
+            .sum::<Vector3<f64>>()
+            .try_normalize(1e-9)
+    };
+    let clip_up = mean_up(true).or_else(|| mean_up(false));
+    let results: Vec<Option<&FrameResult>> = results
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let f = r.as_ref().ok()?;
+            if let (Some(up), Some(t)) = (clip_up, trunk(f))
+                && up.dot(&t) < 0.0
             {
-                o.swap(0, 1);
+                warnings.push(format!(
+                    "frame {i} ({}): the trunk named points against the clip's up (upside down); interpolated or left out",
+                    name(i)
+                ));
+                return None;
             }
-            if limb_distance(&l[3], &p[2]) + limb_distance(&l[2], &p[3])
-                < limb_distance(&l[2], &p[2]) + limb_distance(&l[3], &p[3])
-            {
-                o.swap(2, 3);
+            Some(f)
+        })
+        .collect();
+    // 1. Consistent labels: the limbs of each frame keep the labels of the nearest limbs (least
+    //    sum of squared distances) last seen under them; an arm the curve does not show keeps
+    //    no label on that frame.
+    let mut order: Vec<Option<[Option<usize>; 4]>> = vec![None; results.len()];
+    let mut last: [Option<Limb>; 4] = [None; 4];
+    for (i, r) in results.iter().enumerate() {
+        let Some(f) = r else { continue };
+        let l = &f.fit.limbs;
+        let mut o = [Some(0), Some(1), Some(2), Some(3)];
+        for pair in [0, 2] {
+            let (a, b) = (pair, pair + 1);
+            let cost = |x: usize, y: usize| {
+                let d = |k: usize, label: usize| match (&l[k], &last[label]) {
+                    (Some(m), Some(n)) => limb_distance(m, n),
+                    _ => 0.0,
+                };
+                d(x, a) + d(y, b)
+            };
+            if cost(b, a) < cost(a, b) {
+                o.swap(a, b);
             }
         }
-        previous = Some(o.map(|k| l[k]));
+        let o = o.map(|k| k.filter(|&k| l[k].is_some()));
+        for (label, k) in o.iter().enumerate() {
+            if let Some(k) = k {
+                last[label] = l[*k];
+            }
+        }
         order[i] = Some(o);
     }
-    let labelled = |i: usize| -> Option<[Limb; 4]> {
-        let (Ok(f), Some(o)) = (&results[i], order[i]) else {
+    let labelled = |i: usize| -> Option<[Option<Limb>; 4]> {
+        let (Some(f), Some(o)) = (results[i], order[i]) else {
             return None;
         };
-        Some(o.map(|k| f.fit.limbs[k]))
+        Some(o.map(|k| k.and_then(|k| f.fit.limbs[k])))
     };
 
     // 2. Static lengths from articulated frames.
@@ -107,7 +151,9 @@ pub fn assemble(
     for i in 0..results.len() {
         let Some(limbs) = labelled(i) else { continue };
         for (k, l) in limbs.iter().enumerate() {
-            if let Some(s) = l.split {
+            if let Some(l) = l
+                && let Some(s) = l.split
+            {
                 sums[k][0] += (s - l.root).norm();
                 sums[k][1] += (l.end - s).norm();
                 counts[k] += 1;
@@ -152,15 +198,18 @@ pub fn assemble(
     let sign = |x: f64| if x > 0.0 { 1 } else { -1 };
     for pass in [SidesFrom::Knees, SidesFrom::Elbows] {
         for (i, r) in results.iter().enumerate() {
-            let (Some(l), Ok(f)) = (labelled(i), r) else {
+            let (Some(l), Some(f)) = (labelled(i), r) else {
                 continue;
             };
             let up = f.fit.torso.b - f.fit.torso.a;
             let fronts: Vec<Vector3<f64>> = match pass {
-                SidesFrom::Knees => [2, 3].iter().filter_map(|&k| bend(&l[k])).collect(),
+                SidesFrom::Knees => [2, 3]
+                    .iter()
+                    .filter_map(|&k| l[k].as_ref().and_then(bend))
+                    .collect(),
                 _ => [0, 1]
                     .iter()
-                    .filter_map(|&k| bend(&l[k]).map(|b| -b))
+                    .filter_map(|&k| l[k].as_ref().and_then(bend).map(|b| -b))
                     .collect(),
             };
             let Some(front) = fronts
@@ -172,7 +221,9 @@ pub fn assemble(
                 continue;
             };
             let left = up.cross(&front);
-            votes[1] += sign((l[2].root - l[3].root).dot(&left));
+            if let (Some(l2), Some(l3)) = (&l[2], &l[3]) {
+                votes[1] += sign((l2.root - l3.root).dot(&left));
+            }
             sides_from = pass;
         }
         if sides_from != SidesFrom::Arbitrary {
@@ -180,8 +231,8 @@ pub fn assemble(
         }
     }
     for i in 0..results.len() {
-        if let Some(l) = labelled(i) {
-            votes[0] += sign((l[0].root - l[1].root).dot(&(l[2].root - l[3].root)));
+        if let Some([Some(a0), Some(a1), Some(l2), Some(l3)]) = labelled(i) {
+            votes[0] += sign((a0.root - a1.root).dot(&(l2.root - l3.root)));
         }
     }
     let swap_legs = votes[1] < 0;
@@ -189,7 +240,7 @@ pub fn assemble(
     let swap_arms = (votes[0] < 0) != swap_legs;
 
     // Labels → slots (left arm, right arm, left leg, right leg), in one place.
-    let to_slots = |mut x: [usize; 4]| {
+    let to_slots = |mut x: [Option<usize>; 4]| {
         if swap_arms {
             x.swap(0, 1);
         }
@@ -198,15 +249,54 @@ pub fn assemble(
         }
         x
     };
-    let slots: Vec<Option<[usize; 4]>> = order.iter().map(|o| o.map(to_slots)).collect();
-    let frac = to_slots([0, 1, 2, 3]).map(|label| fraction[label]);
+    let slots: Vec<Option<[Option<usize>; 4]>> = order.iter().map(|o| o.map(to_slots)).collect();
+    let frac = to_slots([Some(0), Some(1), Some(2), Some(3)])
+        .map(|label| label.map_or(0.5, |l| fraction[l]));
 
-    // 4. The 16 joints.
+    // 4. Arms the curve did not show are placed from the frames that saw them (see `place_unseen`).
+    let seen: Vec<Option<[Option<Limb>; 4]>> = (0..results.len())
+        .map(|i| {
+            let (Some(f), Some(s)) = (results[i], slots[i]) else {
+                return None;
+            };
+            Some(s.map(|k| k.and_then(|k| f.fit.limbs[k])))
+        })
+        .collect();
+    let trunk_frames: Vec<Option<TrunkFrame>> = (0..results.len())
+        .map(|i| {
+            let (Some(f), Some(l)) = (results[i], &seen[i]) else {
+                return None;
+            };
+            TrunkFrame::new(f, l)
+        })
+        .collect();
+    let mut placed = seen.clone();
+    for slot in 0..2 {
+        for i in 0..results.len() {
+            let (Some(Some(limbs)), Some(trunk)) = (placed.get(i), &trunk_frames[i]) else {
+                continue;
+            };
+            if limbs[slot].is_some() {
+                continue;
+            }
+            let (limb, how) = place_unseen(slot, i, &seen, &trunk_frames, trunk, limbs);
+            let side = if slot == 0 { "left" } else { "right" };
+            let name = names.get(i).map_or("?", String::as_str);
+            warnings.push(format!(
+                "frame {i} ({name}): the {side} arm lies against the trunk (the skeleton curve has no branch for it); {how}"
+            ));
+            if let Some(Some(l)) = placed.get_mut(i) {
+                l[slot] = Some(limb);
+            }
+        }
+    }
+
+    // 5. The 16 joints.
     let pose = |i: usize| -> Option<PerJoint<Point3<f64>>> {
-        let (Ok(f), Some(s)) = (&results[i], slots[i]) else {
+        let (Some(f), Some(Some(limbs))) = (results[i], placed.get(i)) else {
             return None;
         };
-        let limbs = s.map(|k| f.fit.limbs[k]);
+        let limbs: [Limb; 4] = [limbs[0]?, limbs[1]?, limbs[2]?, limbs[3]?];
         let mid = |k: usize| {
             let l = &limbs[k];
             l.split
@@ -301,4 +391,114 @@ pub fn assemble(
         warnings,
         sides_from,
     }
+}
+
+/// A frame's trunk axes: origin at the pelvis, `up` towards the neck, `across` along the hips
+/// (leg slot 2 to 3, made square to `up`), `out` completing them.
+#[derive(Debug, Clone, Copy)]
+struct TrunkFrame {
+    origin: Point3<f64>,
+    axes: [Vector3<f64>; 3],
+    /// Neck height above the pelvis, metres.
+    height: f64,
+}
+
+impl TrunkFrame {
+    fn new(f: &FrameResult, limbs: &[Option<Limb>; 4]) -> Option<TrunkFrame> {
+        let up_vec = f.fit.torso.b - f.fit.pelvis;
+        let up = up_vec.try_normalize(1e-9)?;
+        let hips = limbs[2]?.root - limbs[3]?.root;
+        let across = (hips - up * hips.dot(&up)).try_normalize(1e-9)?;
+        Some(TrunkFrame {
+            origin: f.fit.pelvis,
+            axes: [up, across, up.cross(&across)],
+            height: up_vec.norm(),
+        })
+    }
+    fn local(&self, p: &Point3<f64>) -> Vector3<f64> {
+        let d = p - self.origin;
+        Vector3::new(
+            d.dot(&self.axes[0]),
+            d.dot(&self.axes[1]),
+            d.dot(&self.axes[2]),
+        )
+    }
+    fn world(&self, v: &Vector3<f64>) -> Point3<f64> {
+        self.origin + self.axes[0] * v.x + self.axes[1] * v.y + self.axes[2] * v.z
+    }
+    fn limb_to_local(&self, l: &Limb) -> [Option<Vector3<f64>>; 3] {
+        [
+            Some(self.local(&l.root)),
+            l.split.map(|s| self.local(&s)),
+            Some(self.local(&l.end)),
+        ]
+    }
+}
+
+/// An arm (slot 0 or 1) frame `i` does not show, and how it was placed: its pose in the trunk's
+/// axes carried from the nearest frames before and after that saw it (linearly between them, or
+/// from the one there is); with none, hanging down the trunk's side opposite the other arm, as
+/// long as the other arm (arms lie against the trunk when they hang).
+fn place_unseen(
+    slot: usize,
+    i: usize,
+    seen: &[Option<[Option<Limb>; 4]>],
+    trunks: &[Option<TrunkFrame>],
+    trunk: &TrunkFrame,
+    limbs: &[Option<Limb>; 4],
+) -> (Limb, String) {
+    let seen_at =
+        |k: usize| -> Option<(Limb, TrunkFrame)> { Some((seen[k].as_ref()?[slot]?, trunks[k]?)) };
+    let before = (0..i).rev().find_map(|k| seen_at(k).map(|x| (k, x)));
+    let after = (i + 1..seen.len()).find_map(|k| seen_at(k).map(|x| (k, x)));
+    let local = |(l, t): &(Limb, TrunkFrame)| t.limb_to_local(l);
+    let radii = |l: &Limb| l.radii;
+    let build = |v: [Option<Vector3<f64>>; 3], r: [f64; 2]| -> Option<Limb> {
+        Some(Limb {
+            root: trunk.world(&v[0]?),
+            split: v[1].map(|s| trunk.world(&s)),
+            end: trunk.world(&v[2]?),
+            radii: r,
+        })
+    };
+    let from_frames = match (&before, &after) {
+        (Some((kb, b)), Some((ka, a))) => {
+            let t = (i - kb) as f64 / (ka - kb) as f64;
+            let (lb, la) = (local(b), local(a));
+            let mix: [Option<Vector3<f64>>; 3] = std::array::from_fn(|j| match (lb[j], la[j]) {
+                (Some(x), Some(y)) => Some(x + (y - x) * t),
+                (x, y) => x.or(y),
+            });
+            build(mix, radii(&b.0)).map(|l| (l, format!("placed between frames {kb} and {ka}")))
+        }
+        (Some((k, x)), None) | (None, Some((k, x))) => {
+            build(local(x), radii(&x.0)).map(|l| (l, format!("placed as on frame {k}")))
+        }
+        (None, None) => None,
+    };
+    from_frames.unwrap_or_else(|| {
+        // Hanging: the shoulder mirrors the other one across the trunk's axis (or sits a fifth
+        // of the trunk's height to the side), the arm as long as the other, straight down.
+        let other = limbs[1 - slot];
+        let side = if slot == 0 { 1.0 } else { -1.0 };
+        let shoulder = other.map_or_else(
+            || Vector3::new(trunk.height * 0.9, side * trunk.height * 0.2, 0.0),
+            |o| {
+                let v = trunk.local(&o.root);
+                Vector3::new(v.x, -v.y, v.z)
+            },
+        );
+        let length = other.map_or(trunk.height * 1.2, |o| (o.end - o.root).norm());
+        let root = trunk.world(&shoulder);
+        let limb = Limb {
+            root,
+            split: None,
+            end: root - trunk.axes[0] * length,
+            radii: other.map_or([0.04, 0.035], |o| o.radii),
+        };
+        (
+            limb,
+            "no frame shows it: hung down the trunk's side".to_owned(),
+        )
+    })
 }

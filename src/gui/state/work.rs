@@ -110,12 +110,12 @@ impl State {
                     self.running = None;
                     match (result, &mut self.volume) {
                         (Ok(p), Some(v)) => {
-                            let ok = p.results.iter().filter(|r| r.is_ok()).count();
                             self.status = format!(
-                                "{}   {} frames, {} with a five-limb skeleton curve, {} warnings",
+                                "{}   {} frames, {} with a five-limb skeleton curve, {} with a pose, {} warnings",
                                 v.dir.display(),
                                 p.files.len(),
-                                ok,
+                                p.five_limb_frames(),
+                                p.posed_frames(),
                                 p.assembled.warnings.len()
                             );
                             v.set(p);

@@ -126,7 +126,7 @@ pub fn volume_scene(v: &VolumeSequence, index: usize) -> Scene {
             .get(index)
             .copied()
             .flatten()
-            .and_then(|s| s.iter().position(|&x| x == usize::from(k)))
+            .and_then(|s| s.iter().position(|&x| x == Some(usize::from(k))))
             .unwrap_or(usize::from(k))
     };
     let limb_colour = |k: u8, lower: bool| {
@@ -168,7 +168,7 @@ pub fn volume_scene(v: &VolumeSequence, index: usize) -> Scene {
         };
         sphere(f.head_centre, f.head_radius, &mut push);
         cylinder(&f.torso, &mut push);
-        for l in &f.limbs {
+        for l in f.limbs.iter().flatten() {
             let knee = l.split.unwrap_or_else(|| nalgebra::center(&l.root, &l.end));
             for (a, b, r) in [(l.root, knee, l.radii[0]), (knee, l.end, l.radii[1])] {
                 cylinder(&Cylinder { a, b, radius: r }, &mut push);
