@@ -12,6 +12,7 @@ pub mod cloud;
 pub mod curve;
 mod handles;
 pub mod isomap;
+pub mod labels;
 pub mod sequence;
 pub mod shells;
 pub mod voxel;

@@ -1,8 +1,9 @@
-//! The second pass across frames (paper §4): consistent limb labels by the least sum of squared
-//! distances between neighbouring frames, static segment lengths from articulated frames (used
-//! to place the elbow or knee of a straight limb), and the 16-joint skeleton3d. Beyond the
-//! paper, which assigns no left and right: the side of each labelled limb is voted from the
-//! direction knees bend (forwards), or elbows (backwards) when no knee ever bends.
+//! The second pass across frames (paper §4), in the order [`assemble`] runs it: the clip's up
+//! (upside-down frames left out), consistent limb labels with left and right (chosen over the
+//! whole clip by `labels`, from continuity and the knees' or elbows' cues; beyond the paper,
+//! which assigns no sides), static segment lengths from articulated frames (used to place the
+//! elbow or knee of a straight limb), arms against the trunk placed from the frames that saw
+//! them, and the 16-joint skeleton3d.
 //!
 //! Frames that gave no pose are interpolated between their good neighbours (flagged
 //! `interpolated`) or, before the first and after the last good frame, left out.
@@ -42,13 +43,10 @@ pub struct Assembled {
 
 type Limb = super::bodies::LimbFit;
 
-fn limb_distance(a: &Limb, b: &Limb) -> f64 {
-    let mut d = (a.root - b.root).norm_squared() + (a.end - b.end).norm_squared();
-    if let (Some(x), Some(y)) = (a.split, b.split) {
-        d += (x - y).norm_squared();
-    }
-    d
-}
+/// What a frame whose left and right cue disagrees with a labelling adds to that labelling's
+/// price, in squared typical motions per frame (see `labels`): a run of frames agreeing on the
+/// sides outweighs one step of doubtful continuity.
+const SIDE_CUE: f64 = 1.0;
 
 /// Offset of the bend point from the root–end line (zero when straight).
 fn bend(l: &Limb) -> Option<Vector3<f64>> {
@@ -108,36 +106,63 @@ pub fn assemble(
             Some(f)
         })
         .collect();
-    // 1. Consistent labels: the limbs of each frame keep the labels of the nearest limbs (least
-    //    sum of squared distances) last seen under them; an arm the curve does not show keeps
-    //    no label on that frame.
-    let mut order: Vec<Option<[Option<usize>; 4]>> = vec![None; results.len()];
-    let mut last: [Option<Limb>; 4] = [None; 4];
-    for (i, r) in results.iter().enumerate() {
-        let Some(f) = r else { continue };
-        let l = &f.fit.limbs;
-        let mut o = [Some(0), Some(1), Some(2), Some(3)];
-        for pair in [0, 2] {
-            let (a, b) = (pair, pair + 1);
-            let cost = |x: usize, y: usize| {
-                let d = |k: usize, label: usize| match (&l[k], &last[label]) {
-                    (Some(m), Some(n)) => limb_distance(m, n),
-                    _ => 0.0,
-                };
-                d(x, a) + d(y, b)
-            };
-            if cost(b, a) < cost(a, b) {
-                o.swap(a, b);
-            }
+    // 1. Labels and sides: left = up × front, where front is the way knees bend (or, if no knee ever
+    //    bends, the opposite of the way elbows bend), and the arms take the side of the leg
+    //    below them. Each frame's cues price its labellings; the labels are then chosen over
+    //    the whole clip (see `labels`), the cues with the continuity of the limbs, and frames
+    //    whose limbs do not follow from the frames around them are left out.
+    let bends = |pair: [usize; 2], sign: f64| {
+        move |f: &FrameResult| -> Vec<Vector3<f64>> {
+            pair.iter()
+                .filter_map(|&k| f.fit.limbs[k].as_ref().and_then(bend).map(|b| b * sign))
+                .collect()
         }
-        let o = o.map(|k| k.filter(|&k| l[k].is_some()));
-        for (label, k) in o.iter().enumerate() {
-            if let Some(k) = k {
-                last[label] = l[*k];
-            }
+    };
+    let knees = bends([2, 3], 1.0);
+    let elbows = bends([0, 1], -1.0);
+    let sides_from = if results.iter().flatten().any(|f| !knees(f).is_empty()) {
+        SidesFrom::Knees
+    } else if results.iter().flatten().any(|f| !elbows(f).is_empty()) {
+        SidesFrom::Elbows
+    } else {
+        SidesFrom::Arbitrary
+    };
+    let cue = |i: usize, labelling: &[usize; 4]| -> f64 {
+        let Some(f) = results[i] else { return 0.0 };
+        let l = labelling.map(|k| f.fit.limbs[k]);
+        let mut cost = 0.0;
+        let fronts = match sides_from {
+            SidesFrom::Knees => knees(f),
+            SidesFrom::Elbows => elbows(f),
+            SidesFrom::Arbitrary => Vec::new(),
+        };
+        let front = fronts.iter().sum::<Vector3<f64>>().try_normalize(1e-12);
+        let up = f.fit.torso.b - f.fit.torso.a;
+        if let (Some(front), Some(l2), Some(l3)) = (front, l[2], l[3])
+            && (l2.root - l3.root).dot(&up.cross(&front)) < 0.0
+        {
+            cost += SIDE_CUE;
         }
-        order[i] = Some(o);
+        if let [Some(a0), Some(a1), Some(l2), Some(l3)] = l
+            && (a0.root - a1.root).dot(&(l2.root - l3.root)) < 0.0
+        {
+            cost += SIDE_CUE;
+        }
+        cost
+    };
+    let labels = super::labels::label(&results, &cue);
+    for &i in &labels.left_out {
+        warnings.push(format!(
+            "frame {i} ({}): its parts do not follow from the frames around it under any labelling (misnamed); interpolated or left out",
+            name(i)
+        ));
     }
+    let order = labels.order;
+    let results: Vec<Option<&FrameResult>> = results
+        .iter()
+        .zip(&order)
+        .map(|(r, o)| r.filter(|_| o.is_some()))
+        .collect();
     let labelled = |i: usize| -> Option<[Option<Limb>; 4]> {
         let (Some(f), Some(o)) = (results[i], order[i]) else {
             return None;
@@ -190,70 +215,10 @@ pub fn assemble(
         neck_chest / (neck_chest + chest_pelvis)
     };
 
-    // 3. Sides, voted frame by frame: left = up × front, where front is the way knees bend
-    //    (or, if no knee ever bends, the opposite of the way elbows bend). The arms then take
-    //    the side of the leg below them.
-    let mut votes = [0i64; 2]; // arms, legs: > 0 means label 0 is the left one
-    let mut sides_from = SidesFrom::Arbitrary;
-    let sign = |x: f64| if x > 0.0 { 1 } else { -1 };
-    for pass in [SidesFrom::Knees, SidesFrom::Elbows] {
-        for (i, r) in results.iter().enumerate() {
-            let (Some(l), Some(f)) = (labelled(i), r) else {
-                continue;
-            };
-            let up = f.fit.torso.b - f.fit.torso.a;
-            let fronts: Vec<Vector3<f64>> = match pass {
-                SidesFrom::Knees => [2, 3]
-                    .iter()
-                    .filter_map(|&k| l[k].as_ref().and_then(bend))
-                    .collect(),
-                _ => [0, 1]
-                    .iter()
-                    .filter_map(|&k| l[k].as_ref().and_then(bend).map(|b| -b))
-                    .collect(),
-            };
-            let Some(front) = fronts
-                .iter()
-                .sum::<Vector3<f64>>()
-                .try_normalize(1e-12)
-                .filter(|_| !fronts.is_empty())
-            else {
-                continue;
-            };
-            let left = up.cross(&front);
-            if let (Some(l2), Some(l3)) = (&l[2], &l[3]) {
-                votes[1] += sign((l2.root - l3.root).dot(&left));
-            }
-            sides_from = pass;
-        }
-        if sides_from != SidesFrom::Arbitrary {
-            break;
-        }
-    }
-    for i in 0..results.len() {
-        if let Some([Some(a0), Some(a1), Some(l2), Some(l3)]) = labelled(i) {
-            votes[0] += sign((a0.root - a1.root).dot(&(l2.root - l3.root)));
-        }
-    }
-    let swap_legs = votes[1] < 0;
-    // Arm 0 is on leg 0's side when votes[0] > 0; it is the left arm when that leg is left.
-    let swap_arms = (votes[0] < 0) != swap_legs;
+    let slots = order;
+    let frac = fraction;
 
-    // Labels → slots (left arm, right arm, left leg, right leg), in one place.
-    let to_slots = |mut x: [Option<usize>; 4]| {
-        if swap_arms {
-            x.swap(0, 1);
-        }
-        if swap_legs {
-            x.swap(2, 3);
-        }
-        x
-    };
-    let slots: Vec<Option<[Option<usize>; 4]>> = order.iter().map(|o| o.map(to_slots)).collect();
-    let frac = to_slots([Some(0), Some(1), Some(2), Some(3)])
-        .map(|label| label.map_or(0.5, |l| fraction[l]));
-
-    // 4. Arms the curve did not show are placed from the frames that saw them (see `place_unseen`).
+    // 3. Arms the curve did not show are placed from the frames that saw them (see `place_unseen`).
     let seen: Vec<Option<[Option<Limb>; 4]>> = (0..results.len())
         .map(|i| {
             let (Some(f), Some(s)) = (results[i], slots[i]) else {
@@ -291,7 +256,7 @@ pub fn assemble(
         }
     }
 
-    // 5. The 16 joints.
+    // 4. The 16 joints.
     let pose = |i: usize| -> Option<PerJoint<Point3<f64>>> {
         let (Some(f), Some(Some(limbs))) = (results[i], placed.get(i)) else {
             return None;
