@@ -226,9 +226,14 @@ pub struct CarveArgs {
     /// Voxel size, millimetres.
     #[arg(long, default_value_t = 40.0)]
     pub voxel_mm: f64,
-    /// Masks that must contain a voxel for it to stay (default: every camera).
+    /// Masks that must contain a voxel for it to stay (default: every camera; one fewer keeps a
+    /// limb one view's segmentation missed, at the cost of a fatter hull).
     #[arg(long)]
     pub min_votes: Option<usize>,
+    /// X,Y,Z (metres, the set-up's world): keep the blob nearest this point, the person the
+    /// carve is for (default: the largest blob). What is dropped is reported.
+    #[arg(long)]
+    pub person: Option<String>,
 }
 
 /// `synth`.
@@ -302,6 +307,11 @@ pub struct SynthArgs {
     /// camera's silhouette masks.
     #[arg(long, default_value_t = 0, requires = "volume")]
     pub views: usize,
+    /// With --views, draw the faults of real segmentation into the masks: edges eroded 2 px on
+    /// the first view and dilated 2 px on the second, the right forearm missing on the third, a
+    /// shadow joined to the feet and a second person 1.2 m to the side (+X).
+    #[arg(long, requires = "views")]
+    pub faulty_silhouettes: bool,
     /// Output directory.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -317,7 +327,8 @@ pub struct BenchArgs {
     /// the flat cut-out; speed), correct (the tracks before and after a simulated user's
     /// corrections, one per 25 frames), scrub (the desktop app's frame access on a long 1080p
     /// clip: open time, random seeks, scrubbing, peak memory), or volume (the point-volume
-    /// pipeline: topology, joint error, labels, dev and test takes, time per frame at
+    /// pipeline: topology, joint error, labels, dev and test takes, carved from clean and faulty
+    /// silhouettes, time per frame at
     /// 3k/10k/30k points). The suite renders once into --suite-dir (about 6 minutes).
     #[arg(default_value = "all")]
     pub what: String,

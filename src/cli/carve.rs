@@ -22,12 +22,30 @@ pub fn run(a: &CarveArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             a.setup.display()
         )));
     }
+    let person = match &a.person {
+        None => None,
+        Some(text) => {
+            let v: Vec<f64> = text
+                .split(',')
+                .map(|x| x.trim().parse::<f64>())
+                .collect::<Result<_, _>>()
+                .ok()
+                .filter(|v: &Vec<f64>| v.len() == 3 && v.iter().all(|x| x.is_finite()))
+                .ok_or_else(|| {
+                    ExitError::bad_input(anyhow!(
+                        "--person must be X,Y,Z in metres (a point in the set-up's world the person stays near), got {text:?}"
+                    ))
+                })?;
+            Some(nalgebra::Point3::new(v[0], v[1], v[2]))
+        }
+    };
     let setup = open_setup(&a.setup).map_err(ExitError::bad_input)?;
     let bar = progress_bar(global, setup.frames.len() as u64, "carving");
-    let counts = carve_sequence(
+    let kept = carve_sequence(
         &setup,
         a.voxel_mm / 1000.0,
         a.min_votes,
+        person,
         &a.output,
         &|done, _| bar.set_position(done as u64),
         &AtomicBool::new(false),
@@ -39,7 +57,7 @@ pub fn run(a: &CarveArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         _ => ExitError::bad_input(e),
     })?;
     bar.finish_and_clear();
-    let empty = counts.iter().filter(|&&c| c == 0).count();
+    let empty = kept.iter().filter(|k| k.voxels == 0).count();
     if empty > 0 {
         say(
             global,
@@ -48,13 +66,41 @@ pub fn run(a: &CarveArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             ),
         );
     }
+    // What the carve dropped: the other blobs (a second person, a shadow cut off, fragments).
+    let with_others: Vec<usize> = (0..kept.len())
+        .filter(|&k| kept[k].dropped_voxels > 0)
+        .collect();
+    if let (Some(first), Some(most)) = (
+        with_others.first(),
+        with_others
+            .iter()
+            .max_by_key(|&&k| kept[k].dropped_voxels)
+            .copied(),
+    ) {
+        say(
+            global,
+            &format!(
+                "dropped other blobs on {} of {} frames (from frame {first}; most on frame {most}: {} voxels in {} blobs), keeping {}",
+                with_others.len(),
+                kept.len(),
+                kept[most].dropped_voxels,
+                kept[most].dropped_components,
+                if person.is_some() {
+                    "the one nearest --person"
+                } else {
+                    "the largest (--person X,Y,Z keeps the one nearest a point)"
+                }
+            ),
+        );
+    }
+    let n = kept.len().max(1) as f64;
     say(
         global,
         &format!(
             "carved {} frames from {} cameras ({:.0} voxels per frame) into {}",
-            counts.len(),
+            kept.len(),
             setup.cameras.len(),
-            counts.iter().sum::<usize>() as f64 / counts.len().max(1) as f64,
+            kept.iter().map(|k| k.voxels).sum::<usize>() as f64 / n,
             a.output.display()
         ),
     );

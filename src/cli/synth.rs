@@ -7,8 +7,9 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use videomocap::camera::PinholeCamera;
 use videomocap::synth::{
-    MotionSource, ProceduralMotion, SensorEffects, SynthError, SynthParams, VideoOutput, View,
-    VoxelParams, load_motion, render_clip, write_carving_setup, write_volume_sequence,
+    MotionSource, ProceduralMotion, SensorEffects, SilhouetteFaults, SynthError, SynthParams,
+    VideoOutput, View, VoxelParams, load_motion, render_clip, write_carving_setup,
+    write_volume_sequence,
 };
 
 /// Horizontal field of view of the synthetic camera when none is given (a phone's main camera
@@ -162,9 +163,19 @@ fn volume(a: &SynthArgs, params: &SynthParams, global: &GlobalArgs) -> Result<()
     if a.views > 0 {
         let dir = a.output.join("carve");
         let bar = progress_bar(global, motion.frames.len() as u64, "silhouettes");
-        write_carving_setup(&motion, &dir, a.views, (a.width, a.height), &|done, _| {
-            bar.set_position(done as u64)
-        })
+        let faults = if a.faulty_silhouettes {
+            SilhouetteFaults::typical()
+        } else {
+            SilhouetteFaults::default()
+        };
+        write_carving_setup(
+            &motion,
+            &dir,
+            a.views,
+            (a.width, a.height),
+            &faults,
+            &|done, _| bar.set_position(done as u64),
+        )
         .map_err(ExitError::failed)?;
         bar.finish_and_clear();
         say(

@@ -165,34 +165,81 @@ pub fn score_volume(truth: &Skeleton3d, result: &Skeleton3d, topology_ok: usize)
     s
 }
 
-/// Carves `motion` from `views` synthetic silhouettes (640×480 cameras around the body, see
-/// [`crate::synth::write_carving_setup`]) at `voxel_m`, runs the volume pipeline on the grids
-/// and scores it against the truth; also returns the mean occupied voxels per frame. Every file
-/// lives in a temporary directory. What the carving test and `bench volume` measure.
+/// How `carve_and_score` carves: views, voxel size, the faults drawn into the silhouettes and
+/// how many masks must hold a voxel (`None`: every one).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CarveCase {
+    /// Cameras on the ring.
+    pub views: usize,
+    /// Voxel edge, metres.
+    pub voxel_m: f64,
+    /// Faults drawn into the masks.
+    pub faults: crate::synth::SilhouetteFaults,
+    /// Masks that must contain a voxel.
+    pub min_votes: Option<usize>,
+}
+
+/// What one carved sequence gave: its score, the mean voxels kept per frame, and the mean
+/// voxels the carve dropped per frame (other components: a second person, fragments).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CarveResult {
+    /// Accuracy against the truth.
+    pub score: VolumeScore,
+    /// Mean voxels kept per frame.
+    pub voxels: f64,
+    /// Mean voxels dropped per frame.
+    pub dropped: f64,
+}
+
+/// Carves `motion` as `case` says (640×480 cameras around the body, see
+/// [`crate::synth::write_carving_setup`]), keeping the component nearest the body's mean
+/// pelvis (the person a user points at), runs the volume pipeline on the grids and scores it
+/// against the truth. Every file lives in a temporary directory. What the carving test and
+/// `bench volume` measure.
 pub fn carve_and_score(
     motion: &crate::synth::Motion,
-    views: usize,
-    voxel_m: f64,
+    case: &CarveCase,
     params: &crate::volume::VolumeParams,
-) -> Result<(VolumeScore, f64), crate::volume::SequenceError> {
+) -> Result<CarveResult, crate::volume::SequenceError> {
     use crate::volume::carve::{carve_sequence, open_setup};
     use crate::volume::{VolumeError, process_directory};
     use std::sync::atomic::AtomicBool;
     let dir = tempfile::tempdir().map_err(VolumeError::io(&std::env::temp_dir()))?;
     let (setup_dir, grids) = (dir.path().join("setup"), dir.path().join("grids"));
-    crate::synth::write_carving_setup(motion, &setup_dir, views, (640, 480), &|_, _| {})?;
+    crate::synth::write_carving_setup(
+        motion,
+        &setup_dir,
+        case.views,
+        (640, 480),
+        &case.faults,
+        &|_, _| {},
+    )?;
     let setup = open_setup(&setup_dir)?;
     let never = AtomicBool::new(false);
-    let counts = carve_sequence(&setup, voxel_m, None, &grids, &|_, _| {}, &never)?;
+    let pelvis = motion
+        .frames
+        .iter()
+        .map(|f| f[crate::skeleton::Joint::Pelvis].coords)
+        .sum::<nalgebra::Vector3<f64>>()
+        / motion.frames.len().max(1) as f64;
+    let kept = carve_sequence(
+        &setup,
+        case.voxel_m,
+        case.min_votes,
+        Some(nalgebra::Point3::from(pelvis)),
+        &grids,
+        &|_, _| {},
+        &never,
+    )?;
     let p = process_directory(&grids, params, motion.fps, &|_, _| {}, &never)?;
-    let ok = p.five_limb_frames();
-    let voxels = counts.iter().sum::<usize>() as f64 / counts.len().max(1) as f64;
-    Ok((
-        score_volume(
+    let n = kept.len().max(1) as f64;
+    Ok(CarveResult {
+        score: score_volume(
             &crate::synth::volume_truth(motion),
             &p.assembled.skeleton,
-            ok,
+            p.five_limb_frames(),
         ),
-        voxels,
-    ))
+        voxels: kept.iter().map(|k| k.voxels).sum::<usize>() as f64 / n,
+        dropped: kept.iter().map(|k| k.dropped_voxels).sum::<usize>() as f64 / n,
+    })
 }

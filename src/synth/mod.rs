@@ -5,6 +5,7 @@
 
 mod appearance;
 mod body;
+mod faults;
 mod ground_truth;
 mod motion;
 mod render;
@@ -12,6 +13,7 @@ mod volume;
 
 pub use appearance::{Appearance, Cloth, Clothes, Pattern};
 pub use body::{BodyShape, JointDefinitions, retarget, shoulder_girdle};
+pub use faults::SilhouetteFaults;
 pub use ground_truth::{GroundTruth, GroundTruthFrame};
 pub use motion::{
     Motion, ProceduralMotion, from_bvh, normalise_orientation, procedural, stature_of,

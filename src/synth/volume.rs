@@ -3,6 +3,7 @@
 //! written as one binary PLY per frame and the true joints as `truth.skeleton3d.json`. This is
 //! the ground truth of the volume pipeline's tests and benchmark.
 
+use super::faults::SilhouetteFaults;
 use super::motion::{Motion, stature_of};
 use super::render::Body;
 use crate::camera::PinholeCamera;
@@ -157,12 +158,14 @@ pub fn silhouette(points: &[Point3<f64>], voxel_m: f64, cam: &CalibratedCamera) 
 /// Writes a carving set-up of `motion` into `dir` for `videomocap carve`: `views` cameras of
 /// `width`×`height` pixels on a ring around the space the body moves in (see [`ring_cameras`]),
 /// `cameras.json` with that box, and `masks/<camera>/frame_NNNN.png`, the body's silhouettes
-/// (from 10 mm voxels), frames in parallel; `progress(done, total)` after each frame.
+/// (from 10 mm voxels), frames in parallel, with `faults` drawn in (a second person widens the
+/// box to hold them); `progress(done, total)` after each frame.
 pub fn write_carving_setup(
     motion: &Motion,
     dir: &Path,
     views: usize,
     (width, height): (u32, u32),
+    faults: &SilhouetteFaults,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(), VolumeError> {
     let stature = stature_of(motion);
@@ -170,10 +173,15 @@ pub fn write_carving_setup(
         Point3::from(Vector3::repeat(f64::MAX)),
         Point3::from(Vector3::repeat(f64::MIN)),
     );
+    let second = Vector3::x() * faults.second_person_m.unwrap_or(0.0);
     for j in &motion.frames {
         let (a, b) = Body::new(j, stature).bounds();
         lo = lo.inf(&a);
         hi = hi.sup(&b);
+        if faults.second_person_m.is_some() {
+            lo = lo.inf(&(a + second));
+            hi = hi.sup(&(b + second));
+        }
     }
     let margin = Vector3::repeat(0.2);
     let (lo, hi) = (lo - margin, hi + margin);
@@ -203,16 +211,34 @@ pub fn write_carving_setup(
             // No noise or holes: the generator is never drawn from.
             let mut rng = rand::rngs::StdRng::seed_from_u64(fine.seed);
             let pts = voxelise(joints, stature, &fine, &mut rng);
-            for c in &cameras {
+            // Faults drawn on every view: the shadow, the second person.
+            let mut extra = Vec::new();
+            if faults.shadow {
+                let floor = pts.iter().map(|p| p.y).fold(f64::INFINITY, f64::min);
+                extra.extend(SilhouetteFaults::shadow_points(joints, floor, fine.voxel_m));
+            }
+            if faults.second_person_m.is_some() {
+                let other = &motion.frames[(i + motion.frames.len() / 2) % motion.frames.len()];
+                let other: PerJoint<Point3<f64>> = PerJoint::from_fn(|j| other[j] + second);
+                extra.extend(voxelise(&other, stature, &fine, &mut rng));
+            }
+            for (view, c) in cameras.iter().enumerate() {
                 let path = dir
                     .join("masks")
                     .join(&c.name)
                     .join(format!("frame_{i:04}.png"));
-                silhouette(&pts, fine.voxel_m, c).save(&path).map_err(|e| {
-                    VolumeError::Invalid {
-                        path: path.clone(),
-                        problem: format!("cannot write the mask: {e}"),
-                    }
+                let drawn: Vec<Point3<f64>> = pts
+                    .iter()
+                    .filter(|p| {
+                        faults.missing_forearm_view != Some(view) || !faults.is_forearm(joints, p)
+                    })
+                    .chain(&extra)
+                    .copied()
+                    .collect();
+                let mask = faults.edges(view, silhouette(&drawn, fine.voxel_m, c));
+                mask.save(&path).map_err(|e| VolumeError::Invalid {
+                    path: path.clone(),
+                    problem: format!("cannot write the mask: {e}"),
                 })?;
             }
             let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;

@@ -5,7 +5,7 @@
 //! (with the box to carve) and `masks/<camera name>/`, one mask image per frame.
 
 use super::VolumeError;
-use super::voxel::VoxelGrid;
+use super::voxel::{Kept, VoxelGrid};
 use crate::formats::{check_header, parse_json, read_text};
 use image::GrayImage;
 use nalgebra::{Matrix3, Point3, Vector3};
@@ -318,8 +318,14 @@ impl Carver {
     }
 
     /// Carves one frame: a voxel is occupied when at least `min_votes` masks (one per camera,
-    /// same order, grey level ≥ 128 = person) contain its centre; then the largest component is kept.
-    pub fn carve(&self, masks: &[GrayImage], min_votes: usize) -> VoxelGrid {
+    /// same order, grey level ≥ 128 = person) contain its centre; then one component is kept:
+    /// the one nearest `person` (a point the person stays near), or the largest.
+    pub fn carve(
+        &self,
+        masks: &[GrayImage],
+        min_votes: usize,
+        person: Option<Point3<f64>>,
+    ) -> (VoxelGrid, Kept) {
         let mut grid = self.template.clone();
         for (i, o) in grid.occupied.iter_mut().enumerate() {
             let votes = self
@@ -338,23 +344,25 @@ impl Carver {
                 .count();
             *o = votes >= min_votes;
         }
-        grid.keep_largest_component();
-        grid
+        let kept = grid.keep_component(person);
+        (grid, kept)
     }
 }
 
 /// Carves every frame of `setup` at `voxel_m` (a voxel stays when `min_votes` masks contain it;
-/// `None` = all cameras) into `out_dir/<first camera's mask name>.voxels.json`, frames in
-/// parallel, calling `progress(done, total)`; returns each frame's occupied voxel count. Stops
-/// at the first unreadable or wrongly sized mask, naming it; `cancel` stops between frames.
+/// `None` = all cameras; the component nearest `person` is kept, or the largest) into
+/// `out_dir/<first camera's mask name>.voxels.json`, frames in parallel, calling
+/// `progress(done, total)`; returns what each frame kept and dropped. Stops at the first
+/// unreadable or wrongly sized mask, naming it; `cancel` stops between frames.
 pub fn carve_sequence(
     setup: &CarvingSetup,
     voxel_m: f64,
     min_votes: Option<usize>,
+    person: Option<Point3<f64>>,
     out_dir: &Path,
     progress: &(dyn Fn(usize, usize) + Sync),
     cancel: &std::sync::atomic::AtomicBool,
-) -> Result<Vec<usize>, VolumeError> {
+) -> Result<Vec<Kept>, VolumeError> {
     use rayon::prelude::*;
     use std::sync::atomic::{AtomicUsize, Ordering};
     let cameras = setup.cameras.len();
@@ -380,14 +388,14 @@ pub fn carve_sequence(
                     problem: "cancelled".into(),
                 });
             }
-            let grid = carver.carve(&setup.read_masks(k)?, votes);
+            let (grid, kept) = carver.carve(&setup.read_masks(k)?, votes, person);
             let stem = setup.frames[k][0].file_stem().map_or_else(
                 || format!("frame_{k:04}"),
                 |s| s.to_string_lossy().into_owned(),
             );
             grid.save(&out_dir.join(format!("{stem}.voxels.json")))?;
             progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
-            Ok(grid.count())
+            Ok(kept)
         })
         .collect()
 }
@@ -452,7 +460,7 @@ mod tests {
             .collect();
         let v = 0.05;
         let grid = VoxelGrid::new(Point3::new(-0.5, 0.5, -0.5), v, [21, 21, 21]);
-        let carved = Carver::new(grid.clone(), &cams).carve(&masks, 4);
+        let (carved, _) = Carver::new(grid.clone(), &cams).carve(&masks, 4, None);
         let [nx, ny, nz] = grid.dims;
         let (mut missed, mut extra) = (0, 0);
         for z in 0..nz {

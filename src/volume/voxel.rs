@@ -10,6 +10,17 @@ use std::path::Path;
 /// The `format` tag of voxel grid files.
 pub const VOXELS_FORMAT: &str = "videomocap.voxels";
 
+/// What [`VoxelGrid::keep_component`] kept and dropped.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Kept {
+    /// Voxels of the component kept.
+    pub voxels: usize,
+    /// Voxels of the other components.
+    pub dropped_voxels: usize,
+    /// How many other components there were.
+    pub dropped_components: usize,
+}
+
 /// A regular grid of cubic voxels, occupied or not.
 #[derive(Debug, Clone, PartialEq)]
 pub struct VoxelGrid {
@@ -79,6 +90,13 @@ impl VoxelGrid {
     /// Keeps only the largest 26-connected component of occupied voxels; returns how many
     /// voxels were removed.
     pub fn keep_largest_component(&mut self) -> usize {
+        self.keep_component(None).dropped_voxels
+    }
+
+    /// Keeps one 26-connected component of occupied voxels: the one holding the occupied voxel
+    /// nearest `near` (the person the user points at), or the largest when `near` is `None`;
+    /// says what it dropped.
+    pub fn keep_component(&mut self, near: Option<Point3<f64>>) -> Kept {
         let [nx, ny, nz] = self.dims;
         let mut label = vec![0u32; self.occupied.len()];
         let mut sizes = vec![0usize]; // label 0 = none
@@ -115,17 +133,38 @@ impl VoxelGrid {
                 }
             }
         }
-        let Some((best, _)) = sizes.iter().enumerate().max_by_key(|(_, s)| **s) else {
-            return 0;
+        let chosen = match near {
+            Some(p) => (0..label.len())
+                .filter(|&i| label[i] != 0)
+                .min_by(|&a, &b| {
+                    let d = |i: usize| {
+                        let (x, y, z) = (i % nx, (i / nx) % ny, i / (nx * ny));
+                        (self.centre(x, y, z) - p).norm_squared()
+                    };
+                    d(a).total_cmp(&d(b))
+                })
+                .map(|i| label[i] as usize),
+            None => sizes
+                .iter()
+                .enumerate()
+                .max_by_key(|(_, s)| **s)
+                .map(|(k, _)| k),
         };
-        let mut removed = 0;
+        let Some(best) = chosen else {
+            return Kept::default();
+        };
+        let mut dropped_voxels = 0;
         for (o, l) in self.occupied.iter_mut().zip(&label) {
             if *o && *l as usize != best {
                 *o = false;
-                removed += 1;
+                dropped_voxels += 1;
             }
         }
-        removed
+        Kept {
+            voxels: sizes.get(best).copied().unwrap_or(0),
+            dropped_voxels,
+            dropped_components: sizes.len().saturating_sub(2),
+        }
     }
 
     /// Reads and checks a `.voxels.json` file.
@@ -206,6 +245,34 @@ mod tests {
         }
         assert_eq!(g.keep_largest_component(), 1);
         assert_eq!(g.count(), 3);
+    }
+
+    /// The person pointed at is kept even when another blob is larger, and the rest is counted.
+    #[test]
+    fn the_blob_nearest_the_point_is_kept_and_the_rest_reported() {
+        let mut g = VoxelGrid::new(Point3::origin(), 0.1, [8, 3, 3]);
+        for (x, y, z) in [
+            (0, 0, 0),
+            (1, 0, 0),
+            (5, 0, 0),
+            (6, 0, 0),
+            (7, 0, 0),
+            (7, 2, 2),
+        ] {
+            let i = g.index(x, y, z);
+            g.occupied[i] = true;
+        }
+        let near = g.centre(0, 0, 0);
+        let kept = g.keep_component(Some(near));
+        assert_eq!(
+            kept,
+            Kept {
+                voxels: 2,
+                dropped_voxels: 4,
+                dropped_components: 2
+            }
+        );
+        assert!(g.occupied[g.index(1, 0, 0)] && !g.occupied[g.index(6, 0, 0)]);
     }
 
     #[test]
