@@ -188,32 +188,10 @@ fn suite_takes(
                 }),
             );
         }
-        lines.push(format!(
+        let title = format!(
             "suite v3 takes at {label} (the bodies of their first clips, {FRAMES} frames at {FPS} fps): frames with a five-limb curve, mean error with left and right as reported (mm, voxel sizes), sides right, labels consistent"
-        ));
-        const WIDTH: usize = 36;
-        lines.extend(Tally::<VolumeScore>::heading(
-            WIDTH,
-            "  curve     mm voxel  sides labels",
-        ));
-        lines.extend(tally.lines(WIDTH, |s| suite_cell(s, voxel_mm)));
-        lines.push(String::new());
-        json.insert(
-            format!("{label} takes"),
-            serde_json::Value::Object(per_take),
         );
-        json.insert(
-            label,
-            tally.json(|s| {
-                serde_json::json!({
-                    "topology": s.topology(), "reported_mm": s.mean_reported_mm(),
-                    "voxel_sizes": s.mean_reported_mm() / voxel_mm,
-                    "sides_right": s.sides_right_share(),
-                    "labels_consistent": s.consistency(),
-                    "matched_once_mm": s.mean_mm(),
-                })
-            }),
-        );
+        push_table(lines, &mut json, &title, &label, &tally, per_take, voxel_mm);
     }
     // Carved from silhouettes: 4 and 8 clean views, and 4 views with the faults of real
     // segmentation (every mask must hold a voxel, or one may miss it).
@@ -252,33 +230,47 @@ fn suite_takes(
         } else {
             ""
         };
-        lines.push(format!(
+        let title = format!(
             "suite v3 takes carved at 40 mm from {label} (640×480 cameras on a ring{what})"
-        ));
-        const WIDTH: usize = 36;
-        lines.extend(Tally::<VolumeScore>::heading(
-            WIDTH,
-            "  curve     mm voxel  sides labels",
-        ));
-        lines.extend(tally.lines(WIDTH, |s| suite_cell(s, 40.0)));
-        lines.push(String::new());
-        json.insert(
-            format!("carved {label} takes"),
-            serde_json::Value::Object(per_take),
         );
-        json.insert(
-            format!("carved {label}"),
-            tally.json(|s| {
-                serde_json::json!({
-                    "topology": s.topology(), "reported_mm": s.mean_reported_mm(),
-                    "voxel_sizes": s.mean_reported_mm() / 40.0,
-                    "sides_right": s.sides_right_share(),
-                    "labels_consistent": s.consistency(),
-                })
-            }),
-        );
+        let key = format!("carved {label}");
+        push_table(lines, &mut json, &title, &key, &tally, per_take, 40.0);
     }
     Ok(serde_json::Value::Object(json))
+}
+
+/// One table of the suite's takes: `title`, the family rows of `tally` (voxel sizes of
+/// `voxel_mm`) into `lines`, and under `key` (and `key` + " takes" for `per_take`) into `json`.
+fn push_table(
+    lines: &mut Vec<String>,
+    json: &mut serde_json::Map<String, serde_json::Value>,
+    title: &str,
+    key: &str,
+    tally: &Tally<VolumeScore>,
+    per_take: serde_json::Map<String, serde_json::Value>,
+    voxel_mm: f64,
+) {
+    const WIDTH: usize = 36;
+    lines.push(title.to_owned());
+    lines.extend(Tally::<VolumeScore>::heading(
+        WIDTH,
+        "  curve     mm voxel  sides labels",
+    ));
+    lines.extend(tally.lines(WIDTH, |s| suite_cell(s, voxel_mm)));
+    lines.push(String::new());
+    json.insert(format!("{key} takes"), serde_json::Value::Object(per_take));
+    json.insert(
+        key.to_owned(),
+        tally.json(|s| {
+            serde_json::json!({
+                "topology": s.topology(), "reported_mm": s.mean_reported_mm(),
+                "voxel_sizes": s.mean_reported_mm() / voxel_mm,
+                "sides_right": s.sides_right_share(),
+                "labels_consistent": s.consistency(),
+                "matched_once_mm": s.mean_mm(),
+            })
+        }),
+    );
 }
 
 /// Runs the volume benchmark and prints its tables.
