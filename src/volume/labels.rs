@@ -1,11 +1,13 @@
-//! Consistent limb labels over the whole clip. The paper (§4) keeps labels from frame to frame by
-//! the least sum of squared distances between neighbouring frames; decided greedily, one wrongly
-//! named frame (an arm taken for the head) hands its mistake to every frame after it. Here the
-//! labelling of every frame is chosen at once, by dynamic programming over the clip: a path
-//! visits the frames in order, each with one of its four labellings (arms swapped or not, legs
-//! swapped or not), and may step over a frame at a fixed price; a step costs the mean squared
-//! distance between the two frames' labelled points (head, neck, pelvis, each limb's root,
-//! bend and end) in units of the clip's own typical motion per frame, scaled by the gap. The
+//! Consistent limb labels, with left and right, over the whole clip. The paper (§4) keeps labels
+//! from frame to frame by the least sum of squared distances between neighbouring frames;
+//! decided greedily, one wrongly named frame (an arm taken for the head) hands its mistake to
+//! every frame after it. Here the labelling of every frame is chosen at once, by dynamic
+//! programming over the clip: a path visits the frames in order, each with one of its four
+//! labellings (which arm is the left one, which leg), and may step over a frame at a fixed
+//! price. A step costs how far the frame's labelled points (head, neck, pelvis, each limb's
+//! root, bend and end) lie from where the previous two frames' points go at constant velocity
+//! (the path's first step: how far they moved), in units of the clip's own typical departure;
+//! each frame adds its own left/right cues' price for the labelling (the caller's `cue`). The
 //! frames the cheapest path steps over do not follow from the frames around them under any
 //! labelling: they are left out.
 

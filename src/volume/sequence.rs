@@ -215,18 +215,8 @@ pub fn assemble(
         neck_chest / (neck_chest + chest_pelvis)
     };
 
-    let slots = order;
-    let frac = fraction;
-
     // 3. Arms the curve did not show are placed from the frames that saw them (see `place_unseen`).
-    let seen: Vec<Option<[Option<Limb>; 4]>> = (0..results.len())
-        .map(|i| {
-            let (Some(f), Some(s)) = (results[i], slots[i]) else {
-                return None;
-            };
-            Some(s.map(|k| k.and_then(|k| f.fit.limbs[k])))
-        })
-        .collect();
+    let seen: Vec<Option<[Option<Limb>; 4]>> = (0..results.len()).map(labelled).collect();
     let trunk_frames: Vec<Option<TrunkFrame>> = (0..results.len())
         .map(|i| {
             let (Some(f), Some(l)) = (results[i], &seen[i]) else {
@@ -246,9 +236,9 @@ pub fn assemble(
             }
             let (limb, how) = place_unseen(slot, i, &seen, &trunk_frames, trunk, limbs);
             let side = if slot == 0 { "left" } else { "right" };
-            let name = names.get(i).map_or("?", String::as_str);
             warnings.push(format!(
-                "frame {i} ({name}): the {side} arm lies against the trunk (the skeleton curve has no branch for it); {how}"
+                "frame {i} ({}): the {side} arm lies against the trunk (the skeleton curve has no branch for it); {how}",
+                name(i)
             ));
             if let Some(Some(l)) = placed.get_mut(i) {
                 l[slot] = Some(limb);
@@ -265,7 +255,7 @@ pub fn assemble(
         let mid = |k: usize| {
             let l = &limbs[k];
             l.split
-                .unwrap_or_else(|| l.root + (l.end - l.root) * frac[k])
+                .unwrap_or_else(|| l.root + (l.end - l.root) * fraction[k])
         };
         use Joint::*;
         Some(PerJoint::from_fn(|j| match j {
@@ -352,7 +342,7 @@ pub fn assemble(
             bone_lengths_m,
             frames,
         },
-        slots,
+        slots: order,
         warnings,
         sides_from,
     }
