@@ -271,6 +271,60 @@ fn a_correction_on_a_later_frame_is_kept_and_anchors_the_track() {
     }
 }
 
+/// After a correction on the last key frame, the re-tracked frames on both sides of it arrive
+/// first (the app draws frames as they arrive), and a re-track that reuses the first run's
+/// background (as the app does) gives the same tracks as one that reads the clip again.
+#[test]
+fn a_correction_redraws_both_sides_of_it_first() {
+    let dir = tempfile::tempdir().unwrap();
+    render(dir.path(), ProceduralMotion::Walk, 48, View::Side);
+    let gt = GroundTruth::load(&dir.path().join("gt.json")).unwrap();
+    let marks = Marks::load(&dir.path().join("marks.json")).unwrap();
+    let mut video = Video::open(&dir.path().join("frames"), &OpenOptions::default()).unwrap();
+    let first = track_video(
+        &mut video,
+        &job(&marks, 2),
+        &mut |_| {},
+        &AtomicBool::new(false),
+    )
+    .unwrap();
+    assert!(
+        first.background.is_some(),
+        "the default settings use a background"
+    );
+    let corrected = 30;
+    let mut j = job(&marks, 2);
+    j.keys.set(
+        corrected,
+        Joint::LeftAnkle,
+        gt.frames[corrected].points2d()[Joint::LeftAnkle],
+    );
+    j.from = Some(corrected);
+    j.previous = Some(first.tracks.clone());
+    let mut arrived = Vec::new();
+    let fresh = track_video(
+        &mut video,
+        &j,
+        &mut |p| arrived.extend(p.frame.as_ref().map(|f| f.index)),
+        &AtomicBool::new(false),
+    )
+    .unwrap();
+    let near = |f: usize| f.abs_diff(corrected) <= 10;
+    let last_near = arrived.iter().rposition(|&f| near(f)).unwrap();
+    let first_far = arrived.iter().position(|&f| !near(f)).unwrap();
+    assert!(
+        (0..=10).all(|d| arrived.contains(&(corrected - d)) && arrived.contains(&(corrected + d))),
+        "frames next to the correction missing: {arrived:?}"
+    );
+    assert!(
+        last_near < first_far,
+        "a frame far from the correction came before one next to it: {arrived:?}"
+    );
+    j.background = first.background.clone();
+    let reused = track_video(&mut video, &j, &mut |_| {}, &AtomicBool::new(false)).unwrap();
+    assert_eq!(fresh.tracks, reused.tracks);
+}
+
 #[test]
 fn a_one_frame_video_is_refused_with_its_name() {
     let dir = tempfile::tempdir().unwrap();

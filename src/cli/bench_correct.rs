@@ -11,16 +11,17 @@
 
 use super::args::{BenchArgs, GlobalArgs};
 use super::bench_suite::{BenchClip, Tally, bench_clips};
-use super::bench_track::{fixed_template_track, threads_and_settings, track_opened};
+use super::bench_track::{fixed_template_track, threads_and_settings};
 use super::{ExitError, say};
 use std::collections::BTreeSet;
 use std::sync::atomic::AtomicBool;
+use std::time::Instant;
 use videomocap::eval::correction::next_correction;
 use videomocap::eval::suite::{CLICK_NOISE_PX, clicked_marks};
 use videomocap::eval::{Accuracy, score_positions, score_tracks};
 use videomocap::formats::{Marks, Tracks2d};
 use videomocap::synth::GroundTruth;
-use videomocap::track::{KeyFrames, TrackJob, TrackerParams, track_video};
+use videomocap::track::{KeyFrames, TrackJob, TrackProgress, TrackerParams, track_video};
 use videomocap::video::{OpenOptions, Video};
 
 /// The PCK@0.2 a clip must reach to count as corrected (the tracking issue's target).
@@ -33,6 +34,17 @@ struct Rounds {
     drags: Vec<usize>,
     /// The fixed-template baseline from the same clicked marks, uncorrected.
     template: Accuracy,
+    /// Per re-track, seconds from its start until every frame within [`REDRAW_SPAN`] of the
+    /// corrected frame had arrived (what the app draws as they come).
+    redraw_s: Vec<f64>,
+}
+
+/// Frames on each side of a correction whose re-tracked result the app should draw at once.
+const REDRAW_SPAN: usize = 10;
+
+/// The frames next to `frame` (within [`REDRAW_SPAN`], inside the clip's `n` frames).
+fn next_to(frame: usize, n: usize) -> std::ops::Range<usize> {
+    frame.saturating_sub(REDRAW_SPAN)..(frame + REDRAW_SPAN + 1).min(n)
 }
 
 /// Tracks a clip and corrects it for `rounds` rounds at most (fewer when nothing is left
@@ -52,7 +64,15 @@ fn correct_clip(
     );
     let mut video =
         Video::open(&dir.join("video.mp4"), &OpenOptions::default()).map_err(ExitError::failed)?;
-    let mut tracks = track_opened(&mut video, &marks, threads, params)?;
+    let first = track_video(
+        &mut video,
+        &TrackJob::from_marks(&marks, params, threads),
+        &mut |_| {},
+        &AtomicBool::new(false),
+    )
+    .map_err(ExitError::failed)?;
+    let mut tracks = first.tracks;
+    let background = first.background;
     let mut keys = KeyFrames::from_marks(&marks);
     let mut done = BTreeSet::from([marks.frame]);
     let score = |tracks: &Tracks2d| -> Result<Accuracy, ExitError> {
@@ -71,6 +91,7 @@ fn correct_clip(
         template: score_positions(&gt, base.into_iter().enumerate())
             .map_err(ExitError::failed)?
             .overall,
+        redraw_s: Vec::new(),
     };
     for _ in 0..rounds {
         let Some(c) = next_correction(&gt, &tracks, &done) else {
@@ -80,16 +101,48 @@ fn correct_clip(
             keys.set(c.frame, *joint, *pos);
         }
         done.insert(c.frame);
+        let n = tracks.frames.len();
         let job = TrackJob {
             keys: keys.clone(),
             params,
             threads,
             from: Some(c.frame),
             previous: Some(tracks),
+            background: background.clone(),
         };
-        tracks = track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false))
+        // The re-track changes nothing before the latest key every joint has before the
+        // correction (those frames stay drawn as they were).
+        let low = videomocap::skeleton::Joint::ALL
+            .iter()
+            .map(|&j| {
+                keys.frames
+                    .range(..c.frame)
+                    .rev()
+                    .find(|(_, k)| k[j].is_some())
+                    .map_or(0, |(&f, _)| f)
+            })
+            .min()
+            .unwrap_or(0);
+        let mut waiting: BTreeSet<usize> = next_to(c.frame, n).filter(|&f| f >= low).collect();
+        // Timed as the app re-tracks: the job opens the video, reuses the background of the
+        // first run, and draws frames as they arrive.
+        let started = Instant::now();
+        let mut video = Video::open(&dir.join("video.mp4"), &OpenOptions::default())
+            .map_err(ExitError::failed)?;
+        let mut arrived_s = None;
+        let mut on_progress = |p: &TrackProgress| {
+            if let Some(f) = &p.frame {
+                waiting.remove(&f.index);
+                if waiting.is_empty() && arrived_s.is_none() {
+                    arrived_s = Some(started.elapsed().as_secs_f64());
+                }
+            }
+        };
+        tracks = track_video(&mut video, &job, &mut on_progress, &AtomicBool::new(false))
             .map_err(ExitError::failed)?
             .tracks;
+        out.redraw_s
+            .push(arrived_s.unwrap_or_else(|| started.elapsed().as_secs_f64()));
         out.scores.push(score(&tracks)?);
         out.drags.push(c.drags.len());
     }
@@ -175,6 +228,30 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             rounds_to_goal(r)
         ));
     }
+    let redraw: Vec<String> = clips
+        .iter()
+        .zip(&results)
+        .filter(|(_, (_, r))| !r.redraw_s.is_empty())
+        .filter(|(clip, _)| clip.family == videomocap::eval::suite::Family::Real)
+        .map(|(clip, (_, r))| {
+            let mut t = r.redraw_s.clone();
+            t.sort_by(f64::total_cmp);
+            format!(
+                "{} median {:.2} s, worst {:.2} s ({} re-tracks)",
+                clip.name,
+                t[t.len() / 2],
+                t[t.len() - 1],
+                t.len()
+            )
+        })
+        .collect();
+    if !redraw.is_empty() {
+        lines.push(String::new());
+        lines.push(format!(
+            "after a correction, every frame within {REDRAW_SPAN} of it re-tracked (1080×1920): {}",
+            redraw.join("; ")
+        ));
+    }
     if global.json {
         let rows: Vec<_> = clips
             .iter()
@@ -186,6 +263,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
                     "pck02": r.scores.iter().map(Accuracy::pck02).collect::<Vec<_>>(),
                     "lost": r.scores.iter().map(Accuracy::lost).collect::<Vec<_>>(),
                     "drags": r.drags,
+                    "redraw_s": r.redraw_s,
                 })
             })
             .collect();

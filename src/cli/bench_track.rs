@@ -23,7 +23,7 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 use videomocap::eval::suite::{CLICK_NOISE_PX, Family, REAL_CLIPS, Split, clicked_marks};
-use videomocap::eval::{Accuracy, score_positions, score_tracks};
+use videomocap::eval::{Accuracy, ClipScore, LIMB_JOINTS, score_positions, score_tracks};
 use videomocap::formats::Marks;
 use videomocap::skeleton::{Joint, PerJoint};
 use videomocap::synth::GroundTruth;
@@ -165,24 +165,25 @@ const TRACK_COLUMNS: &str = " PCK.2   lost mean px  exact  templ";
 const TRACK_WIDTH: usize = 35;
 
 /// Tracks and scores one clip: (VBA from the clicked marks, VBA from the exact marks, the fixed
-/// template from the clicked marks), and the clicked marks.
+/// template from the clicked marks), the VBA's [`LIMB_JOINTS`] from the clicked marks, and the
+/// clicked marks.
 fn score_clip(
     clip: &BenchClip,
     threads: usize,
     params: TrackerParams,
-) -> Result<(TrackScores, Marks), ExitError> {
+) -> Result<(TrackScores, Accuracy, Marks), ExitError> {
     let gt = GroundTruth::load(&clip.dir.join("gt.json")).map_err(ExitError::failed)?;
     let marks = Marks::load(&clip.dir.join("marks.json")).map_err(ExitError::failed)?;
     let clicked = clicked_marks(&marks, CLICK_NOISE_PX, &clip.name);
     let mut video = Video::open(&clip.dir.join("video.mp4"), &OpenOptions::default())
         .map_err(ExitError::failed)?;
-    let mut vba = |m: &Marks| -> Result<Accuracy, ExitError> {
+    let mut vba = |m: &Marks| -> Result<ClipScore, ExitError> {
         let tracks = track_opened(&mut video, m, threads, params)?;
-        Ok(score_tracks(&gt, &tracks)
-            .map_err(ExitError::failed)?
-            .overall)
+        score_tracks(&gt, &tracks).map_err(ExitError::failed)
     };
     let (from_clicks, from_exact) = (vba(&clicked)?, vba(&marks)?);
+    let limbs = from_clicks.limbs();
+    let (from_clicks, from_exact) = (from_clicks.overall, from_exact.overall);
     let stature = videomocap::track::body::stature_px(
         &clicked.points,
         &videomocap::skeleton::Proportions::default(),
@@ -191,7 +192,7 @@ fn score_clip(
     let template = score_positions(&gt, base.into_iter().enumerate())
         .map_err(ExitError::failed)?
         .overall;
-    Ok(([from_clicks, from_exact, template], clicked))
+    Ok(([from_clicks, from_exact, template], limbs, clicked))
 }
 
 /// Runs the accuracy and speed benchmark and prints its tables.
@@ -218,9 +219,13 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     ];
     let mut rows_json = Vec::new();
     let mut clicked = Vec::new();
+    let mut real_limbs: Vec<(String, Accuracy)> = Vec::new();
     for clip in &clips {
         say(global, &format!("tracking {} …", clip.name));
-        let (s, marks) = score_clip(clip, threads, params)?;
+        let (s, limbs, marks) = score_clip(clip, threads, params)?;
+        if clip.family == Family::Real {
+            real_limbs.push((clip.name.clone(), limbs));
+        }
         lines.push(format!(
             "{:<26} {:<5} {:<11} {}",
             clip.name,
@@ -243,6 +248,18 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     );
     lines.extend(Tally::<TrackScores>::heading(TRACK_WIDTH, TRACK_COLUMNS));
     lines.extend(tally.lines(TRACK_WIDTH, track_cell));
+    if !real_limbs.is_empty() {
+        lines.push(String::new());
+        lines.push(format!(
+            "real clips, the {} limb joints (the four chains and the pelvis), VBA from clicked marks: {}",
+            LIMB_JOINTS.len(),
+            real_limbs
+                .iter()
+                .map(|(name, a)| format!("{name} PCK@0.2 {:.3}", a.pck02()))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+    }
     let opencv = super::bench_opencv::run(&clips, &clicked, &a.suite_dir, global)?;
     if let Some(t) = &opencv {
         lines.push(String::new());
@@ -316,6 +333,10 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
                 "vba": tally.json(|s| accuracy_json(&s[0])),
                 "vba_exact_marks": tally.json(|s| accuracy_json(&s[1])),
                 "fixed_template": tally.json(|s| accuracy_json(&s[2])),
+                "real_limb_joints": real_limbs
+                    .iter()
+                    .map(|(name, a)| serde_json::json!({"clip": name, "vba": accuracy_json(a)}))
+                    .collect::<Vec<_>>(),
                 "opencv": opencv.map(|t| serde_json::json!({
                     "lucas_kanade": t.json(|s| accuracy_json(&s[0])),
                     "csrt": t.json(|s| accuracy_json(&s[1])),

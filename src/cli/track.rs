@@ -69,6 +69,7 @@ pub fn track_with_progress(
         threads,
         from: None,
         previous: None,
+        background: None,
     };
     let bar = progress_bar(global, video.info().frame_count as u64, "tracking");
     let cancel = AtomicBool::new(false);

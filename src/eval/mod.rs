@@ -104,6 +104,35 @@ pub struct ClipScore {
     pub overall: Accuracy,
 }
 
+/// The limb joints the real-sample target counts: every joint but the head's two (head top,
+/// neck) and the chest (derived on the real sample): the four chains and the pelvis, 13.
+pub const LIMB_JOINTS: [Joint; 13] = [
+    Joint::Pelvis,
+    Joint::LeftShoulder,
+    Joint::LeftElbow,
+    Joint::LeftWrist,
+    Joint::RightShoulder,
+    Joint::RightElbow,
+    Joint::RightWrist,
+    Joint::LeftHip,
+    Joint::LeftKnee,
+    Joint::LeftAnkle,
+    Joint::RightHip,
+    Joint::RightKnee,
+    Joint::RightAnkle,
+];
+
+impl ClipScore {
+    /// The [`LIMB_JOINTS`]' samples together.
+    pub fn limbs(&self) -> Accuracy {
+        let mut a = Accuracy::default();
+        for j in LIMB_JOINTS {
+            a.merge(&self.per_joint[j]);
+        }
+        a
+    }
+}
+
 /// The ground truth does not fit the tracks.
 #[derive(Debug, thiserror::Error)]
 #[error("ground truth has {gt} frames but the tracks cover frame {frame}")]

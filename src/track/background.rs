@@ -12,6 +12,7 @@
 //! within `tau` of their median in [`STABLE_SHARE`] of the samples, there is none.
 
 use image::RgbImage;
+use std::sync::Arc;
 
 /// Frames sampled for the median.
 pub const SAMPLES: usize = 25;
@@ -31,6 +32,34 @@ pub struct Background {
     /// The foreground level of every largest channel difference, 0 to 255
     /// ([`foreground_level`]).
     levels: [f32; 256],
+}
+
+/// What a run found of a clip's background (one, or none: a moving camera), kept so that a
+/// re-track of the same video need not read the clip again (it costs a 1080p clip's app a
+/// good part of a second after every correction).
+#[derive(Debug, Clone)]
+pub struct KnownBackground {
+    /// The working size it was estimated at.
+    size: (u32, u32),
+    /// The foreground threshold it was estimated with.
+    tau: f32,
+    /// The background, `None` when the camera moves.
+    background: Option<Arc<Background>>,
+}
+
+impl KnownBackground {
+    /// What a run found at working size `size` with threshold `tau`.
+    pub fn new(size: (u32, u32), tau: f32, background: Option<Arc<Background>>) -> Self {
+        KnownBackground {
+            size,
+            tau,
+            background,
+        }
+    }
+    /// The background, when it was found at `size` with `tau` (else the run estimates it anew).
+    pub fn get(&self, size: (u32, u32), tau: f32) -> Option<Option<Arc<Background>>> {
+        (self.size == size && self.tau == tau).then(|| self.background.clone())
+    }
 }
 
 impl Background {

@@ -58,6 +58,9 @@ pub(crate) struct PassOutput {
     /// Per key frame the pass went through (not its first), where it arrived before the
     /// hand-placed joints re-started it: how well it agrees with that key.
     pub(crate) arrivals: BTreeMap<usize, PerJoint<JointResult>>,
+    /// The body tracker as it stands after the pass's last frame (to go on with the frames
+    /// after it: [`PassContext::pass`]'s `resume`).
+    pub(crate) tracker: Option<BodyTracker>,
 }
 
 pub(crate) struct PassContext<'a, 'p> {
@@ -119,10 +122,13 @@ impl PassContext<'_, '_> {
     /// its first frame and re-started with the hand-placed joints at every key frame on the way;
     /// returns the results in video pixels, one per frame of `order` (the first is the starting
     /// pose), and where the pass arrived on each key frame before it was re-started there.
+    /// With `resume` (a tracker another call left after the frame before `order`'s first), the
+    /// pass goes on from it instead, and `pose` is not used.
     pub(crate) fn pass(
         &mut self,
         order: &[usize],
         pose: &PerJoint<Point2<f64>>,
+        resume: Option<BodyTracker>,
     ) -> Result<PassOutput, TrackError> {
         let scale = self.scale;
         let params = self.params;
@@ -138,7 +144,7 @@ impl PassContext<'_, '_> {
         };
         let mut out = Vec::with_capacity(order.len());
         let mut arrivals = BTreeMap::new();
-        let mut tracker: Option<BodyTracker> = None;
+        let mut tracker: Option<BodyTracker> = resume;
         let proportions = Proportions::default();
         let check = |index: usize, image: &RgbImage| {
             if image.width() != width || image.height() != height {
@@ -261,7 +267,10 @@ impl PassContext<'_, '_> {
                 let (tx, rx) = std::sync::mpsc::sync_channel::<Decoded>(6);
                 s.spawn(move || {
                     for chunk in decode_order(&order_owned) {
-                        let mut images = Vec::with_capacity(chunk.decode.len());
+                        // A forward chunk is sent frame by frame as decoded; a backward one
+                        // is gathered and sent in reverse.
+                        let mut images =
+                            Vec::with_capacity(if chunk.reverse { chunk.decode.len() } else { 0 });
                         for &index in &chunk.decode {
                             if stop.load(Ordering::Relaxed) {
                                 return;
@@ -275,7 +284,11 @@ impl PassContext<'_, '_> {
                                     .transpose()
                                     .map(|image| (index, image))
                             });
-                            images.push(item);
+                            if chunk.reverse {
+                                images.push(item);
+                            } else if tx.send(item).is_err() {
+                                return;
+                            }
                         }
                         if chunk.reverse {
                             images.reverse();
@@ -308,6 +321,7 @@ impl PassContext<'_, '_> {
         Ok(PassOutput {
             results: out,
             arrivals,
+            tracker,
         })
     }
 }

@@ -11,6 +11,7 @@
 //! backwards from the last key frame to the earliest frame the correction can change, keeping the
 //! earlier result elsewhere.
 
+use super::background::KnownBackground;
 use super::body::{JointResult, stature_px};
 use super::fuse::fuse;
 use super::occlusion::{WeakSpan, fill_weak_runs};
@@ -79,6 +80,9 @@ pub struct TrackJob {
     pub from: Option<usize>,
     /// The earlier result (needed with `from`).
     pub previous: Option<Tracks2d>,
+    /// The background an earlier run of this video found ([`TrackOutput::background`]): used
+    /// when it fits (same working size and threshold) instead of reading the clip again.
+    pub background: Option<KnownBackground>,
 }
 
 impl TrackJob {
@@ -94,6 +98,7 @@ impl TrackJob {
             threads,
             from: None,
             previous: None,
+            background: None,
         }
     }
 }
@@ -121,7 +126,14 @@ pub struct TrackOutput {
     /// Frames the decoder could not read (damaged or cut-short files), ascending. They are
     /// tracked as lost (reliability 0) and filled like occlusions, not fatal.
     pub damaged: Vec<usize>,
+    /// The background this run used (`None` when the settings use none): give it to the next
+    /// job on this video ([`TrackJob::background`]).
+    pub background: Option<KnownBackground>,
 }
+
+/// Frames of a re-track's backward pass (the corrected frame and the ten before it) tracked
+/// before its forward pass, so that the app draws both sides of a correction at once.
+const DRAWN_FIRST: usize = 11;
 
 /// Tracks the video from its key frames.
 ///
@@ -273,12 +285,15 @@ fn track_at_working_scale(
         cancel,
         background: None,
     };
-    ctx.background = if job.params.arm_foreground > 0.0 {
-        ctx.estimate_background(n, job.params.foreground_tau)?
-            .map(Arc::new)
-    } else {
-        None
+    let tau = job.params.foreground_tau;
+    let known = job.background.as_ref().and_then(|k| k.get((ww, wh), tau));
+    ctx.background = match known {
+        _ if job.params.arm_foreground <= 0.0 => None,
+        Some(known) => known,
+        None => ctx.estimate_background(n, tau)?.map(Arc::new),
     };
+    let background = (job.params.arm_foreground > 0.0)
+        .then(|| KnownBackground::new((ww, wh), tau, ctx.background.clone()));
     let mut backward: Vec<Option<PerJoint<JointResult>>> = vec![None; n];
     // Where each pass arrived on the key frames it went through (a re-track's forward pass
     // arrived on the corrected frame where the earlier result had it).
@@ -302,34 +317,54 @@ fn track_at_working_scale(
             });
             (keyed(&base.map(|_, r| r.pos), &job.keys, f), base)
         };
+        // A pass over `order` from its first frame's pose, or going on with `resume` (the
+        // tracker an earlier part of the same pass left); returns the tracker it leaves.
         let run_pass =
             |ctx: &mut PassContext,
              order: &[usize],
              (pose, before): (PerJoint<Point2<f64>>, PerJoint<JointResult>),
+             resume: Option<super::body::BodyTracker>,
              into: &mut Vec<Option<PerJoint<JointResult>>>,
              arrived: &mut BTreeMap<usize, PerJoint<JointResult>>| {
-                let out = ctx.pass(order, &pose)?;
+                let fresh = resume.is_none();
+                let out = ctx.pass(order, &pose, resume)?;
                 for (f, r) in order.iter().zip(out.results) {
                     into[*f] = Some(r);
                 }
                 arrived.extend(out.arrivals);
-                if let Some(now) = into[order[0]].as_mut() {
+                if let Some(now) = into[order[0]].as_mut().filter(|_| fresh) {
                     for j in Joint::ALL {
                         if !job.keys.is_key(order[0], j) {
                             now[j].reliability = before[j].reliability;
                         }
                     }
                 }
-                Ok::<(), TrackError>(())
+                Ok::<_, TrackError>(out.tracker)
             };
         // Forwards from the start to the end, then backwards from the last key frame, each
-        // re-started at every key frame on the way.
+        // re-started at every key frame on the way. A re-track from the last key frame runs the
+        // backward pass's first [`DRAWN_FIRST`] frames (those just before the correction)
+        // before the forward pass and the rest after it, so that both sides of the correction
+        // are drawn at once (the results are the same in either order).
         let forward_frames: Vec<usize> = (start..n).collect();
+        let near = match job.from {
+            Some(from) if backward_frames.first() == Some(&from) => {
+                DRAWN_FIRST.min(backward_frames.len())
+            }
+            _ => 0,
+        };
+        let (near, far) = backward_frames.split_at(near);
+        let mut resume = None;
+        if let Some(&first) = near.first() {
+            let begin = starting(forward, first);
+            resume = run_pass(ctx, near, begin, None, backward, &mut arrivals.1)?;
+        }
         let begin = starting(forward, start);
-        run_pass(ctx, &forward_frames, begin, forward, &mut arrivals.0)?;
-        if let Some(&last) = backward_frames.first() {
-            let begin = starting(forward, last);
-            run_pass(ctx, &backward_frames, begin, backward, &mut arrivals.1)?;
+        run_pass(ctx, &forward_frames, begin, None, forward, &mut arrivals.0)?;
+        if let Some(&first) = far.first() {
+            // (Not used when the pass goes on from `near`.)
+            let begin = starting(forward, first);
+            run_pass(ctx, far, begin, resume, backward, &mut arrivals.1)?;
         }
         Ok::<(), TrackError>(())
     };
@@ -418,6 +453,7 @@ fn track_at_working_scale(
     damaged.dedup();
     Ok(TrackOutput {
         damaged,
+        background,
         tracks: Tracks2d { source, frames },
         spans,
         shrink,
@@ -446,6 +482,7 @@ mod tests {
             threads: 1,
             from: None,
             previous: None,
+            background: None,
         }
     }
 

@@ -397,6 +397,7 @@ impl State {
             self.config.proxy_dir.clone(),
         ));
         self.project = Some(Project::new(path.to_owned()));
+        self.background = None;
         self.results_changed();
         self.status = format!("Opening {}…", path.display());
     }
@@ -409,6 +410,7 @@ impl State {
         self.loader = None;
         self.volume = None;
         self.project = None;
+        self.background = None;
         self.project_path = None;
         self.history.clear();
         self.results_changed();

@@ -113,8 +113,11 @@ pub struct State {
     marking: Option<usize>,
     move_limb: bool,
     running: Option<Running>,
-    /// Frames tracked so far by the running job (drawn as they arrive).
+    /// Frames tracked so far by the running job (drawn as they arrive, over the earlier
+    /// tracks a re-track replaces).
     partial: BTreeMap<usize, FrameTracks>,
+    /// The background the last tracking run of this video found (a re-track reuses it).
+    background: Option<videomocap::track::background::KnownBackground>,
     spans: Vec<WeakSpan>,
     strips: Option<Strips>,
     choices: Vec<LiftChoices>,
@@ -175,6 +178,7 @@ impl State {
             move_limb: false,
             running: None,
             partial: BTreeMap::new(),
+            background: None,
             spans: Vec::new(),
             strips: None,
             choices: Vec::new(),
@@ -427,22 +431,21 @@ impl State {
         self.dirty && self.project.is_some()
     }
 
-    /// What to draw for a frame: keys win, then final tracks, then tracks arriving.
+    /// What to draw for a frame: keys win, then tracks arriving (a running job's, newer than the
+    /// tracks it replaces), then the final tracks.
     pub fn points(&self, frame: usize) -> PerJoint<Option<(Point2<f64>, PointState)>> {
         let Some(p) = &self.project else {
             return PerJoint::from_fn(|_| None);
         };
         let weak = p.settings.tracker.weak_reliability;
-        let tracked = p
-            .tracks
-            .as_ref()
-            .and_then(|t| {
+        let tracked = self.partial.get(&frame).or_else(|| {
+            p.tracks.as_ref().and_then(|t| {
                 t.frames
                     .binary_search_by_key(&frame, |f| f.index)
                     .ok()
                     .map(|k| &t.frames[k])
             })
-            .or_else(|| self.partial.get(&frame));
+        });
         let keys = p.keys.frames.get(&frame);
         PerJoint::from_fn(|j| {
             if let Some(k) = keys.and_then(|k| k[j]) {
@@ -483,6 +486,7 @@ impl State {
 
     fn set_project(&mut self, p: Project) {
         self.project = Some(p);
+        self.background = None;
         self.subject_fit = None;
         self.history.clear();
         self.results_changed();

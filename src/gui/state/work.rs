@@ -36,6 +36,7 @@ impl State {
             threads: 2,
             from: from.filter(|_| p.tracks.is_some()),
             previous: p.tracks.as_deref().cloned(),
+            background: self.background.clone(),
         };
         self.running = Some(Running {
             job: Job::track(p.video.clone(), job, self.ctx.clone()),
@@ -219,6 +220,7 @@ impl State {
                     p.tracks = Some(Arc::new(out.tracks));
                     p.skeleton = None;
                 }
+                self.background = out.background;
                 self.dirty = true;
                 self.autosave();
                 self.results_changed();
