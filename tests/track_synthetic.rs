@@ -199,13 +199,18 @@ fn one_thread_and_two_threads_give_the_same_tracks() {
     assert_eq!(one.tracks, two.tracks);
 }
 
-#[test]
-fn a_correction_on_a_later_frame_is_kept_and_anchors_the_track() {
-    let dir = tempfile::tempdir().unwrap();
-    render(dir.path(), ProceduralMotion::Walk, 20, View::Side);
-    let gt = GroundTruth::load(&dir.path().join("gt.json")).unwrap();
-    let marks = Marks::load(&dir.path().join("marks.json")).unwrap();
-    let mut video = Video::open(&dir.path().join("frames"), &OpenOptions::default()).unwrap();
+/// A side-on walk of `frames` frames tracked from its marks, and the re-track job of the user
+/// dragging the left ankle on frame `corrected` to its true place: (reference, the open video,
+/// the first result, the job).
+fn walk_with_a_correction(
+    dir: &Path,
+    frames: usize,
+    corrected: usize,
+) -> (GroundTruth, Video, videomocap::track::TrackOutput, TrackJob) {
+    render(dir, ProceduralMotion::Walk, frames, View::Side);
+    let gt = GroundTruth::load(&dir.join("gt.json")).unwrap();
+    let marks = Marks::load(&dir.join("marks.json")).unwrap();
+    let mut video = Video::open(&dir.join("frames"), &OpenOptions::default()).unwrap();
     let first = track_video(
         &mut video,
         &job(&marks, 2),
@@ -213,12 +218,23 @@ fn a_correction_on_a_later_frame_is_kept_and_anchors_the_track() {
         &AtomicBool::new(false),
     )
     .unwrap();
-    // The user drags the left ankle on frame 10 to its true place and re-tracks from there.
-    let truth = gt.frames[10].points2d()[Joint::LeftAnkle];
     let mut j = job(&marks, 2);
-    j.keys.set(10, Joint::LeftAnkle, truth);
-    j.from = Some(10);
+    j.keys.set(
+        corrected,
+        Joint::LeftAnkle,
+        gt.frames[corrected].points2d()[Joint::LeftAnkle],
+    );
+    j.from = Some(corrected);
     j.previous = Some(first.tracks.clone());
+    (gt, video, first, j)
+}
+
+#[test]
+fn a_correction_on_a_later_frame_is_kept_and_anchors_the_track() {
+    let dir = tempfile::tempdir().unwrap();
+    // The user drags the left ankle on frame 10 to its true place and re-tracks from there.
+    let (gt, mut video, first, j) = walk_with_a_correction(dir.path(), 20, 10);
+    let truth = gt.frames[10].points2d()[Joint::LeftAnkle];
     let again = track_video(&mut video, &j, &mut |_| {}, &AtomicBool::new(false)).unwrap();
     let p = again.tracks.frames[10].points[Joint::LeftAnkle];
     assert!((p.pos - truth).norm() < 1e-9);
@@ -277,30 +293,12 @@ fn a_correction_on_a_later_frame_is_kept_and_anchors_the_track() {
 #[test]
 fn a_correction_redraws_both_sides_of_it_first() {
     let dir = tempfile::tempdir().unwrap();
-    render(dir.path(), ProceduralMotion::Walk, 48, View::Side);
-    let gt = GroundTruth::load(&dir.path().join("gt.json")).unwrap();
-    let marks = Marks::load(&dir.path().join("marks.json")).unwrap();
-    let mut video = Video::open(&dir.path().join("frames"), &OpenOptions::default()).unwrap();
-    let first = track_video(
-        &mut video,
-        &job(&marks, 2),
-        &mut |_| {},
-        &AtomicBool::new(false),
-    )
-    .unwrap();
+    let corrected = 30;
+    let (_, mut video, first, mut j) = walk_with_a_correction(dir.path(), 48, corrected);
     assert!(
         first.background.is_some(),
         "the default settings use a background"
     );
-    let corrected = 30;
-    let mut j = job(&marks, 2);
-    j.keys.set(
-        corrected,
-        Joint::LeftAnkle,
-        gt.frames[corrected].points2d()[Joint::LeftAnkle],
-    );
-    j.from = Some(corrected);
-    j.previous = Some(first.tracks.clone());
     let mut arrived = Vec::new();
     let fresh = track_video(
         &mut video,

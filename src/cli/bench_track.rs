@@ -23,7 +23,7 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 use videomocap::eval::suite::{CLICK_NOISE_PX, Family, REAL_CLIPS, Split, clicked_marks};
-use videomocap::eval::{Accuracy, ClipScore, LIMB_JOINTS, score_positions, score_tracks};
+use videomocap::eval::{Accuracy, ClipScore, is_limb_joint, score_positions, score_tracks};
 use videomocap::formats::Marks;
 use videomocap::skeleton::{Joint, PerJoint};
 use videomocap::synth::GroundTruth;
@@ -165,8 +165,8 @@ const TRACK_COLUMNS: &str = " PCK.2   lost mean px  exact  templ";
 const TRACK_WIDTH: usize = 35;
 
 /// Tracks and scores one clip: (VBA from the clicked marks, VBA from the exact marks, the fixed
-/// template from the clicked marks), the VBA's [`LIMB_JOINTS`] from the clicked marks, and the
-/// clicked marks.
+/// template from the clicked marks), the VBA's limb joints ([`is_limb_joint`]) from the clicked
+/// marks, and the clicked marks.
 fn score_clip(
     clip: &BenchClip,
     threads: usize,
@@ -252,7 +252,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         lines.push(String::new());
         lines.push(format!(
             "real clips, the {} limb joints (the four chains and the pelvis), VBA from clicked marks: {}",
-            LIMB_JOINTS.len(),
+            Joint::ALL.into_iter().filter(|&j| is_limb_joint(j)).count(),
             real_limbs
                 .iter()
                 .map(|(name, a)| format!("{name} PCK@0.2 {:.3}", a.pck02()))

@@ -104,29 +104,18 @@ pub struct ClipScore {
     pub overall: Accuracy,
 }
 
-/// The limb joints the real-sample target counts: every joint but the head's two (head top,
-/// neck) and the chest (derived on the real sample): the four chains and the pelvis, 13.
-pub const LIMB_JOINTS: [Joint; 13] = [
-    Joint::Pelvis,
-    Joint::LeftShoulder,
-    Joint::LeftElbow,
-    Joint::LeftWrist,
-    Joint::RightShoulder,
-    Joint::RightElbow,
-    Joint::RightWrist,
-    Joint::LeftHip,
-    Joint::LeftKnee,
-    Joint::LeftAnkle,
-    Joint::RightHip,
-    Joint::RightKnee,
-    Joint::RightAnkle,
-];
+/// Whether a joint is one of the limb joints the real-sample target counts: every joint but
+/// the head's two (head top, neck) and the chest (derived on the real sample), i.e. the four
+/// chains and the pelvis, 13.
+pub fn is_limb_joint(j: Joint) -> bool {
+    !matches!(j, Joint::HeadTop | Joint::Neck | Joint::Chest)
+}
 
 impl ClipScore {
-    /// The [`LIMB_JOINTS`]' samples together.
+    /// The limb joints' samples together ([`is_limb_joint`]).
     pub fn limbs(&self) -> Accuracy {
         let mut a = Accuracy::default();
-        for j in LIMB_JOINTS {
+        for j in Joint::ALL.into_iter().filter(|&j| is_limb_joint(j)) {
             a.merge(&self.per_joint[j]);
         }
         a
