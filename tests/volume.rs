@@ -9,8 +9,7 @@ use videomocap::eval::volume::{CarveCase, VolumeScore, carve_and_score, score_vo
 use videomocap::formats::Skeleton3d;
 use videomocap::skeleton::{Joint, SubjectModel};
 use videomocap::synth::{
-    Motion, ProceduralMotion, SilhouetteFaults, VoxelParams, procedural, stature_of, volume_truth,
-    voxelise,
+    Motion, ProceduralMotion, VoxelParams, procedural, stature_of, volume_truth, voxelise,
 };
 use videomocap::volume::cloud::write_ply;
 use videomocap::volume::{
@@ -293,29 +292,36 @@ fn volume_refuses_a_file_and_an_empty_directory_by_name() {
 #[test]
 fn marching_carved_from_four_silhouettes_gives_the_pose() {
     let motion = procedural(ProceduralMotion::March, &SubjectModel::default(), 16, 10.0);
-    let case = CarveCase {
-        views: 4,
-        voxel_m: 0.04,
-        faults: SilhouetteFaults::default(),
-        min_votes: None,
-    };
-    let r = carve_and_score(&motion, &case, &VolumeParams::default()).unwrap();
+    let r = carve_and_score(
+        &motion,
+        &CarveCase::clean(4, 0.04),
+        &VolumeParams::default(),
+    )
+    .unwrap();
     let (s, voxels) = (r.score, r.voxels);
     assert!(voxels > 1000.0, "{voxels} voxels per frame");
     assert!(s.topology() >= 0.95, "topology {}", s.topology());
     assert!(s.mean_mm() <= 2.0 * 40.0, "mean error {} mm", s.mean_mm());
 }
 
+/// `synth --volume` of `frames` marching frames with a carving set-up of `views` 320×240
+/// cameras (and `extra` options) into `vols`.
+fn synth_carving_setup(vols: &std::path::Path, frames: &str, views: &str, extra: &[&str]) {
+    videomocap()
+        .args(["synth", "--motion", "march", "--frames", frames, "--volume"])
+        .args(["--views", views, "--width", "320", "--height", "240"])
+        .args(extra)
+        .arg("-o")
+        .arg(vols)
+        .assert()
+        .success();
+}
+
 #[test]
 fn synth_views_then_carve_writes_one_grid_per_frame_and_refuses_bad_set_ups_by_name() {
     let tmp = tempfile::tempdir().unwrap();
     let vols = tmp.path().join("vols");
-    videomocap()
-        .args(["synth", "--motion", "march", "--frames", "3", "--volume"])
-        .args(["--views", "3", "--width", "320", "--height", "240", "-o"])
-        .arg(&vols)
-        .assert()
-        .success();
+    synth_carving_setup(&vols, "3", "3", &[]);
     let setup = vols.join("carve");
     let grids = tmp.path().join("grids");
     videomocap()
@@ -373,13 +379,7 @@ fn synth_views_then_carve_writes_one_grid_per_frame_and_refuses_bad_set_ups_by_n
 fn carve_keeps_the_person_pointed_at_and_reports_the_other_blob() {
     let tmp = tempfile::tempdir().unwrap();
     let vols = tmp.path().join("vols");
-    videomocap()
-        .args(["synth", "--motion", "march", "--frames", "2", "--volume"])
-        .args(["--views", "4", "--width", "320", "--height", "240"])
-        .args(["--faulty-silhouettes", "-o"])
-        .arg(&vols)
-        .assert()
-        .success();
+    synth_carving_setup(&vols, "2", "4", &["--faulty-silhouettes"]);
     let truth = Skeleton3d::load(&vols.join("truth.skeleton3d.json")).unwrap();
     let grids = tmp.path().join("grids");
     for (side, x) in [("the marcher", 0.0), ("the other", 1.2)] {

@@ -110,19 +110,8 @@ fn correct_clip(
             previous: Some(tracks),
             background: background.clone(),
         };
-        // The re-track changes nothing before the latest key every joint has before the
-        // correction (those frames stay drawn as they were).
-        let low = videomocap::skeleton::Joint::ALL
-            .iter()
-            .map(|&j| {
-                keys.frames
-                    .range(..c.frame)
-                    .rev()
-                    .find(|(_, k)| k[j].is_some())
-                    .map_or(0, |(&f, _)| f)
-            })
-            .min()
-            .unwrap_or(0);
+        // The re-track changes nothing before this (those frames stay drawn as they were).
+        let low = keys.earliest_changed_by(c.frame);
         let mut waiting: BTreeSet<usize> = next_to(c.frame, n).filter(|&f| f >= low).collect();
         // Timed as the app re-tracks: the job opens the video, reuses the background of the
         // first run, and draws frames as they arrive.

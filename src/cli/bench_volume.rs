@@ -195,20 +195,23 @@ fn suite_takes(
     }
     // Carved from silhouettes: 4 and 8 clean views, and 4 views with the faults of real
     // segmentation (every mask must hold a voxel, or one may miss it).
-    let faulty = SilhouetteFaults::typical();
+    let faulty = CarveCase {
+        faults: SilhouetteFaults::typical(),
+        ..CarveCase::clean(4, 0.04)
+    };
     let cases = [
-        ("4 views", 4, SilhouetteFaults::default(), None),
-        ("8 views", 8, SilhouetteFaults::default(), None),
-        ("4 faulty views", 4, faulty.clone(), None),
-        ("4 faulty views, 3 votes", 4, faulty, Some(3)),
+        ("4 views", CarveCase::clean(4, 0.04)),
+        ("8 views", CarveCase::clean(8, 0.04)),
+        ("4 faulty views", faulty.clone()),
+        (
+            "4 faulty views, 3 votes",
+            CarveCase {
+                min_votes: Some(3),
+                ..faulty
+            },
+        ),
     ];
-    for (label, views, faults, min_votes) in cases {
-        let case = CarveCase {
-            views,
-            voxel_m: 0.04,
-            faults,
-            min_votes,
-        };
+    for (label, case) in cases {
         let mut tally: Tally<VolumeScore> = Tally::default();
         let mut per_take = serde_json::Map::new();
         for (take, bench, motion, _) in &takes {
@@ -368,13 +371,8 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         }
         for views in [4, 8] {
             say(global, &format!("{name} carved from {views} views …"));
-            let case = CarveCase {
-                views,
-                voxel_m: 0.04,
-                faults: SilhouetteFaults::default(),
-                min_votes: None,
-            };
-            let r = carve_and_score(motion, &case, &params).map_err(ExitError::failed)?;
+            let r = carve_and_score(motion, &CarveCase::clean(views, 0.04), &params)
+                .map_err(ExitError::failed)?;
             let (s, voxels) = (r.score, r.voxels);
             lines.push(format!(
                 "{:<20} {:>6} {:>9.0} {:>8.1}% {:>9.1} {:>9.2} {:>9.1}%",

@@ -179,6 +179,18 @@ pub struct CarveCase {
     pub min_votes: Option<usize>,
 }
 
+impl CarveCase {
+    /// `views` cameras with clean silhouettes, every mask holding each voxel, at `voxel_m`.
+    pub fn clean(views: usize, voxel_m: f64) -> CarveCase {
+        CarveCase {
+            views,
+            voxel_m,
+            faults: crate::synth::SilhouetteFaults::default(),
+            min_votes: None,
+        }
+    }
+}
+
 /// What one carved sequence gave: its score, the mean voxels kept per frame, and the mean
 /// voxels the carve dropped per frame (other components: a second person, fragments).
 #[derive(Debug, Clone, Copy, PartialEq)]

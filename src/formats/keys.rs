@@ -62,6 +62,23 @@ impl KeyFrames {
             .or_insert_with(|| PerJoint([None; JOINT_COUNT]))[joint] = Some(pos);
     }
 
+    /// The earliest frame a re-track from a correction on frame `from` can change: the latest
+    /// key before `from` that every joint has had (each joint's last key before it, the
+    /// earliest of those; 0 when a joint has none).
+    pub fn earliest_changed_by(&self, from: usize) -> usize {
+        Joint::ALL
+            .iter()
+            .map(|&j| {
+                self.frames
+                    .range(..from)
+                    .rev()
+                    .find(|(_, k)| k[j].is_some())
+                    .map_or(0, |(&f, _)| f)
+            })
+            .min()
+            .unwrap_or(0)
+    }
+
     /// Whether a joint was placed by hand on a frame.
     pub fn is_key(&self, frame: usize, joint: Joint) -> bool {
         self.frames

@@ -249,21 +249,9 @@ fn track_at_working_scale(
         .next_back()
         .copied()
         .unwrap_or(first_key);
-    let low = match job.from {
-        None => 0,
-        Some(from) => Joint::ALL
-            .iter()
-            .map(|&j| {
-                job.keys
-                    .frames
-                    .range(..from)
-                    .rev()
-                    .find(|(_, k)| k[j].is_some())
-                    .map_or(0, |(&f, _)| f)
-            })
-            .min()
-            .unwrap_or(0),
-    };
+    let low = job
+        .from
+        .map_or(0, |from| job.keys.earliest_changed_by(from));
     let backward_frames: Vec<usize> = if last_key > low {
         (low..=last_key).rev().collect()
     } else {

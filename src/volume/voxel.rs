@@ -87,12 +87,6 @@ impl VoxelGrid {
         self.occupied.iter().filter(|o| **o).count()
     }
 
-    /// Keeps only the largest 26-connected component of occupied voxels; returns how many
-    /// voxels were removed.
-    pub fn keep_largest_component(&mut self) -> usize {
-        self.keep_component(None).dropped_voxels
-    }
-
     /// Keeps one 26-connected component of occupied voxels: the one holding the occupied voxel
     /// nearest `near` (the person the user points at), or the largest when `near` is `None`;
     /// says what it dropped.
@@ -243,7 +237,7 @@ mod tests {
             let i = g.index(x, y, z);
             g.occupied[i] = true;
         }
-        assert_eq!(g.keep_largest_component(), 1);
+        assert_eq!(g.keep_component(None).dropped_voxels, 1);
         assert_eq!(g.count(), 3);
     }
 
