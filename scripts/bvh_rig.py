@@ -1,4 +1,4 @@
-"""Where each of videomocap's 16 joints sits in the BVH it writes (see src/export/rig.rs):
+"""Where each of videomocap's 16 joints sits in the BVH it writes (see crates/videomocap-core/src/export/rig.rs):
 joint name -> (BVH joint, whether the position is that joint's End Site rather than the joint
 itself). Shared by check_bvh_reader.py and check_bvh_blender.py (in Blender, an End Site is the
 tail of its joint's bone)."""

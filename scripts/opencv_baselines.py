@@ -3,7 +3,7 @@
 same (clicked) marks: OpenCV pyramidal Lucas-Kanade (all 16 joints as points, frame to frame) and
 CSRT (one tracker per joint, a square box of 8% of the marked stature around it).
 
-`videomocap bench track` runs this when Python's OpenCV is present: it writes a jobs file (one
+`videomocap-bench track` runs this when Python's OpenCV is present: it writes a jobs file (one
 entry per clip: its video, the marks it tracks from, which methods, where to write) and scores the
 positions written here itself, with the same metrics as its own tracker. Each output is
 {"lk": [[[x, y] x 16] per frame], "csrt": ...}.

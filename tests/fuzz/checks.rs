@@ -4,10 +4,10 @@
 //! formats) or keep the promises of its type (BVH frames, finite points).
 
 use std::path::Path;
-use videomocap::bvh::Bvh;
-use videomocap::formats::{Marks, Skeleton3d, Tracks2d};
-use videomocap::project::Project;
-use videomocap::volume::cloud::{CloudKind, parse_cloud};
+use videomocap_core::bvh::Bvh;
+use videomocap_core::formats::{Marks, Skeleton3d, Tracks2d};
+use videomocap_core::project::Project;
+use videomocap_volume::cloud::{CloudKind, parse_cloud};
 
 /// The fuzz targets, by name (also the folder names under `seeds/` and `regressions/`).
 #[allow(dead_code)]

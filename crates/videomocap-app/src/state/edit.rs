@@ -1,0 +1,339 @@
+//! The state's edits of the project, each one named undo step autosaved at once: marking the 16
+//! joints, correcting a joint by dragging it (which re-tracks from there), settings from the
+//! side panel (a slider drag is one step), flipping a bone's depth on a frame.
+
+use super::State;
+use nalgebra::Point2;
+use videomocap_core::project::{History, Project, Settings};
+use videomocap_core::skeleton::{Bone, Joint};
+
+/// Undo or redo: the project to bring back and the name of the edit.
+type HistoryStep = fn(&mut History<Project>, Project) -> Option<(Project, String)>;
+
+impl State {
+    /// Applies an edit named `what` to the project, with undo and autosave.
+    pub(super) fn edit(&mut self, what: &str, f: impl FnOnce(&mut Project)) {
+        let Some(p) = &mut self.project else { return };
+        self.history.record(p.clone(), what);
+        f(p);
+        self.dirty = true;
+        self.autosave();
+        self.results_changed();
+    }
+
+    /// A settings change from the side panel: a slider drag is one undo step, not one per
+    /// repaint.
+    pub(super) fn edit_settings(&mut self, settings: Settings, dragging: bool) {
+        if dragging && self.settings_drag_recorded {
+            if let Some(p) = &mut self.project {
+                p.settings = settings;
+                self.dirty = true;
+                self.autosave();
+            }
+        } else {
+            let what = self.project.as_ref().map_or("change settings", |p| {
+                settings_changed(&p.settings, &settings)
+            });
+            self.edit(what, |p| p.settings = settings);
+        }
+        self.settings_drag_recorded = dragging;
+    }
+
+    pub(super) fn autosave(&self) {
+        if let (Some(a), Some(p)) = (&self.autosaver, &self.project) {
+            a.save(p);
+        }
+    }
+
+    /// Undoes the last edit.
+    pub(super) fn undo(&mut self) {
+        self.step_history(History::undo, "Undid");
+    }
+
+    /// Redoes an undone edit.
+    pub(super) fn redo(&mut self) {
+        self.step_history(History::redo, "Redid");
+    }
+
+    /// Swaps the project for the one `step` brings back from the history, if any.
+    fn step_history(&mut self, step: HistoryStep, done: &str) {
+        let Some(p) = self.project.take() else { return };
+        self.project = Some(match step(&mut self.history, p.clone()) {
+            Some((other, what)) => {
+                self.status = format!("{done}: {what}");
+                other
+            }
+            None => {
+                self.status = format!("Nothing to {}", done.to_lowercase());
+                p
+            }
+        });
+        self.dirty = true;
+        self.autosave();
+        self.results_changed();
+    }
+
+    /// Starts the marking guide on the current frame (asks for each joint in turn).
+    pub(super) fn start_marking(&mut self) {
+        if self.project.is_some() {
+            self.marking = Some(0);
+            self.status = "Marking: click each joint in turn (Esc to stop)".to_owned();
+        }
+    }
+
+    pub(super) fn skip_joint(&mut self) {
+        self.marking = self
+            .marking
+            .filter(|&k| k + 1 < Joint::ALL.len())
+            .map(|k| k + 1);
+    }
+
+    /// Places (or moves) a joint on the current frame by hand; with "move the limb below" on,
+    /// the joints below it on its limb move by the same amount.
+    fn place(&mut self, what: &str, joint: Joint, pos: Point2<f64>) {
+        let frame = self.current;
+        let shown = self.points(frame);
+        let move_limb = self.move_limb;
+        // Hand-placed joints stay on the image (marks and key frames must be on it to be saved
+        // and read back); a click beside the image lands on its edge.
+        let size = self.video_info().map(|i| (i.width, i.height));
+        let onto_image = move |q: Point2<f64>| match size {
+            Some((w, h)) => Point2::new(
+                q.x.clamp(-0.5, f64::from(w) - 0.5),
+                q.y.clamp(-0.5, f64::from(h) - 0.5),
+            ),
+            None => q,
+        };
+        self.edit(what, |p| {
+            let old = shown[joint].map(|(q, _)| q);
+            p.keys.set(frame, joint, onto_image(pos));
+            if move_limb && let Some(old) = old {
+                let delta = pos - old;
+                for j in descendants(joint) {
+                    if let Some((q, _)) = shown[j] {
+                        p.keys.set(frame, j, onto_image(q + delta));
+                    }
+                }
+            }
+        });
+    }
+
+    /// A click on the frame: places the joint the marking guide asks for.
+    pub(super) fn click(&mut self, pos: Point2<f64>) {
+        let Some(k) = self.marking else { return };
+        let joint = Joint::ALL[k];
+        self.place(&format!("mark the {}", words(joint)), joint, pos);
+        if k + 1 < Joint::ALL.len() {
+            self.marking = Some(k + 1);
+        } else {
+            self.marking = None;
+            self.status =
+                "All 16 joints marked: Track (T) follows them through the video".to_owned();
+        }
+    }
+
+    /// A joint dragged on the current frame: a key there, and a re-track from it.
+    pub(super) fn moved(&mut self, joint: Joint, pos: Point2<f64>) {
+        let what = format!("move the {} on frame {}", words(joint), self.current);
+        self.place(&what, joint, pos);
+        let has_tracks = self.project.as_ref().is_some_and(|p| p.tracks.is_some());
+        if has_tracks && self.marking.is_none() {
+            self.status = format!(
+                "{} corrected on frame {}: re-tracking from there",
+                joint.name(),
+                self.current
+            );
+            self.start_tracking(Some(self.current));
+        } else {
+            self.status = format!("Moved {} on frame {}", joint.name(), self.current);
+        }
+    }
+
+    /// Flips the depth choice of `bone` on the current frame and lifts again; says why not
+    /// when the bone has one depth only there.
+    pub(super) fn flip(&mut self, bone: Bone) {
+        let frame = self.current;
+        let Some(k) = self
+            .project
+            .as_ref()
+            .and_then(|p| p.tracks.as_ref())
+            .and_then(|t| t.frames.binary_search_by_key(&frame, |f| f.index).ok())
+        else {
+            self.status = format!("Frame {frame} is not tracked: nothing to flip");
+            return;
+        };
+        let skeleton = self.project.as_ref().and_then(|p| p.skeleton.clone());
+        let known = skeleton.and_then(|s| {
+            self.choices
+                .iter()
+                .find(|c| std::sync::Arc::ptr_eq(&c.skeleton, &s))
+        });
+        let Some(choices) = known else {
+            self.status = "This 3D result's depth choices are not known (it was loaded from a \
+                           file): lift again (Track > Lift to 3D again), then flip"
+                .to_owned();
+            return;
+        };
+        if choices.single_root.get(k).is_some_and(|s| s[bone.index()]) {
+            self.status = format!(
+                "{} cannot flip on frame {frame}: its 2D image is longer than the bone, so both \
+                 depths are one point. Correct its joints on the frame, or the subject height",
+                bone.key()
+            );
+            return;
+        }
+        let Some(current) = choices.roots.get(k).map(|c| c[bone.index()]) else {
+            return;
+        };
+        self.edit(&format!("flip {} on frame {frame}", bone.key()), |p| {
+            p.overrides.insert((frame, bone), current.flipped());
+        });
+        self.status = format!("{} flipped on frame {frame}: lifting again", bone.key());
+        self.start_lift();
+    }
+}
+
+/// A name for a settings change (the undo step's name).
+fn settings_changed(before: &Settings, after: &Settings) -> &'static str {
+    if before.height_m != after.height_m {
+        "change the subject height"
+    } else if before.focal_px != after.focal_px {
+        "change the focal length"
+    } else if before.lengths != after.lengths {
+        "change the known lengths"
+    } else if before.tracker != after.tracker {
+        "change the tracker settings"
+    } else if before.lift != after.lift {
+        "change the lift settings"
+    } else {
+        "change settings"
+    }
+}
+
+/// A joint's name in words ("left wrist").
+fn words(joint: Joint) -> String {
+    joint.name().replace('_', " ")
+}
+
+/// Joints below `joint` on its limb (the bone tree's descendants).
+fn descendants(joint: Joint) -> Vec<Joint> {
+    let mut out = Vec::new();
+    let mut frontier = vec![joint];
+    while let Some(j) = frontier.pop() {
+        for b in Bone::ALL {
+            if b.parent == j {
+                out.push(b.child);
+                frontier.push(b.child);
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::intent::Intent;
+    use crate::state::file_dialogs::PreparedDialogs;
+    use crate::state::{Config, LiftChoices};
+    use std::sync::Arc;
+    use videomocap_core::camera::PinholeCamera;
+    use videomocap_core::formats::Tracks2d;
+    use videomocap_core::formats::{
+        FrameTracks, PointSource, Skeleton3d, SourceInfo, TrackedPoint,
+    };
+    use videomocap_core::lift::Root;
+    use videomocap_core::skeleton::{BONE_COUNT, PerJoint};
+
+    /// A state without a window, dialogs or autosave, on a project of `frames` tracked frames.
+    fn state_with_tracks(frames: usize) -> State {
+        let config = Config {
+            dialogs: Box::new(PreparedDialogs::default()),
+            autosave_dir: None,
+            proxy_dir: None,
+        };
+        let mut s = State::new(&egui::Context::default(), config);
+        let mut p = Project::new("clip.mp4".into());
+        p.tracks = Some(Arc::new(Tracks2d {
+            source: SourceInfo {
+                path: "clip.mp4".into(),
+                width: 64,
+                height: 48,
+                fps: 30.0,
+                frame_count: frames,
+            },
+            frames: (0..frames)
+                .map(|index| FrameTracks {
+                    index,
+                    points: PerJoint::from_fn(|_| TrackedPoint {
+                        pos: Point2::new(10.0, 10.0),
+                        confidence: 0.9,
+                        source: PointSource::Tracked,
+                    }),
+                })
+                .collect(),
+        }));
+        s.set_project(p);
+        s
+    }
+
+    /// A lift's result with its choices: bone 4 has one root on frame 0.
+    fn lifted(s: &mut State, frames: usize) {
+        let skeleton = Arc::new(Skeleton3d {
+            camera: PinholeCamera::centred(60.0, 64, 48),
+            fps: Some(30.0),
+            bone_lengths_m: Default::default(),
+            frames: Vec::new(),
+        });
+        let mut single_root = vec![[false; BONE_COUNT]; frames];
+        single_root[0][4] = true;
+        s.choices.push(LiftChoices {
+            skeleton: skeleton.clone(),
+            roots: vec![[Root::Near; BONE_COUNT]; frames],
+            single_root,
+        });
+        if let Some(p) = &mut s.project {
+            p.skeleton = Some(skeleton);
+        }
+    }
+
+    #[test]
+    fn a_flip_that_cannot_change_the_bone_says_why_and_records_nothing() {
+        let mut s = state_with_tracks(3);
+        lifted(&mut s, 3);
+        s.apply(Intent::Flip(Bone::ALL[4]));
+        assert!(
+            s.status().contains("cannot flip on frame 0"),
+            "{}",
+            s.status()
+        );
+        assert!(s.project().unwrap().overrides.is_empty());
+        assert_eq!(s.undo_name(), None);
+        // Another bone flips (an override, an undo step named for it).
+        s.apply(Intent::Flip(Bone::ALL[5]));
+        assert_eq!(s.project().unwrap().overrides.len(), 1);
+        let name = format!("flip {} on frame 0", Bone::ALL[5].key());
+        assert_eq!(s.undo_name(), Some(name.as_str()));
+    }
+
+    #[test]
+    fn undo_and_redo_say_what_they_took_back() {
+        let mut s = state_with_tracks(3);
+        s.apply(Intent::StartMarking);
+        s.apply(Intent::Click(Point2::new(5.0, 6.0)));
+        assert_eq!(s.undo_name(), Some("mark the head top"));
+        s.apply(Intent::Undo);
+        assert_eq!(s.status(), "Undid: mark the head top");
+        assert_eq!(s.redo_name(), Some("mark the head top"));
+        s.apply(Intent::Redo);
+        assert_eq!(s.status(), "Redid: mark the head top");
+        let mut settings = s.project().unwrap().settings;
+        settings.height_m = 1.8;
+        s.apply(Intent::Settings {
+            settings: Box::new(settings),
+            dragging: false,
+        });
+        s.apply(Intent::Undo);
+        assert_eq!(s.status(), "Undid: change the subject height");
+    }
+}

@@ -1,0 +1,148 @@
+//! The state's exports: what the Export menu can write, where (a dialog, or the path field when
+//! none can be shown), and the status line naming the file written or why nothing was.
+
+use super::file_dialogs::Picked;
+use super::{PathPurpose, State};
+use std::path::Path;
+use videomocap_core::export;
+
+/// Things the export menu can write.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExportKind {
+    /// The motion as BVH.
+    Bvh,
+    /// The 2D tracks (tracks2d.json).
+    TracksJson,
+    /// The 3D skeleton (skeleton3d.json).
+    SkeletonJson,
+    /// The 2D tracks as CSV.
+    TracksCsv,
+    /// The 3D joints as CSV.
+    JointsCsv,
+    /// OpenSim markers.
+    Trc,
+    /// The marks (marks.json).
+    Marks,
+}
+
+impl ExportKind {
+    /// Every export, in menu order.
+    pub const ALL: [ExportKind; 7] = [
+        ExportKind::Bvh,
+        ExportKind::TracksJson,
+        ExportKind::SkeletonJson,
+        ExportKind::TracksCsv,
+        ExportKind::JointsCsv,
+        ExportKind::Trc,
+        ExportKind::Marks,
+    ];
+
+    /// The menu entry.
+    pub fn label(self) -> &'static str {
+        match self {
+            ExportKind::Bvh => "BVH (Blender, motion builders)…",
+            ExportKind::TracksJson => "2D tracks (tracks2d.json)…",
+            ExportKind::SkeletonJson => "3D skeleton (skeleton3d.json)…",
+            ExportKind::TracksCsv => "2D tracks CSV…",
+            ExportKind::JointsCsv => "3D joints CSV…",
+            ExportKind::Trc => "OpenSim markers (.trc)…",
+            ExportKind::Marks => "Marks (marks.json)…",
+        }
+    }
+
+    /// The file name proposed, after the video's name.
+    pub(super) fn file_name(self, stem: &str) -> String {
+        let suffix = match self {
+            ExportKind::Bvh => ".bvh",
+            ExportKind::TracksJson => ".tracks2d.json",
+            ExportKind::SkeletonJson => ".skeleton3d.json",
+            ExportKind::TracksCsv => ".tracks2d.csv",
+            ExportKind::JointsCsv => ".joints3d.csv",
+            ExportKind::Trc => ".trc",
+            ExportKind::Marks => ".marks.json",
+        };
+        format!("{stem}{suffix}")
+    }
+}
+
+impl State {
+    /// Asks where to write an export, then writes it.
+    pub(super) fn export(&mut self, kind: ExportKind) {
+        let name = kind.file_name(&self.video_stem());
+        let folder = self.default_folder();
+        let picked = if self.no_native_dialogs {
+            Picked::Unavailable
+        } else {
+            self.config
+                .dialogs
+                .save_file("Export", Some(&folder), &name)
+        };
+        match picked {
+            Picked::Path(path) => {
+                let _ = self.export_to(kind, &path);
+            }
+            Picked::Cancelled => self.status = "Export cancelled: nothing written".to_owned(),
+            Picked::Unavailable => {
+                let title = format!("Export {}", kind.label().trim_end_matches('…'));
+                self.ask_path(PathPurpose::Export(kind), &title, folder.join(name));
+            }
+        }
+    }
+
+    /// Writes one export to `path`; the status line names the file or the reason.
+    pub(super) fn export_to(&mut self, kind: ExportKind, path: &Path) -> Result<(), String> {
+        let result = self.write_export(kind, path).map_err(|e| e.to_string());
+        self.status = match &result {
+            Ok(()) => format!("Wrote {}", path.display()),
+            Err(e) => format!("Nothing written to {}: {e}", path.display()),
+        };
+        result
+    }
+
+    fn write_export(&self, kind: ExportKind, path: &Path) -> anyhow::Result<()> {
+        let p = self
+            .project
+            .as_ref()
+            .ok_or_else(|| anyhow::anyhow!("no video open"))?;
+        let need_tracks = || {
+            p.tracks
+                .as_deref()
+                .ok_or_else(|| anyhow::anyhow!("nothing tracked yet (Track > Track and lift)"))
+        };
+        let need_world = || {
+            self.world
+                .as_ref()
+                .map(|(w, _)| w)
+                .ok_or_else(|| anyhow::anyhow!("no 3D skeleton yet (Track > Track and lift)"))
+        };
+        match kind {
+            ExportKind::Bvh => {
+                let b = export::bvh(need_world()?)?;
+                export::save_text(path, &b.text)?;
+            }
+            ExportKind::TracksJson => need_tracks()?.save(path)?,
+            ExportKind::SkeletonJson => p
+                .skeleton
+                .as_deref()
+                .ok_or_else(|| anyhow::anyhow!("no 3D skeleton yet (Track > Track and lift)"))?
+                .save(path)?,
+            ExportKind::TracksCsv => {
+                export::save_text(path, &export::tracks_csv(need_tracks()?))?;
+            }
+            ExportKind::JointsCsv => {
+                export::save_text(path, &export::skeleton_csv(need_world()?))?;
+            }
+            ExportKind::Trc => {
+                let name = path
+                    .file_name()
+                    .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+                export::save_text(path, &export::trc(need_world()?, &name))?;
+            }
+            ExportKind::Marks => p
+                .marks()
+                .ok_or_else(|| anyhow::anyhow!("not all 16 joints are marked on one frame"))?
+                .save(path)?,
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,437 @@
+//! The state's file actions: open (video, image folder, project, point volumes, marks), the
+//! recent list, recovery of an autosaved session, save, and leaving (opening something else,
+//! quitting) with "save changes?" first. Every save ends with a status line naming the file
+//! written or saying why not; when no file dialog can be shown, the app's own path field asks
+//! instead (for exports too: `export`).
+
+use super::file_dialogs::Picked;
+use super::frame_loader::FrameLoader;
+use super::jobs::Job;
+use super::volume::VolumeSequence;
+use super::{ExportKind, Running, State};
+use std::path::{Path, PathBuf};
+use videomocap_core::formats::Marks;
+use videomocap_core::project::Project;
+
+/// What can be opened from the File menu.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Choose {
+    /// A video file.
+    Video,
+    /// A folder of images.
+    ImageFolder,
+    /// A folder of point volumes.
+    PointVolumes,
+    /// A project file.
+    Project,
+    /// A marks file, loaded into the project's keys.
+    Marks,
+}
+
+impl Choose {
+    fn title(self) -> &'static str {
+        match self {
+            Choose::Video => "Open video",
+            Choose::ImageFolder => "Open image folder",
+            Choose::PointVolumes => "Open point volumes",
+            Choose::Project => "Open project",
+            Choose::Marks => "Load marks",
+        }
+    }
+}
+
+/// Where the user is going once "save changes?" is answered.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Leave {
+    /// Opening this file or folder.
+    Open(PathBuf),
+    /// Quitting the app.
+    Quit,
+}
+
+/// The answers to "save changes?".
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SaveAnswer {
+    /// Save, then go on.
+    Save,
+    /// Go on without saving.
+    Discard,
+    /// Stay.
+    Cancel,
+}
+
+/// What a path typed into the app's own path field is for.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum PathPurpose {
+    /// Opening something.
+    Open(Choose),
+    /// Saving the project, then going where the user was going.
+    Save(Option<Leave>),
+    /// Writing an export.
+    Export(ExportKind),
+}
+
+/// The app's own path field: shown when no file dialog can be.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PathRequest {
+    /// What the path is for.
+    pub purpose: PathPurpose,
+    /// The window's title.
+    pub title: String,
+    /// The path as typed (the default name and folder to start with).
+    pub text: String,
+    /// Why the last path given did not work.
+    pub error: Option<String>,
+}
+
+/// The status line when no dialog could be shown.
+pub(super) const NO_DIALOG: &str = "No file dialog could be shown on this desktop (no XDG portal, zenity or \
+     kdialog): type the path in the window instead";
+
+impl State {
+    /// Opens `path`, or asks "save changes?" first; quits, likewise.
+    pub(super) fn leave(&mut self, to: Leave) {
+        if self.dirty() {
+            self.leaving = Some(to);
+        } else {
+            self.go(to);
+        }
+    }
+
+    fn go(&mut self, to: Leave) {
+        match to {
+            Leave::Open(path) => self.open_now(&path),
+            Leave::Quit => {
+                // A deliberate quit leaves nothing to recover.
+                if let Some(a) = &mut self.autosaver {
+                    a.clear();
+                }
+                self.quitting = true;
+            }
+        }
+    }
+
+    /// Answers "save changes?": save (then go on), discard (go on) or cancel (stay).
+    pub(super) fn answer_save(&mut self, answer: SaveAnswer) {
+        let Some(to) = self.leaving.take() else {
+            return;
+        };
+        match answer {
+            SaveAnswer::Save => self.save_project(false, Some(to)),
+            SaveAnswer::Discard => {
+                self.dirty = false;
+                self.go(to);
+            }
+            SaveAnswer::Cancel => self.status = "Cancelled: nothing closed".to_owned(),
+        }
+    }
+
+    /// Asks for a file or folder to open (a dialog, or the path field).
+    pub(super) fn choose(&mut self, what: Choose) {
+        let picked = if self.no_native_dialogs {
+            Picked::Unavailable
+        } else {
+            match what {
+                Choose::Video => self.config.dialogs.open_file(what.title(), &[]),
+                Choose::Project | Choose::Marks => {
+                    self.config.dialogs.open_file(what.title(), &["json"])
+                }
+                Choose::ImageFolder | Choose::PointVolumes => {
+                    self.config.dialogs.open_folder(what.title())
+                }
+            }
+        };
+        match picked {
+            Picked::Path(p) => self.chosen(what, &p),
+            Picked::Cancelled => {}
+            Picked::Unavailable => {
+                let folder = self.default_folder();
+                self.ask_path(PathPurpose::Open(what), what.title(), folder);
+            }
+        }
+    }
+
+    fn chosen(&mut self, what: Choose, path: &Path) {
+        match what {
+            Choose::Marks => self.load_marks(path),
+            _ => self.leave(Leave::Open(path.to_owned())),
+        }
+    }
+
+    fn load_marks(&mut self, path: &Path) {
+        match Marks::load(path) {
+            Ok(m) => self.edit("load marks", |p| {
+                for (j, q) in m.points.iter() {
+                    p.keys.set(m.frame, j, *q);
+                }
+            }),
+            Err(e) => self.status = format!("Cannot load marks: {e}"),
+        }
+    }
+
+    /// The folder files are proposed in: the project's, else the video's.
+    pub(super) fn default_folder(&self) -> PathBuf {
+        self.project_path
+            .as_deref()
+            .or_else(|| self.project.as_ref().map(|p| p.video.as_path()))
+            .and_then(Path::parent)
+            .map(Path::to_owned)
+            .or_else(|| std::env::current_dir().ok())
+            .unwrap_or_default()
+    }
+
+    /// The video's name without its extension (names proposed for saves and exports).
+    pub(super) fn video_stem(&self) -> String {
+        self.project
+            .as_ref()
+            .and_then(|p| p.video.file_stem())
+            .map_or_else(|| "motion".to_owned(), |s| s.to_string_lossy().into_owned())
+    }
+
+    pub(super) fn ask_path(&mut self, purpose: PathPurpose, title: &str, default: PathBuf) {
+        self.no_native_dialogs = true;
+        self.status = NO_DIALOG.to_owned();
+        self.path_request = Some(PathRequest {
+            purpose,
+            title: title.to_owned(),
+            text: default.display().to_string(),
+            error: None,
+        });
+    }
+
+    pub(super) fn path_edited(&mut self, text: String) {
+        if let Some(r) = &mut self.path_request {
+            r.text = text;
+            r.error = None;
+        }
+    }
+
+    /// The path field was confirmed or cancelled.
+    pub(super) fn path_chosen(&mut self, path: Option<PathBuf>) {
+        let Some(request) = self.path_request.take() else {
+            return;
+        };
+        let Some(path) = path.filter(|p| !p.as_os_str().is_empty()) else {
+            self.status = match request.purpose {
+                PathPurpose::Open(_) => "Nothing opened".to_owned(),
+                PathPurpose::Save(_) => "Not saved (cancelled)".to_owned(),
+                PathPurpose::Export(_) => "Export cancelled: nothing written".to_owned(),
+            };
+            return;
+        };
+        let failed = match &request.purpose {
+            PathPurpose::Open(what) => {
+                if path.exists() {
+                    self.chosen(*what, &path);
+                    None
+                } else {
+                    Some(format!("{} does not exist", path.display()))
+                }
+            }
+            PathPurpose::Save(then) => {
+                self.save_project_to(&path);
+                if self.dirty {
+                    Some(self.status.clone())
+                } else {
+                    if let Some(to) = then.clone() {
+                        self.go(to);
+                    }
+                    None
+                }
+            }
+            PathPurpose::Export(kind) => self.export_to(*kind, &path).err(),
+        };
+        if let Some(error) = failed {
+            // The window stays, saying why, so the user can change the path.
+            self.path_request = Some(PathRequest {
+                error: Some(error),
+                text: path.display().to_string(),
+                ..request
+            });
+        }
+    }
+
+    /// Saves the project to its file, or asks where (`ask`, or no file yet); then goes on to
+    /// `then`.
+    pub(super) fn save_project(&mut self, ask: bool, then: Option<Leave>) {
+        if self.project.is_none() {
+            self.status = "Nothing to save: open a video first".to_owned();
+            return;
+        }
+        let picked = match (&self.project_path, ask) {
+            (Some(p), false) => Picked::Path(p.clone()),
+            _ if self.no_native_dialogs => Picked::Unavailable,
+            _ => {
+                let name = format!("{}.videomocap.json", self.video_stem());
+                let folder = self.default_folder();
+                self.config
+                    .dialogs
+                    .save_file("Save project", Some(&folder), &name)
+            }
+        };
+        match picked {
+            Picked::Path(path) => {
+                self.save_project_to(&path);
+                if !self.dirty
+                    && let Some(to) = then
+                {
+                    self.go(to);
+                }
+            }
+            Picked::Cancelled => self.status = "Not saved (cancelled)".to_owned(),
+            Picked::Unavailable => {
+                let default = self
+                    .default_folder()
+                    .join(format!("{}.videomocap.json", self.video_stem()));
+                self.ask_path(PathPurpose::Save(then), "Save project", default);
+            }
+        }
+    }
+
+    /// Saves the project to `path` and clears the recovery file.
+    pub(super) fn save_project_to(&mut self, path: &Path) {
+        let Some(p) = &self.project else { return };
+        match p.save(path) {
+            Ok(()) => {
+                self.project_path = Some(path.to_owned());
+                self.dirty = false;
+                if let Some(a) = &mut self.autosaver {
+                    a.clear();
+                }
+                self.status = format!("Saved {}", path.display());
+            }
+            Err(e) => self.status = format!("Not saved: {e}"),
+        }
+    }
+
+    /// Accepts or declines the recovery offered at start.
+    pub(super) fn answer_recovery(&mut self, recover: bool) {
+        let Some(path) = self.recovery.take() else {
+            return;
+        };
+        if recover {
+            match Project::load(&path) {
+                Ok(p) => {
+                    self.open_video(&p.video.clone());
+                    self.set_project(p);
+                    self.dirty = true;
+                    self.autosave();
+                    self.status = "Recovered the unsaved session".to_owned();
+                }
+                Err(e) => self.status = format!("Cannot recover: {e}"),
+            }
+        } else if let Some(a) = &mut self.autosaver {
+            a.clear();
+        }
+    }
+
+    /// Opens a video, image folder, project file or a folder of point volumes now.
+    pub(super) fn open_now(&mut self, path: &Path) {
+        self.dirty = false;
+        if is_volume_dir(path) {
+            self.open_volume(path);
+        } else if path.is_file() && path.extension().is_some_and(|e| e == "json") {
+            match Project::load(path) {
+                Ok(p) => {
+                    self.open_video(&p.video.clone());
+                    self.set_project(p);
+                    self.project_path = Some(path.to_owned());
+                    self.status = format!("Opened project {}", path.display());
+                }
+                Err(e) => self.status = format!("Cannot open project: {e}"),
+            }
+        } else {
+            self.open_video(path);
+        }
+        self.recent.retain(|p| p != path);
+        self.recent.insert(0, path.to_owned());
+        self.recent.truncate(8);
+        self.save_recent();
+    }
+
+    fn recent_path(&self) -> Option<PathBuf> {
+        self.config
+            .autosave_dir
+            .as_ref()
+            .map(|d| d.join("recent.json"))
+    }
+
+    /// The recent-files list kept beside the autosave (missing or unreadable: empty).
+    pub(super) fn load_recent(&self) -> Vec<PathBuf> {
+        self.recent_path()
+            .and_then(|p| std::fs::read_to_string(p).ok())
+            .and_then(|t| serde_json::from_str(&t).ok())
+            .unwrap_or_default()
+    }
+
+    fn save_recent(&self) {
+        let Some(path) = self.recent_path() else {
+            return;
+        };
+        if let Some(dir) = path.parent() {
+            let _ = std::fs::create_dir_all(dir);
+        }
+        if let Ok(text) = serde_json::to_string_pretty(&self.recent) {
+            // Losing the recent list is harmless; the write is still atomic.
+            let _ = videomocap_core::formats::write_atomically(&path, text.as_bytes());
+        }
+    }
+
+    /// Volume mode: processes the point volumes of `dir` on a worker thread.
+    fn open_volume(&mut self, dir: &Path) {
+        self.close_current();
+        self.volume = Some(VolumeSequence::new(dir.to_owned()));
+        self.running = Some(Running {
+            job: Job::volume(dir.to_owned(), 30.0, self.ctx.clone()),
+            keys: Default::default(),
+            overrides: Default::default(),
+        });
+        self.status = format!("Processing point volumes in {}…", dir.display());
+    }
+
+    fn open_video(&mut self, path: &Path) {
+        self.close_current();
+        self.loader = Some(FrameLoader::open(
+            path.to_owned(),
+            self.ctx.clone(),
+            self.config.proxy_dir.clone(),
+        ));
+        self.project = Some(Project::new(path.to_owned()));
+        self.background = None;
+        self.results_changed();
+        self.status = format!("Opening {}…", path.display());
+    }
+
+    /// Stops any job and forgets the open video, project or volume sequence.
+    fn close_current(&mut self) {
+        if let Some(r) = self.running.take() {
+            r.job.cancel();
+        }
+        self.loader = None;
+        self.volume = None;
+        self.project = None;
+        self.background = None;
+        self.project_path = None;
+        self.history.clear();
+        self.results_changed();
+        self.current = 0;
+        self.shown = None;
+        self.preview = false;
+        self.texture = None;
+        self.marking = None;
+        self.subject_fit = None;
+        self.opened_count += 1;
+    }
+}
+
+/// Whether `path` is a folder of point clouds (and no images): volume mode.
+fn is_volume_dir(path: &Path) -> bool {
+    path.is_dir()
+        && videomocap_volume::list_frames(path).is_ok()
+        && !std::fs::read_dir(path).is_ok_and(|entries| {
+            entries.filter_map(Result::ok).any(|e| {
+                let name = e.file_name().to_string_lossy().to_ascii_lowercase();
+                name.ends_with(".png") || name.ends_with(".jpg") || name.ends_with(".jpeg")
+            })
+        })
+}

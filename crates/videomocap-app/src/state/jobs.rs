@@ -1,0 +1,200 @@
+//! Heavy work off the UI thread: tracking and lifting run on worker threads, report progress
+//! through a channel (with each newly tracked frame, so results draw as they arrive), and stop
+//! when their cancel flag is set.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{Receiver, channel};
+use std::time::Instant;
+use videomocap_core::formats::{FrameTracks, Tracks2d};
+use videomocap_core::lift::{DepthOverrides, LiftJob, LiftOutput, LiftParams, lift};
+use videomocap_core::lift::{SubjectFit, subject_from_height};
+use videomocap_core::track::{TrackJob, TrackOutput, track_video};
+use videomocap_core::video::{OpenOptions, Video};
+use videomocap_volume::{Processed, VolumeParams, process_directory};
+
+/// What a job sends back.
+pub enum JobEvent {
+    /// Steps done of a total, and a frame just tracked.
+    Progress {
+        done: usize,
+        total: usize,
+        stage: String,
+        frame: Option<FrameTracks>,
+    },
+    /// Tracking finished.
+    Tracked(Result<TrackOutput, String>),
+    /// Lifting finished.
+    Lifted(Result<(LiftOutput, SubjectFit), String>),
+    /// A point-volume sequence was processed.
+    Volume(Result<Processed, String>),
+}
+
+/// A running job.
+pub struct Job {
+    /// "Tracking" or "Lifting".
+    pub what: &'static str,
+    events: Receiver<JobEvent>,
+    cancel: Arc<AtomicBool>,
+    started: Instant,
+    /// Progress so far.
+    pub done: usize,
+    /// Steps in all.
+    pub total: usize,
+    /// What is being done now.
+    pub stage: String,
+}
+
+impl Job {
+    /// Tracks `video` on a worker thread.
+    pub fn track(video: PathBuf, job: TrackJob, ctx: egui::Context) -> Job {
+        let (tx, rx) = channel();
+        let cancel = Arc::new(AtomicBool::new(false));
+        let flag = cancel.clone();
+        std::thread::spawn(move || {
+            let result = Video::open(&video, &OpenOptions::default())
+                .map_err(|e| e.to_string())
+                .and_then(|mut v| {
+                    let progress_tx = tx.clone();
+                    let repaint = ctx.clone();
+                    let mut progress = move |p: &videomocap_core::track::TrackProgress| {
+                        let _ = progress_tx.send(JobEvent::Progress {
+                            done: p.done,
+                            total: p.total,
+                            stage: "tracking".to_owned(),
+                            frame: p.frame.clone(),
+                        });
+                        repaint.request_repaint();
+                    };
+                    track_video(&mut v, &job, &mut progress, &flag).map_err(|e| e.to_string())
+                });
+            let _ = tx.send(JobEvent::Tracked(result));
+            ctx.request_repaint();
+        });
+        Job::new("Tracking", rx, cancel)
+    }
+
+    /// Lifts `tracks` to 3D on a worker thread with the project's lift settings `params` and
+    /// the lengths the user knows.
+    pub fn lift(
+        tracks: Arc<Tracks2d>,
+        focal_px: f64,
+        height_m: f64,
+        known: videomocap_core::formats::KnownLengths,
+        params: LiftParams,
+        overrides: DepthOverrides,
+        ctx: egui::Context,
+    ) -> Job {
+        let (tx, rx) = channel();
+        let cancel = Arc::new(AtomicBool::new(false));
+        let flag = cancel.clone();
+        std::thread::spawn(move || {
+            let camera = videomocap_core::camera::PinholeCamera::centred(
+                focal_px,
+                tracks.source.width,
+                tracks.source.height,
+            );
+            let result = subject_from_height(height_m, &tracks, camera, &params, &known)
+                .map_err(|e| e.to_string())
+                .and_then(|(subject, fit)| {
+                    let job = LiftJob {
+                        tracks: &tracks,
+                        camera,
+                        subject,
+                        params,
+                        overrides,
+                    };
+                    let progress_tx = tx.clone();
+                    let repaint = ctx.clone();
+                    let mut progress = move |p: &videomocap_core::lift::LiftProgress| {
+                        let _ = progress_tx.send(JobEvent::Progress {
+                            done: p.done,
+                            total: p.total,
+                            stage: p.stage.to_owned(),
+                            frame: None,
+                        });
+                        repaint.request_repaint();
+                    };
+                    lift(&job, &mut progress, &flag)
+                        .map(|out| (out, fit))
+                        .map_err(|e| e.to_string())
+                });
+            let _ = tx.send(JobEvent::Lifted(result));
+            ctx.request_repaint();
+        });
+        Job::new("Lifting", rx, cancel)
+    }
+
+    /// Runs the point-volume pipeline on `dir` on a worker thread (frames in parallel).
+    pub fn volume(dir: PathBuf, fps: f64, ctx: egui::Context) -> Job {
+        let (tx, rx) = channel();
+        let cancel = Arc::new(AtomicBool::new(false));
+        let flag = cancel.clone();
+        std::thread::spawn(move || {
+            let progress_tx = tx.clone();
+            let repaint = ctx.clone();
+            let progress = move |done: usize, total: usize| {
+                let _ = progress_tx.send(JobEvent::Progress {
+                    done,
+                    total,
+                    stage: "volumes".to_owned(),
+                    frame: None,
+                });
+                repaint.request_repaint();
+            };
+            let result = process_directory(&dir, &VolumeParams::default(), fps, &progress, &flag)
+                .map_err(|e| e.to_string());
+            let _ = tx.send(JobEvent::Volume(result));
+            ctx.request_repaint();
+        });
+        Job::new("Volumes", rx, cancel)
+    }
+
+    fn new(what: &'static str, events: Receiver<JobEvent>, cancel: Arc<AtomicBool>) -> Job {
+        Job {
+            what,
+            events,
+            cancel,
+            started: Instant::now(),
+            done: 0,
+            total: 0,
+            stage: String::new(),
+        }
+    }
+
+    /// Asks the job to stop (it answers with a "cancelled" error).
+    pub fn cancel(&self) {
+        self.cancel.store(true, Ordering::Relaxed);
+    }
+
+    /// Events since the last call (progress is folded into `done`/`total`).
+    pub fn poll(&mut self) -> Vec<JobEvent> {
+        let mut out = Vec::new();
+        while let Ok(e) = self.events.try_recv() {
+            if let JobEvent::Progress {
+                done, total, stage, ..
+            } = &e
+            {
+                self.done = *done;
+                self.total = *total;
+                self.stage.clone_from(stage);
+            }
+            out.push(e);
+        }
+        out
+    }
+
+    /// Share done, steps per second and seconds left.
+    pub fn rate(&self) -> (f32, f64, Option<f64>) {
+        let share = if self.total == 0 {
+            0.0
+        } else {
+            self.done as f32 / self.total as f32
+        };
+        let secs = self.started.elapsed().as_secs_f64().max(1e-3);
+        let per_s = self.done as f64 / secs;
+        let left = (per_s > 0.0).then(|| (self.total.saturating_sub(self.done)) as f64 / per_s);
+        (share, per_s, left)
+    }
+}

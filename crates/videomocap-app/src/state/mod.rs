@@ -1,0 +1,550 @@
+//! The app's state and its actions, in plain Rust (no drawing): the open video or point-volume
+//! sequence, the project with its undo history, autosave and recovery, the running job, and
+//! what is derived from the results (reliability strips, weak spans, the 3D world). The views
+//! read it and return [`Intent`]s; [`State::apply`] carries them out.
+//!
+//! The actions live by subject: `files` (open, save, quit, the path field), `export`, `edit`
+//! (marks, corrections, settings, flips, undo), `work` (tracking and lifting jobs, decoded
+//! frames arriving). The workers it owns: [`frame_loader`], [`jobs`], [`autosave`], and the
+//! desktop's [`file_dialogs`].
+
+pub mod autosave;
+mod edit;
+mod export;
+pub mod file_dialogs;
+mod files;
+pub mod frame_loader;
+pub mod jobs;
+pub mod volume;
+mod work;
+
+pub use export::ExportKind;
+pub use files::{Choose, Leave, PathPurpose, PathRequest, SaveAnswer};
+
+use crate::intent::Intent;
+use crate::views::frame_view::PointState;
+use crate::views::timeline::Strips;
+use autosave::Autosaver;
+use file_dialogs::{Dialogs, RfdDialogs};
+use frame_loader::FrameLoader;
+use jobs::Job;
+use nalgebra::Point2;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::sync::Arc;
+use videomocap_core::export::WorldSkeleton;
+use videomocap_core::formats::{FrameTracks, Skeleton3d};
+use videomocap_core::lift::Root;
+use videomocap_core::lift::SubjectFit;
+use videomocap_core::project::{History, Project};
+use videomocap_core::skeleton::{BONE_COUNT, JOINT_COUNT, Joint, PerJoint};
+use videomocap_core::track::{KeyFrames, WeakSpan, weak_spans};
+use videomocap_core::video::VideoInfo;
+use volume::VolumeSequence;
+
+/// How the app is set up (tests swap the dialogs and the autosave directory).
+pub struct Config {
+    /// File dialogs.
+    pub dialogs: Box<dyn Dialogs>,
+    /// Where the recovery file lives (`None`: no autosave).
+    pub autosave_dir: Option<PathBuf>,
+    /// Where seek proxies of long-GOP videos are kept (`None`: no proxies).
+    pub proxy_dir: Option<PathBuf>,
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Config {
+            dialogs: Box::new(RfdDialogs),
+            autosave_dir: autosave::default_dir(),
+            proxy_dir: dirs::cache_dir().map(|d| d.join("videomocap").join("proxies")),
+        }
+    }
+}
+
+/// A running job and the keys it started from (its result is dropped if they changed since).
+struct Running {
+    job: Job,
+    keys: KeyFrames,
+    overrides: videomocap_core::lift::DepthOverrides,
+}
+
+/// What a lift chose per frame and bone, kept with the skeleton it produced (so that undo and
+/// redo, which bring back an earlier skeleton, find its choices).
+struct LiftChoices {
+    skeleton: Arc<Skeleton3d>,
+    roots: Vec<[Root; BONE_COUNT]>,
+    single_root: Vec<[bool; BONE_COUNT]>,
+}
+
+/// How much of the clip's tracks is weak, lost or filled in (the side panel's headline).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct WeakShare {
+    /// Joint-frames in weak spans (a joint on a frame counts once).
+    pub joint_frames: usize,
+    /// All joint-frames of the tracked clip (16 per frame).
+    pub total: usize,
+}
+
+impl WeakShare {
+    /// The weak share of the clip, 0–1.
+    pub fn share(self) -> f64 {
+        self.joint_frames as f64 / self.total.max(1) as f64
+    }
+}
+
+/// Everything the app knows and does, without a window.
+pub struct State {
+    ctx: egui::Context,
+    config: Config,
+    loader: Option<FrameLoader>,
+    project: Option<Project>,
+    project_path: Option<PathBuf>,
+    history: History<Project>,
+    autosaver: Option<Autosaver>,
+    /// A recovery file found at start, waiting for the user's answer.
+    recovery: Option<PathBuf>,
+    current: usize,
+    shown: Option<usize>,
+    /// The texture holds the seek proxy's smaller picture of `shown`; the full frame follows.
+    preview: bool,
+    texture: Option<egui::TextureHandle>,
+    /// Index into [`Joint::ALL`] of the joint the marking guide asks for.
+    marking: Option<usize>,
+    move_limb: bool,
+    running: Option<Running>,
+    /// Frames tracked so far by the running job (drawn as they arrive, over the earlier
+    /// tracks a re-track replaces).
+    partial: BTreeMap<usize, FrameTracks>,
+    /// The background the last tracking run of this video found (a re-track reuses it).
+    background: Option<videomocap_core::track::KnownBackground>,
+    spans: Vec<WeakSpan>,
+    strips: Option<Strips>,
+    choices: Vec<LiftChoices>,
+    /// What the last lift read of the subject from the tracks (shown under the height).
+    subject_fit: Option<SubjectFit>,
+    /// The project's 3D skeleton in the exports' world (what exports write), with the skeleton
+    /// it was made from.
+    world: Option<(WorldSkeleton, Arc<Skeleton3d>)>,
+    /// The last 3D skeleton shown, kept on screen while a job makes the next one.
+    last_world: Option<(WorldSkeleton, Arc<Skeleton3d>)>,
+    playing: bool,
+    play_time: f64,
+    show_help: bool,
+    show_guide: bool,
+    recent: Vec<PathBuf>,
+    status: String,
+    /// Volume mode: a point-volume sequence instead of a video.
+    volume: Option<VolumeSequence>,
+    /// The project has edits not saved to its file (the autosave holds them).
+    dirty: bool,
+    /// Where the user is going once "save changes?" is answered.
+    leaving: Option<Leave>,
+    /// The app's own path field, shown when no file dialog can be.
+    path_request: Option<PathRequest>,
+    /// A file dialog could not be shown once: use the path field from then on.
+    no_native_dialogs: bool,
+    /// The user chose to quit and nothing is left to ask: the window closes.
+    quitting: bool,
+    /// A settings slider is being dragged and its undo step is already recorded.
+    settings_drag_recorded: bool,
+    /// How many times something was opened (the views reset their zoom and orbit on a change).
+    opened_count: u64,
+}
+
+impl State {
+    /// The state at start, with the given dialogs and autosave directory; a recovery file left
+    /// by an earlier session is offered.
+    pub fn new(ctx: &egui::Context, config: Config) -> State {
+        let autosaver = config.autosave_dir.as_deref().map(Autosaver::new);
+        let recovery = autosaver
+            .as_ref()
+            .map(|a| a.path().to_owned())
+            .filter(|p| p.is_file());
+        let mut state = State {
+            ctx: ctx.clone(),
+            config,
+            loader: None,
+            project: None,
+            project_path: None,
+            history: History::new(200),
+            autosaver,
+            recovery,
+            current: 0,
+            shown: None,
+            preview: false,
+            texture: None,
+            marking: None,
+            move_limb: false,
+            running: None,
+            partial: BTreeMap::new(),
+            background: None,
+            spans: Vec::new(),
+            strips: None,
+            choices: Vec::new(),
+            subject_fit: None,
+            world: None,
+            last_world: None,
+            playing: false,
+            play_time: 0.0,
+            show_help: false,
+            show_guide: false,
+            recent: Vec::new(),
+            status: "Open a video with File > Open video (or drop one here)".to_owned(),
+            volume: None,
+            dirty: false,
+            leaving: None,
+            path_request: None,
+            no_native_dialogs: false,
+            quitting: false,
+            settings_drag_recorded: false,
+            opened_count: 0,
+        };
+        state.recent = state.load_recent();
+        state
+    }
+
+    /// Carries out what a view asked for.
+    pub fn apply(&mut self, intent: Intent) {
+        match intent {
+            Intent::Open(path) => self.leave(Leave::Open(path)),
+            Intent::Choose(what) => self.choose(what),
+            Intent::Save => self.save_project(false, None),
+            Intent::SaveAs => self.save_project(true, None),
+            Intent::Export(kind) => self.export(kind),
+            Intent::Quit => self.leave(Leave::Quit),
+            Intent::AnswerSave(answer) => self.answer_save(answer),
+            Intent::AnswerRecovery(recover) => self.answer_recovery(recover),
+            Intent::PathEdited(text) => self.path_edited(text),
+            Intent::PathChosen(path) => self.path_chosen(path),
+            Intent::Undo => self.undo(),
+            Intent::Redo => self.redo(),
+            Intent::StartMarking => self.start_marking(),
+            Intent::SkipJoint => self.skip_joint(),
+            Intent::StopMarking => self.marking = None,
+            Intent::MoveLimb(on) => self.move_limb = on,
+            Intent::Click(pos) => self.click(pos),
+            Intent::Moved(joint, pos) => self.moved(joint, pos),
+            Intent::Track => self.start_tracking(None),
+            Intent::Lift => self.start_lift(),
+            Intent::Cancel => self.cancel_job(),
+            Intent::Flip(bone) => self.flip(bone),
+            Intent::GoTo(frame) => self.go_to(frame),
+            Intent::Step(by) => self.go_to(self.current.saturating_add_signed(by)),
+            Intent::TogglePlay => self.playing = !self.playing,
+            Intent::Settings { settings, dragging } => self.edit_settings(*settings, dragging),
+            Intent::SettingsReleased => self.settings_drag_recorded = false,
+            Intent::VolumeLayers(layers) => {
+                if let Some(v) = &mut self.volume {
+                    v.layers = layers;
+                }
+            }
+            Intent::Help(show) => self.show_help = show,
+            Intent::Guide(show) => self.show_guide = show,
+            Intent::Escape => {
+                self.marking = None;
+                self.show_help = false;
+                self.show_guide = false;
+            }
+        }
+    }
+
+    // ----- what the views read -----
+
+    /// The project being edited.
+    pub fn project(&self) -> Option<&Project> {
+        self.project.as_ref()
+    }
+
+    /// Metadata of the open video.
+    pub fn video_info(&self) -> Option<&VideoInfo> {
+        self.loader.as_ref().and_then(FrameLoader::info)
+    }
+
+    /// The frame loader of the open video (the status bar shows its seek proxy).
+    pub fn loader(&self) -> Option<&FrameLoader> {
+        self.loader.as_ref()
+    }
+
+    /// Number of frames of the open video or volume sequence (0 when none).
+    pub fn frame_count(&self) -> usize {
+        match &self.volume {
+            Some(v) => v.frame_count(),
+            None => self.video_info().map_or(0, |i| i.frame_count),
+        }
+    }
+
+    /// Frames per second of what is open (30 until known).
+    pub fn fps(&self) -> f64 {
+        match &self.volume {
+            Some(v) => v.world.as_ref().map_or(30.0, |w| w.fps),
+            None => self.video_info().map_or(30.0, |i| i.fps),
+        }
+    }
+
+    /// Volume mode's state, when a point-volume sequence is open.
+    pub fn volume(&self) -> Option<&VolumeSequence> {
+        self.volume.as_ref()
+    }
+
+    /// The frame the user is on.
+    pub fn current_frame(&self) -> usize {
+        self.current
+    }
+
+    /// The status line.
+    pub fn status(&self) -> &str {
+        &self.status
+    }
+
+    /// The frame index the shown texture holds.
+    #[cfg(test)]
+    pub fn shown(&self) -> Option<usize> {
+        self.shown
+    }
+
+    /// Whether the texture is the seek proxy's preview of the current frame.
+    pub fn preview(&self) -> bool {
+        self.preview
+    }
+
+    /// The picture of the current frame.
+    pub fn texture(&self) -> Option<&egui::TextureHandle> {
+        self.texture.as_ref()
+    }
+
+    /// Whether a tracking, lifting or volume job runs.
+    pub fn busy(&self) -> bool {
+        self.running.is_some()
+    }
+
+    /// The running job (the progress bar reads it).
+    pub fn job(&self) -> Option<&Job> {
+        self.running.as_ref().map(|r| &r.job)
+    }
+
+    /// The joint the marking guide asks for, if marking, and its place in the order.
+    pub fn asking(&self) -> Option<(usize, Joint)> {
+        self.marking.map(|k| (k, Joint::ALL[k]))
+    }
+
+    /// Whether dragging a joint moves the limb below it.
+    pub fn move_limb(&self) -> bool {
+        self.move_limb
+    }
+
+    /// The edit undo would take back, if any.
+    pub fn undo_name(&self) -> Option<&str> {
+        self.history.undo_name()
+    }
+
+    /// The edit redo would bring back, if any.
+    pub fn redo_name(&self) -> Option<&str> {
+        self.history.redo_name()
+    }
+
+    /// The recent files (newest first).
+    pub fn recent(&self) -> &[PathBuf] {
+        &self.recent
+    }
+
+    /// Whether playback runs.
+    pub fn playing(&self) -> bool {
+        self.playing
+    }
+
+    /// Whether the shortcuts window shows.
+    pub fn show_help(&self) -> bool {
+        self.show_help
+    }
+
+    /// Whether the user guide window shows.
+    pub fn show_guide(&self) -> bool {
+        self.show_guide
+    }
+
+    /// The reliability strips of the tracks.
+    pub fn strips(&self) -> Option<&Strips> {
+        self.strips.as_ref()
+    }
+
+    /// The tracks' weak spans (fragments the user can jump to).
+    pub fn spans(&self) -> &[WeakSpan] {
+        &self.spans
+    }
+
+    /// How much of the tracks is weak: joint-frames in weak spans and all joint-frames.
+    pub fn weak_share(&self) -> Option<WeakShare> {
+        let tracks = self.project.as_ref()?.tracks.as_ref()?;
+        Some(WeakShare {
+            joint_frames: self.spans.iter().map(|s| s.end + 1 - s.start).sum(),
+            total: tracks.frames.len() * JOINT_COUNT,
+        })
+    }
+
+    /// What the last lift read of the subject.
+    pub fn subject_fit(&self) -> Option<&SubjectFit> {
+        self.subject_fit.as_ref()
+    }
+
+    /// The 3D skeleton to show: the project's, or while a job makes the next one, the last.
+    pub fn shown_world(&self) -> Option<(&WorldSkeleton, &Skeleton3d)> {
+        match &self.world {
+            Some((w, s)) => Some((w, s.as_ref())),
+            None if self.busy() => self.last_world.as_ref().map(|(w, s)| (w, s.as_ref())),
+            None => None,
+        }
+    }
+
+    /// Whether the 3D skeleton shown is the last one, kept while a job makes the next.
+    pub fn world_is_stale(&self) -> bool {
+        self.world.is_none() && self.busy() && self.last_world.is_some()
+    }
+
+    /// Whether a recovery prompt is showing.
+    pub fn offers_recovery(&self) -> bool {
+        self.recovery.is_some()
+    }
+
+    /// Where the user is going once "save changes?" is answered (the prompt shows meanwhile).
+    pub fn leaving(&self) -> Option<&Leave> {
+        self.leaving.as_ref()
+    }
+
+    /// The app's own path field, when it shows.
+    pub fn path_request(&self) -> Option<&PathRequest> {
+        self.path_request.as_ref()
+    }
+
+    /// How many times something was opened (a change: the views fit the new frame).
+    pub fn opened(&self) -> u64 {
+        self.opened_count
+    }
+
+    /// Whether the user chose to quit and nothing is left to ask.
+    pub fn quitting(&self) -> bool {
+        self.quitting
+    }
+
+    /// Whether the project has changes not saved to a project file.
+    pub fn dirty(&self) -> bool {
+        self.dirty && self.project.is_some()
+    }
+
+    /// What to draw for a frame: keys win, then tracks arriving (a running job's, newer than the
+    /// tracks it replaces), then the final tracks.
+    pub fn points(&self, frame: usize) -> PerJoint<Option<(Point2<f64>, PointState)>> {
+        let Some(p) = &self.project else {
+            return PerJoint::from_fn(|_| None);
+        };
+        let weak = p.settings.tracker.weak_reliability;
+        let tracked = self.partial.get(&frame).or_else(|| {
+            p.tracks.as_ref().and_then(|t| {
+                t.frames
+                    .binary_search_by_key(&frame, |f| f.index)
+                    .ok()
+                    .map(|k| &t.frames[k])
+            })
+        });
+        let keys = p.keys.frames.get(&frame);
+        PerJoint::from_fn(|j| {
+            if let Some(k) = keys.and_then(|k| k[j]) {
+                return Some((k, PointState::Key));
+            }
+            let t = tracked?.points[j];
+            Some((t.pos, PointState::of(&t, weak)))
+        })
+    }
+
+    /// The recovery file's path (when autosave is on).
+    #[cfg(test)]
+    pub fn autosave_path(&self) -> Option<PathBuf> {
+        self.autosaver.as_ref().map(|a| a.path().to_owned())
+    }
+
+    /// Waits until autosaves are written (tests).
+    #[cfg(test)]
+    pub fn flush_autosave(&mut self) {
+        if let Some(a) = &mut self.autosaver {
+            a.flush();
+        }
+    }
+
+    /// The project, for tests that set one up directly.
+    #[cfg(test)]
+    pub fn project_mut(&mut self) -> Option<&mut Project> {
+        self.project.as_mut()
+    }
+
+    /// Puts a project in place without a video (tests of the panels).
+    #[cfg(test)]
+    pub fn set_project_for_test(&mut self, p: Project) {
+        self.set_project(p);
+    }
+
+    // ----- derived results -----
+
+    fn set_project(&mut self, p: Project) {
+        self.project = Some(p);
+        self.background = None;
+        self.subject_fit = None;
+        self.history.clear();
+        self.results_changed();
+    }
+
+    /// Recomputes what is derived from the results (strips, spans, the 3D world).
+    fn results_changed(&mut self) {
+        self.partial.clear();
+        if let Some(w) = self.world.take() {
+            self.last_world = Some(w);
+        }
+        let Some(p) = &self.project else {
+            self.strips = None;
+            self.spans.clear();
+            self.last_world = None;
+            return;
+        };
+        let weak = p.settings.tracker.weak_reliability;
+        self.strips = p.tracks.as_ref().map(|t| Strips::new(t, &p.keys, weak));
+        // From the tracks, so a reopened project or an undone re-track shows its own spans.
+        self.spans = p.tracks.as_ref().map_or_else(Vec::new, |t| {
+            weak_spans(&t.frames, weak, &|i, j| p.keys.is_key(t.frames[i].index, j))
+        });
+        self.world = p
+            .skeleton
+            .as_ref()
+            .and_then(|s| WorldSkeleton::new(s, None).ok().map(|w| (w, Arc::clone(s))));
+    }
+
+    /// Per frame by play time: advances the current frame while playing (the caller repaints).
+    pub fn play(&mut self, dt_s: f64) {
+        if !self.playing {
+            return;
+        }
+        let fps = self.fps();
+        self.play_time += dt_s;
+        let steps = (self.play_time * fps).floor();
+        if steps >= 1.0 {
+            self.play_time -= steps / fps;
+            let next = self.current + steps as usize;
+            if next >= self.frame_count() {
+                self.playing = false;
+            }
+            self.go_to(next);
+        }
+    }
+
+    fn go_to(&mut self, index: usize) {
+        let n = self.frame_count();
+        if n == 0 {
+            return;
+        }
+        let index = index.min(n - 1);
+        if index != self.current {
+            self.current = index;
+            if let Some(l) = &self.loader {
+                l.request(index);
+            }
+        }
+    }
+}

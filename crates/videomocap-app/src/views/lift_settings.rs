@@ -1,0 +1,59 @@
+//! The Parameters panel's Lift section: the lift settings a project keeps (the same as the
+//! command line's `--lift-settings` file), the ones a user is likely to change.
+
+use videomocap_core::lift::LiftParams;
+
+/// "on" or "off", for the hover texts' defaults.
+fn on_off(b: bool) -> &'static str {
+    if b { "on" } else { "off" }
+}
+
+/// Edits `l` in place; the caller records the change (undo, autosave).
+pub fn lift_settings_ui(ui: &mut egui::Ui, l: &mut LiftParams) {
+    let d = LiftParams::default();
+    ui.checkbox(&mut l.refine, "global refinement").on_hover_text(format!(
+        "After the per-frame solve, one least-squares pass over the whole clip (reprojection, bone \
+         lengths, smooth motion); on the benchmark ten times slower and 0.2 to 2 mm more \
+         accurate; default {}",
+        on_off(d.refine)
+    ));
+    // The fixed smoothing replaces the adaptive one: greyed out while it is set.
+    let adaptive = egui::Checkbox::new(
+        &mut l.adaptive_smoothing,
+        "smooth each joint by its own noise",
+    );
+    ui.add_enabled(l.smoothing_s == 0.0, adaptive)
+        .on_hover_text(format!(
+            "Before the lift, each joint's track is smoothed by as much as its own jitter calls \
+             for (used when the fixed smoothing below is 0); default {}",
+            on_off(d.adaptive_smoothing)
+        ));
+    ui.add(egui::Slider::new(&mut l.smoothing_s, 0.0..=0.3).text("fixed smoothing (s)"))
+        .on_hover_text(format!(
+            "Above 0: every joint's track is smoothed by a Gaussian this many seconds wide \
+             instead; default {}",
+            d.smoothing_s
+        ));
+    ui.checkbox(&mut l.key_path_smoothing, "refit the trunk's path")
+        .on_hover_text(format!(
+            "The shoulders' and chest's 3D path is refitted over the whole clip (steadier depth \
+             and turn); default {}",
+            on_off(d.key_path_smoothing)
+        ));
+    let a = &mut l.ambiguity;
+    ui.add(egui::Slider::new(&mut a.arm_swing, 0.0..=3.0).text("arms swing against the legs"))
+        .on_hover_text(format!(
+            "When walking or running, how strongly each arm is taken to swing against its own leg \
+             when its depth is in doubt (0 = off); default {}",
+            d.ambiguity.arm_swing
+        ));
+    ui.add(egui::Slider::new(&mut a.contact, 0.0..=30.0).text("hands stay out of the body"))
+        .on_hover_text(format!(
+            "How strongly a hand is kept out of the trunk and the thighs when its depth is in \
+             doubt (0 = off); default {}",
+            d.ambiguity.contact
+        ));
+    if ui.button("Defaults").clicked() {
+        *l = d;
+    }
+}

@@ -1,0 +1,545 @@
+//! Beyond the paper: one nonlinear least-squares pass over all frames at once.
+//!
+//! Unknowns: every joint of every frame (camera space) and the 15 bone lengths plus the
+//! shoulder width. Residuals, each divided by its expected size:
+//! - reprojection of every joint onto its track, weighted by the track's confidence (an
+//!   interpolated point counts half), `σ = reprojection_sigma_px`;
+//! - every bone (and the shoulder line) at its length, `σ = length_sigma_m`;
+//! - the pelvis halfway between the hips (the model's definition), `σ = length_sigma_m`;
+//! - every joint's acceleration, `σ = a · Δt²` with `a` from the tracks' noise (adaptive, the
+//!   default) or `acceleration_sigma_mps2`;
+//! - each length near its starting value (`σ = length_prior` of it) and their sum at its
+//!   starting value (a monocular camera cannot see scale: the subject's height sets it);
+//! - every joint near where the per-frame solve put it, `σ = anchor_sigma_m` (a trust region:
+//!   one camera sees depth poorly, and without it a few 2D points the skeleton cannot reach
+//!   re-posed whole bodies to reach them).
+//!
+//! Solved by Levenberg–Marquardt; the normal equations are sparse (banded over frames plus
+//! the length columns) and factored with `nalgebra-sparse`'s Cholesky.
+
+use super::error::{LiftError, check_setting};
+use super::least_squares::{Residuals, Row, frame_interval_s, minimise};
+use crate::camera::PinholeCamera;
+use crate::formats::{PointSource, TrackedPoint};
+use crate::skeleton::{BONE_COUNT, Bone, JOINT_COUNT, Joint, PerJoint, SubjectModel};
+use nalgebra::{DVector, Point2, Point3, Vector3};
+use serde::{Deserialize, Serialize};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Weights of the refinement.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RefineParams {
+    /// Expected 2D error of a fully trusted track point, pixels (default 20: the tracker's
+    /// errors are drift and jumps of several to tens of pixels, and the per-frame solve already
+    /// lies on the smoothed tracks' rays, so the pass mostly smooths and evens the lengths).
+    /// Swept with `bench lift` before the calibration pose was chosen by `fit_score`
+    /// (per-frame → refined, mm; suite with true lengths (b) four draws of 2 px noise, (c) the
+    /// tracker's output; real sample (a) its reference 2D, (c) the tracker's output from the
+    /// height):
+    ///
+    /// | σ px | suite (b) | suite (c) | real (a) | real (c), height |
+    /// |---|---|---|---|---|
+    /// | per frame | 49.5 | 117.7 | 69.3 | 165.5 |
+    /// | 2 | 48.5 | 118.3 | 72.9 | 170.3 |
+    /// | 5 | 48.1 | 117.6 | 70.2 | 167.3 |
+    /// | 10 | 48.0 | 117.5 | 68.6 | 166.0 |
+    /// | 20 | 48.0 | 117.5 | 67.9 | 165.5 |
+    /// | 40 | 48.0 | 117.5 | 67.7 | 165.4 |
+    ///
+    /// Exact 2D stays at 20.3 mm throughout.
+    pub reprojection_sigma_px: f64,
+    /// Allowed deviation of a bone from its length, metres (default 0.005).
+    pub length_sigma_m: f64,
+    /// Typical joint acceleration when `adaptive` is off, m/s² (default 100: only jitter is
+    /// smoothed; at 20 the refinement bent fast motions such as jumping jacks out of shape on
+    /// the suite).
+    pub acceleration_sigma_mps2: f64,
+    /// Allowed relative change of each bone length from its start (default 0.01: one camera
+    /// cannot tell a longer bone from a bone turned towards it, and at 0.1 the refinement traded
+    /// lengths for depth and tilted whole poses on the suite).
+    pub length_prior: f64,
+    /// Levenberg–Marquardt iterations at most (default 20).
+    pub max_iterations: usize,
+    /// How far (metres, standard deviation per axis) a joint may move from the per-frame solve
+    /// (default 0.03; 0 turns the anchor off). Without it, on the synthetic suite with the
+    /// tracker's 2D and true lengths, a forearm the tracker made too long pulled whole trunks
+    /// 5 cm off (jumping jacks: shoulders 7 → 57 mm) and the refinement raised the error,
+    /// 111.2 → 117.0 mm; with it 111.2 → 110.8 mm, and exact tracks stay at 20.4 mm (21.6
+    /// without). 2 px noise: 63.5 → 62.2 mm (61.5 without).
+    pub anchor_sigma_m: f64,
+    /// Set the acceleration deviation from the tracks' own noise (default true): it is
+    /// `ACCELERATION_TIMES_NOISE` over the median white-noise deviation of the joints' tracks
+    /// (`super::smoothing::median_noise_px`), so noisy tracks are smoothed firmly and exact ones
+    /// barely. Off, `acceleration_sigma_mps2` is used as it is.
+    pub adaptive: bool,
+}
+
+impl Default for RefineParams {
+    fn default() -> Self {
+        RefineParams {
+            reprojection_sigma_px: 20.0,
+            length_sigma_m: 0.005,
+            acceleration_sigma_mps2: 100.0,
+            length_prior: 0.01,
+            max_iterations: 20,
+            anchor_sigma_m: 0.03,
+            adaptive: true,
+        }
+    }
+}
+
+impl RefineParams {
+    /// Checks every deviation is finite and above 0 (each divides its residual), the anchor's
+    /// at least 0 (0 turns it off).
+    pub fn validate(&self) -> Result<(), LiftError> {
+        // Destructured so that a new setting cannot be left unchecked.
+        let RefineParams {
+            reprojection_sigma_px,
+            length_sigma_m,
+            acceleration_sigma_mps2,
+            length_prior,
+            max_iterations: _,
+            anchor_sigma_m,
+            adaptive: _,
+        } = *self;
+        check_setting(
+            "refinement.reprojection_sigma_px",
+            reprojection_sigma_px,
+            true,
+        )?;
+        check_setting("refinement.length_sigma_m", length_sigma_m, true)?;
+        check_setting(
+            "refinement.acceleration_sigma_mps2",
+            acceleration_sigma_mps2,
+            true,
+        )?;
+        check_setting("refinement.length_prior", length_prior, true)?;
+        check_setting("refinement.anchor_sigma_m", anchor_sigma_m, false)
+    }
+}
+
+/// The adaptive refinement's acceleration deviation (m/s²) is this over the tracks' noise
+/// (pixels): jitter needs a firm hand, exact tracks almost none. On the synthetic suite with true
+/// lengths and before the anchor ([`RefineParams::anchor_sigma_m`]) it gave 63.5 → 61.5 mm
+/// MPJPE with 2 px noise and 20.4 → 21.6 mm with exact tracks
+/// (without the floor below, 30 gave 66.3 and 23.5 and 100 gave 63.1 and 20.9; the fixed
+/// 100 m/s² gives 64.2 and 24.4).
+pub const ACCELERATION_TIMES_NOISE: f64 = 60.0;
+
+/// The firmest acceleration deviation the adaptive refinement uses, m/s² (reached at 2 px of
+/// noise): at 20 m/s² it bent fast motions such as jumping jacks out of shape on the suite.
+pub const MIN_ACCELERATION_MPS2: f64 = 30.0;
+
+/// The least noise the adaptive refinement assumes, pixels (exact tracks read 0.1–1 px: fast
+/// motion is not quite smooth at the frame rate).
+pub const MIN_NOISE_PX: f64 = 0.1;
+
+/// What the refinement did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RefineSummary {
+    /// Iterations run.
+    pub iterations: usize,
+    /// Weighted cost before.
+    pub cost_before: f64,
+    /// Weighted cost at the least-squares minimum (before the bones are snapped to their
+    /// lengths).
+    pub cost_after: f64,
+    /// RMS reprojection error before, pixels.
+    pub reprojection_px_before: f64,
+    /// RMS reprojection error of the returned (snapped) points, pixels.
+    pub reprojection_px_after: f64,
+}
+
+/// The refined sequence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Refined {
+    /// Joints per frame.
+    pub points: Vec<PerJoint<Point3<f64>>>,
+    /// Bone lengths (indexed like [`Bone::ALL`]), metres.
+    pub bone_lengths: [f64; BONE_COUNT],
+    /// Shoulder width, metres.
+    pub shoulder_width: f64,
+    /// Summary.
+    pub summary: RefineSummary,
+}
+
+/// The weight of a track point in the reprojection term: its confidence (at least 0.05), halved
+/// when it was interpolated or completed from the gait (not seen there).
+pub fn track_weight(p: &TrackedPoint) -> f64 {
+    let c = f64::from(p.confidence).clamp(0.05, 1.0);
+    if matches!(p.source, PointSource::Interpolated | PointSource::Gait) {
+        0.5 * c
+    } else {
+        c
+    }
+}
+
+/// Lengths held: the 15 bones then the shoulder width.
+const LENGTHS: usize = BONE_COUNT + 1;
+// The scale row has one entry per length.
+const _: () = assert!(LENGTHS <= super::least_squares::MAX_ENTRIES);
+const PER_FRAME: usize = 3 * JOINT_COUNT;
+
+/// The pairs of joints held at a length, in [`Bone::ALL`] order then the shoulders.
+fn length_pairs() -> [(Joint, Joint); LENGTHS] {
+    let mut pairs = [(Joint::LeftShoulder, Joint::RightShoulder); LENGTHS];
+    for (k, b) in Bone::ALL.iter().enumerate() {
+        pairs[k] = (b.parent, b.child);
+    }
+    pairs
+}
+
+/// The problem's data.
+struct Problem<'a> {
+    cam: &'a PinholeCamera,
+    images: &'a [PerJoint<Point2<f64>>],
+    weights: &'a [PerJoint<f64>],
+    /// The per-frame solve, where the anchor rows hold the joints.
+    start: &'a [PerJoint<Point3<f64>>],
+    start_lengths: [f64; LENGTHS],
+    params: RefineParams,
+    /// Acceleration deviation, metres per frame² ([`acceleration_sigma_m`]).
+    accel_sigma_m: f64,
+}
+
+/// The subject's lengths in refinement order: the 15 bones, then the shoulder width.
+fn subject_lengths(subject: &SubjectModel) -> [f64; LENGTHS] {
+    let mut lengths = [subject.shoulder_width_m; LENGTHS];
+    lengths[..BONE_COUNT].copy_from_slice(&subject.bone_length_m);
+    lengths
+}
+
+impl Problem<'_> {
+    /// The unknowns as one vector: every frame's joints, then the lengths.
+    fn pack(points: &[PerJoint<Point3<f64>>], lengths: &[f64; LENGTHS]) -> DVector<f64> {
+        let n = points.len();
+        let mut x = DVector::zeros(n * PER_FRAME + LENGTHS);
+        for (t, frame) in points.iter().enumerate() {
+            for j in Joint::ALL {
+                let c = Self::col(t, j);
+                x[c] = frame[j].x;
+                x[c + 1] = frame[j].y;
+                x[c + 2] = frame[j].z;
+            }
+        }
+        for (k, l) in lengths.iter().enumerate() {
+            x[n * PER_FRAME + k] = *l;
+        }
+        x
+    }
+
+    fn col(t: usize, j: Joint) -> usize {
+        t * PER_FRAME + 3 * j.index()
+    }
+
+    fn point(x: &DVector<f64>, t: usize, j: Joint) -> Point3<f64> {
+        let c = Self::col(t, j);
+        Point3::new(x[c], x[c + 1], x[c + 2])
+    }
+
+    fn reprojection_rms(&self, x: &DVector<f64>) -> f64 {
+        let mut sum = 0.0;
+        let mut count = 0.0f64;
+        for (t, image) in self.images.iter().enumerate() {
+            for j in Joint::ALL {
+                if let Some(p) = self.cam.project(&Self::point(x, t, j)) {
+                    sum += (p - image[j]).norm_squared();
+                    count += 1.0;
+                }
+            }
+        }
+        (sum / count.max(1.0)).sqrt()
+    }
+}
+
+impl Residuals for Problem<'_> {
+    fn rows(&self, x: &DVector<f64>, emit: &mut dyn FnMut(Row)) {
+        let n = self.images.len();
+        let lcol = n * PER_FRAME;
+        let p = &self.params;
+        let f = self.cam.focal_px;
+        let pairs = length_pairs();
+        for t in 0..n {
+            for j in Joint::ALL {
+                let c = Self::col(t, j);
+                let q = Self::point(x, t, j);
+                let z = q.z.max(1e-3);
+                let s = self.weights[t][j].sqrt() / p.reprojection_sigma_px;
+                let u = f * q.x / z + self.cam.cx - self.images[t][j].x;
+                let v = f * q.y / z + self.cam.cy - self.images[t][j].y;
+                emit(
+                    Row::new(s * u)
+                        .with(c, s * f / z)
+                        .with(c + 2, -s * f * q.x / (z * z)),
+                );
+                emit(
+                    Row::new(s * v)
+                        .with(c + 1, s * f / z)
+                        .with(c + 2, -s * f * q.y / (z * z)),
+                );
+            }
+            if p.anchor_sigma_m > 0.0 {
+                let s = 1.0 / p.anchor_sigma_m;
+                for j in Joint::ALL {
+                    let c = Self::col(t, j);
+                    let q = Self::point(x, t, j) - self.start[t][j];
+                    for axis in 0..3 {
+                        emit(Row::new(s * q[axis]).with(c + axis, s));
+                    }
+                }
+            }
+            let s = 1.0 / p.length_sigma_m;
+            for (k, &(a, b)) in pairs.iter().enumerate() {
+                let d = Self::point(x, t, b) - Self::point(x, t, a);
+                let len = d.norm().max(1e-9);
+                let u = d / len;
+                let (ca, cb) = (Self::col(t, a), Self::col(t, b));
+                emit(
+                    Row::new(s * (len - x[lcol + k]))
+                        .with(cb, s * u.x)
+                        .with(cb + 1, s * u.y)
+                        .with(cb + 2, s * u.z)
+                        .with(ca, -s * u.x)
+                        .with(ca + 1, -s * u.y)
+                        .with(ca + 2, -s * u.z)
+                        .with(lcol + k, -s),
+                );
+            }
+            let (cl, cr, cp) = (
+                Self::col(t, Joint::LeftHip),
+                Self::col(t, Joint::RightHip),
+                Self::col(t, Joint::Pelvis),
+            );
+            for axis in 0..3 {
+                emit(
+                    Row::new(s * (x[cl + axis] + x[cr + axis] - 2.0 * x[cp + axis]))
+                        .with(cl + axis, s)
+                        .with(cr + axis, s)
+                        .with(cp + axis, -2.0 * s),
+                );
+            }
+            if t >= 1 && t + 1 < n {
+                let s = 1.0 / self.accel_sigma_m;
+                for j in Joint::ALL {
+                    for axis in 0..3 {
+                        let (a, b, c) = (
+                            Self::col(t - 1, j) + axis,
+                            Self::col(t, j) + axis,
+                            Self::col(t + 1, j) + axis,
+                        );
+                        emit(
+                            Row::new(s * (x[a] - 2.0 * x[b] + x[c]))
+                                .with(a, s)
+                                .with(b, -2.0 * s)
+                                .with(c, s),
+                        );
+                    }
+                }
+            }
+        }
+        let mut sum = 0.0;
+        let mut start_sum = 0.0;
+        for k in 0..LENGTHS {
+            let l0 = self.start_lengths[k];
+            let s = 1.0 / (p.length_prior * l0);
+            emit(Row::new(s * (x[lcol + k] - l0)).with(lcol + k, s));
+            sum += x[lcol + k];
+            start_sum += l0;
+        }
+        // Scale: the sum of the lengths stays at its start, within 0.1 %.
+        let s = 1.0 / (0.001 * start_sum);
+        let mut row = Row::new(s * (sum - start_sum));
+        for k in 0..LENGTHS {
+            row = row.with(lcol + k, s);
+        }
+        emit(row);
+    }
+}
+
+/// The pose with every bone at exactly its length: from the pelvis outwards ([`Bone::ALL`] lists
+/// parents first), each child is put at its bone's length from its (already placed) parent along
+/// the direction the refinement gave the bone. The least-squares pass holds lengths only within
+/// `length_sigma_m`, and a BVH's offsets are fixed: without this the exported file would not
+/// give the skeleton back exactly (0.75 mm off on the bundled synthetic clip). A bone the
+/// refinement shrank to nothing takes its direction from `fallback` (the per-frame solve), or
+/// straight down (+Y) when that one is nothing too.
+pub fn snap_to_lengths(
+    free: &PerJoint<Point3<f64>>,
+    fallback: &PerJoint<Point3<f64>>,
+    lengths: &[f64; BONE_COUNT],
+) -> PerJoint<Point3<f64>> {
+    let mut snapped = *free;
+    for (bone, &len) in Bone::ALL.iter().zip(lengths) {
+        let dir = (free[bone.child] - free[bone.parent])
+            .try_normalize(1e-9)
+            .or_else(|| (fallback[bone.child] - fallback[bone.parent]).try_normalize(1e-12))
+            .unwrap_or_else(Vector3::y);
+        snapped[bone.child] = snapped[bone.parent] + len * dir;
+    }
+    snapped
+}
+
+/// The acceleration deviation in metres per frame²: from the tracks' noise when
+/// `params.adaptive`, else `params.acceleration_sigma_mps2`.
+fn acceleration_sigma_m(track_noise_px: f64, params: &RefineParams, dt: f64) -> f64 {
+    let accel = if params.adaptive {
+        (ACCELERATION_TIMES_NOISE / track_noise_px.max(MIN_NOISE_PX)).max(MIN_ACCELERATION_MPS2)
+    } else {
+        params.acceleration_sigma_mps2
+    };
+    accel * dt * dt
+}
+
+/// Refines a sequence; `start` is the per-frame solve, `fps` sets Δt, and `track_noise_px` is
+/// the tracks' white noise ([`super::smoothing::median_noise_px`]) for the adaptive
+/// acceleration term.
+#[allow(clippy::too_many_arguments)]
+pub fn refine(
+    cam: &PinholeCamera,
+    images: &[PerJoint<Point2<f64>>],
+    weights: &[PerJoint<f64>],
+    start: &[PerJoint<Point3<f64>>],
+    subject: &SubjectModel,
+    fps: f64,
+    track_noise_px: f64,
+    params: &RefineParams,
+    progress: &mut dyn FnMut(usize, usize),
+    cancel: &AtomicBool,
+) -> Result<Refined, LiftError> {
+    let n = start.len();
+    let start_lengths = subject_lengths(subject);
+    let dt = frame_interval_s(fps);
+    let problem = Problem {
+        cam,
+        images,
+        weights,
+        start,
+        start_lengths,
+        params: *params,
+        accel_sigma_m: acceleration_sigma_m(track_noise_px, params, dt),
+    };
+    let x = Problem::pack(start, &start_lengths);
+    let reprojection_px_before = problem.reprojection_rms(&x);
+    let minimum = minimise(&problem, x, params.max_iterations, &mut |i| {
+        progress(i, params.max_iterations);
+        !cancel.load(Ordering::Relaxed)
+    })
+    .ok_or(LiftError::Cancelled)?;
+    let x = minimum.x;
+    progress(params.max_iterations, params.max_iterations);
+    let mut lengths = [0.0; LENGTHS];
+    lengths.copy_from_slice(&x.as_slice()[n * PER_FRAME..]);
+    let mut bone_lengths = [0.0; BONE_COUNT];
+    bone_lengths.copy_from_slice(&lengths[..BONE_COUNT]);
+    let points: Vec<PerJoint<Point3<f64>>> = (0..n)
+        .map(|t| {
+            let free = PerJoint::from_fn(|j| Problem::point(&x, t, j));
+            snap_to_lengths(&free, &start[t], &bone_lengths)
+        })
+        .collect();
+    // The reprojection reported is that of the snapped points, which are what is returned.
+    let reprojection_px_after = problem.reprojection_rms(&Problem::pack(&points, &lengths));
+    Ok(Refined {
+        points,
+        bone_lengths,
+        shoulder_width: lengths[BONE_COUNT],
+        summary: RefineSummary {
+            iterations: minimum.iterations,
+            cost_before: minimum.cost_before,
+            cost_after: minimum.cost_after,
+            reprojection_px_before,
+            reprojection_px_after,
+        },
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::least_squares::assert_rows_match_finite_differences;
+    use super::*;
+
+    #[test]
+    fn the_adaptive_acceleration_term_is_firmer_for_noisier_tracks() {
+        let params = RefineParams::default();
+        let dt = 1.0 / 30.0;
+        let exact = acceleration_sigma_m(0.0, &params, dt);
+        let half = acceleration_sigma_m(0.5, &params, dt);
+        let noisy = acceleration_sigma_m(2.0, &params, dt);
+        let very = acceleration_sigma_m(8.0, &params, dt);
+        assert!(exact > half && half > noisy, "{exact} {half} {noisy}");
+        assert!((exact - 600.0 * dt * dt).abs() < 1e-9, "{exact}");
+        assert!(
+            (very - MIN_ACCELERATION_MPS2 * dt * dt).abs() < 1e-12,
+            "{very}"
+        );
+        let fixed = RefineParams {
+            adaptive: false,
+            ..params
+        };
+        assert_eq!(acceleration_sigma_m(2.0, &fixed, dt), 100.0 * dt * dt);
+    }
+
+    #[test]
+    fn snapping_puts_every_bone_at_its_length_along_its_direction() {
+        let free: PerJoint<Point3<f64>> = PerJoint::from_fn(|j| {
+            let i = j.index() as f64;
+            Point3::new(0.07 * i - 0.5, 0.11 * i - 0.9, 3.0 + 0.03 * (i * i).sin())
+        });
+        let mut fallback = free;
+        fallback[Joint::LeftWrist] = free[Joint::LeftElbow] + Vector3::new(0.0, 0.0, 0.3);
+        let mut free = free;
+        // A forearm shrunk to nothing takes the per-frame solve's direction.
+        free[Joint::LeftWrist] = free[Joint::LeftElbow];
+        let lengths: [f64; BONE_COUNT] = std::array::from_fn(|k| 0.2 + 0.01 * k as f64);
+        let snapped = snap_to_lengths(&free, &fallback, &lengths);
+        assert_eq!(snapped[Joint::Pelvis], free[Joint::Pelvis]);
+        for (b, &len) in Bone::ALL.iter().zip(&lengths) {
+            let d = snapped[b.child] - snapped[b.parent];
+            assert!((d.norm() - len).abs() < 1e-12, "{}", b.key());
+            let want = if b.child == Joint::LeftWrist {
+                Vector3::z()
+            } else {
+                (free[b.child] - free[b.parent]).normalize()
+            };
+            assert!((d.normalize() - want).norm() < 1e-12, "{}", b.key());
+        }
+    }
+
+    /// Central finite differences of every residual against the analytic rows.
+    #[test]
+    fn analytic_rows_match_finite_differences() {
+        let cam = PinholeCamera::centred(800.0, 640, 480);
+        let subject = SubjectModel::default();
+        let n = 4;
+        let start: Vec<PerJoint<Point3<f64>>> = (0..n)
+            .map(|t| {
+                PerJoint::from_fn(|j| {
+                    let i = j.index() as f64;
+                    Point3::new(
+                        0.05 * i - 0.3 + 0.01 * t as f64,
+                        0.1 * i - 0.8,
+                        3.0 + 0.02 * i,
+                    )
+                })
+            })
+            .collect();
+        let images: Vec<PerJoint<Point2<f64>>> = start
+            .iter()
+            .map(|f| f.map(|_, p| cam.project(p).unwrap() + nalgebra::Vector2::new(1.5, -0.5)))
+            .collect();
+        let weights = vec![PerJoint::from_fn(|j| 0.3 + 0.04 * j.index() as f64); n];
+        let start_lengths = subject_lengths(&subject);
+        let problem = Problem {
+            cam: &cam,
+            images: &images,
+            weights: &weights,
+            start: &start,
+            start_lengths,
+            params: RefineParams::default(),
+            accel_sigma_m: 20.0 / 900.0,
+        };
+        let x = Problem::pack(&start, &start_lengths.map(|l| l * 1.05));
+        assert_rows_match_finite_differences(&problem, &x);
+    }
+}

@@ -1,0 +1,38 @@
+//! 2D tracking (VBA, Pan et al. "Feature tracking"): from the marks of one frame to the
+//! positions of all 16 joints in every frame, with a reliability per joint and frame.
+//!
+//! In: a [`crate::video::Video`] and [`crate::formats::Marks`] (plus any corrections as
+//! [`KeyFrames`]). Out: [`crate::formats::Tracks2d`] and a list of weak spans.
+//!
+//! - `block`: the morph-block `A = {(x, y), m, n, θ}` (Fig. 7)
+//! - `similarity`: the sub-pixel morph-block similarity (eqs. 3–5), the hot loop
+//! - `background`: a static camera's background, foreground evidence for the arms
+//! - `head`: image-difference head prediction (eqs. 1–5)
+//! - `search`: the spiral search path (Fig. 6) and the anchored angular search
+//! - `body`: the top-down tracker (head → trunk → limbs)
+//! - `occlusion`: interpolation over weak runs, the weak-span report
+//! - `smooth`: the finished tracks smoothed over time, weighted by reliability
+//! - `run`: tracking a video from its key frames, the order of the steps, re-tracking
+//! - `pass`: one pass over consecutive frames, forwards or backwards, re-started at key frames
+//! - `fuse`: the forward and backward passes made one, per joint between its key frames
+
+mod background;
+mod block;
+mod body;
+mod fuse;
+mod head;
+mod occlusion;
+mod params;
+mod pass;
+mod run;
+mod search;
+mod similarity;
+pub(crate) mod smooth;
+
+pub use occlusion::{SpanKind, WeakSpan, weak_spans};
+pub use params::TrackerParams;
+pub use run::{KeyFrames, TrackError, TrackJob, TrackOutput, TrackProgress, track_video};
+// Inner facts the app and the scoring need, exported by name.
+pub use background::KnownBackground;
+pub use body::stature_px;
+pub use similarity::FloatFrame;

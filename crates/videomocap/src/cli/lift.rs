@@ -1,0 +1,202 @@
+//! `videomocap lift`: from tracks2d.json to skeleton3d.json (the lift step of `run` too).
+
+use super::args::{GlobalArgs, LiftArgs, LiftOptions};
+use super::{ExitError, progress_bar, say};
+use anyhow::anyhow;
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+use videomocap_core::camera::PinholeCamera;
+use videomocap_core::formats::{KnownLengths, Tracks2d};
+use videomocap_core::lift::fit_in_perspective;
+use videomocap_core::lift::{DEFAULT_FOV_LONG_SIDE_DEG, default_focal, estimate_focal};
+use videomocap_core::lift::{FrameFlag, LiftError, LiftJob, LiftOutput, LiftParams, lift};
+use videomocap_core::skeleton::{DEFAULT_HEIGHT_M, Proportions, SubjectModel};
+
+/// Checks the camera and subject options before any work, and reads the lift settings (the
+/// defaults without `--lift-settings`) and the known lengths (none without `--lengths`) they
+/// name.
+pub fn check_options(o: &LiftOptions) -> Result<(LiftParams, KnownLengths), ExitError> {
+    if let Some(f) = o.focal_px
+        && !(f.is_finite() && f > 0.0)
+    {
+        return Err(ExitError::bad_input(anyhow!(
+            "--focal-px must be positive, got {f}"
+        )));
+    }
+    if let Some(d) = o.fov_deg
+        && !(d.is_finite() && d > 0.0 && d < 180.0)
+    {
+        return Err(ExitError::bad_input(anyhow!(
+            "--fov-deg must be between 0 and 180, got {d}"
+        )));
+    }
+    if let Some(h) = o.height_m
+        && !(h.is_finite() && h > 0.3 && h < 3.0)
+    {
+        return Err(ExitError::bad_input(anyhow!(
+            "--height-m must be a person's height in metres (0.3 to 3), got {h}"
+        )));
+    }
+    let params = match &o.lift_settings {
+        Some(p) => load_settings(p)?,
+        None => LiftParams::default(),
+    };
+    let known = match &o.lengths {
+        Some(p) => KnownLengths::load(p).map_err(ExitError::bad_input)?,
+        None => KnownLengths::default(),
+    };
+    Ok((params, known))
+}
+
+/// Reads lift settings from a JSON file.
+pub fn load_settings(path: &Path) -> Result<LiftParams, ExitError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| ExitError::bad_input(anyhow!("{}: cannot read: {e}", path.display())))?;
+    let params: LiftParams = serde_json::from_str(&text)
+        .map_err(|e| ExitError::bad_input(anyhow!("{}: bad lift settings: {e}", path.display())))?;
+    params
+        .validate()
+        .map_err(|e| ExitError::bad_input(anyhow!("{}: {e}", path.display())))?;
+    Ok(params)
+}
+
+/// A lift error naming the input it came from.
+fn lift_error(source: &Path, e: LiftError) -> ExitError {
+    let named = anyhow!("{}: {e}", source.display());
+    match e {
+        LiftError::Cancelled | LiftError::CalibrationFailed { .. } => ExitError::failed(named),
+        _ => ExitError::bad_input(named),
+    }
+}
+
+/// Lifts tracks with the options' camera and subject and the lift settings `params` (from
+/// [`check_options`]), with progress; shared by `lift` and `run`. `source` names the tracks (or
+/// the video they came from) in errors.
+pub fn lift_with_progress(
+    tracks: &Tracks2d,
+    source: &Path,
+    o: &LiftOptions,
+    params: LiftParams,
+    known: &KnownLengths,
+    global: &GlobalArgs,
+) -> Result<LiftOutput, ExitError> {
+    let table = SubjectModel::from_height(
+        o.height_m.unwrap_or(DEFAULT_HEIGHT_M),
+        Proportions::default(),
+    )
+    .map_err(ExitError::bad_input)?;
+    let (w, h) = (tracks.source.width, tracks.source.height);
+    let mut camera = PinholeCamera::centred(1.0, w, h);
+    if let Some(f) = o.focal_px {
+        camera.focal_px = f;
+    } else if let Some(fov) = o.fov_deg {
+        camera.focal_px = PinholeCamera::focal_from_horizontal_fov(fov, w);
+    } else if o.estimate_focal {
+        say(global, "estimating the focal length …");
+        // On the table's lengths: see `estimate_focal`.
+        let table_job = LiftJob {
+            tracks,
+            camera,
+            subject: table.clone(),
+            params,
+            overrides: Default::default(),
+        };
+        let est = estimate_focal(&table_job).map_err(|e| lift_error(source, e))?;
+        camera.focal_px = est.focal_px;
+        let fov = 2.0 * (f64::from(w) / 2.0 / est.focal_px).atan().to_degrees();
+        say(
+            global,
+            &format!(
+                "estimated focal length {:.0} px (horizontal field of view {fov:.0}°)",
+                est.focal_px
+            ),
+        );
+    } else {
+        camera.focal_px = default_focal(w, h);
+        say(
+            global,
+            &format!(
+                "focal length {:.0} px: the default {DEFAULT_FOV_LONG_SIDE_DEG:.0}° across the longer image side (give --focal-px or --fov-deg if you know the camera)",
+                camera.focal_px
+            ),
+        );
+    }
+    let (subject, fit) = fit_in_perspective(&table, tracks, camera, &params, known)
+        .map_err(|e| lift_error(source, e))?;
+    say(global, &fit.to_string());
+    let job = LiftJob {
+        tracks,
+        camera,
+        subject,
+        params,
+        overrides: Default::default(),
+    };
+    let bar = progress_bar(global, 1, "lifting");
+    let cancel = AtomicBool::new(false);
+    let out = lift(
+        &job,
+        &mut |p| {
+            bar.set_message(p.stage);
+            bar.set_length(p.total as u64);
+            bar.set_position(p.done as u64);
+        },
+        &cancel,
+    )
+    .map_err(|e| lift_error(source, e))?;
+    bar.finish_and_clear();
+    Ok(out)
+}
+
+/// Prints what the lift found.
+pub fn report(out: &LiftOutput, global: &GlobalArgs) {
+    let n = out.reports.len();
+    let count = |pred: &dyn Fn(&FrameFlag) -> bool| {
+        out.reports
+            .iter()
+            .filter(|r| r.flags.iter().any(pred))
+            .count()
+    };
+    say(
+        global,
+        &format!(
+            "lifted {n} frames with focal length {:.0} px; camera calibrated on frame {}",
+            out.skeleton.camera.focal_px, out.reports[out.calibration_frame].index
+        ),
+    );
+    say(
+        global,
+        &format!(
+            "frames with a bone too long for its 2D image: {}; with no key-triangle pose that fits: {}",
+            count(&|f| matches!(f, FrameFlag::TooLong(_))),
+            count(&|f| matches!(f, FrameFlag::KeyTriangleNotConverged)),
+        ),
+    );
+    if let Some(r) = &out.refinement {
+        say(
+            global,
+            &format!(
+                "global refinement: {} iterations, reprojection RMS {:.2} → {:.2} px",
+                r.iterations, r.reprojection_px_before, r.reprojection_px_after
+            ),
+        );
+    }
+}
+
+/// `lift`.
+pub fn run(a: &LiftArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+    let (params, known) = check_options(&a.options)?;
+    let tracks = Tracks2d::load(&a.tracks).map_err(ExitError::bad_input)?;
+    let out = lift_with_progress(&tracks, &a.tracks, &a.options, params, &known, global)?;
+    out.skeleton.save(&a.output).map_err(ExitError::failed)?;
+    report(&out, global);
+    say(global, &format!("wrote {}", a.output.display()));
+    if let Some(bvh) = &a.bvh {
+        let outputs = super::export::Outputs3d {
+            bvh: Some(bvh.clone()),
+            ..Default::default()
+        };
+        let written = super::export::write_3d(&out.skeleton, &a.output, None, &outputs)?;
+        super::export::report_3d(&written, global);
+    }
+    Ok(())
+}

@@ -1,0 +1,232 @@
+//! What every accuracy benchmark shares: the clips (suite v3, rendered once, and the two real
+//! clips) and tables that put `dev` and `test` side by side, per clip family and overall.
+
+use crate::args::GlobalArgs;
+use crate::{ExitError, say};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use videomocap_testkit::eval::suite::{Family, REAL_CLIPS, Split, Suite};
+use videomocap_testkit::repo_root;
+
+/// One clip a benchmark scores.
+#[derive(Debug, Clone)]
+pub struct BenchClip {
+    /// Its name.
+    pub name: String,
+    /// Its family ([`Family::Real`] for the real clips).
+    pub family: Family,
+    /// Its split (the real clips are development material).
+    pub split: Split,
+    /// Its folder (video.mp4, gt.json, marks.json).
+    pub dir: PathBuf,
+}
+
+/// `--split`: all (`None`), dev or test.
+pub fn parse_split(split: &str) -> Result<Option<Split>, ExitError> {
+    match split {
+        "all" => Ok(None),
+        "dev" => Ok(Some(Split::Dev)),
+        "test" => Ok(Some(Split::Test)),
+        other => Err(ExitError::bad_input(anyhow::anyhow!(
+            "--split {other}: expected all, dev or test"
+        ))),
+    }
+}
+
+/// The suite's clips, rendered into `suite_dir` when missing, then the real clips.
+pub fn bench_clips(
+    suite_dir: &Path,
+    split: &str,
+    clip: Option<&str>,
+    global: &GlobalArgs,
+) -> Result<Vec<BenchClip>, ExitError> {
+    let wanted = parse_split(split)?;
+    let suite = Suite::load(&repo_root()).map_err(ExitError::failed)?;
+    let dirs = suite
+        .ensure_rendered(suite_dir, &mut |name| {
+            say(global, &format!("rendering suite clip {name} …"))
+        })
+        .map_err(ExitError::failed)?;
+    let mut out: Vec<BenchClip> = suite
+        .clips
+        .iter()
+        .zip(dirs)
+        .map(|(c, dir)| BenchClip {
+            name: c.name.clone(),
+            family: c.family,
+            split: c.split,
+            dir,
+        })
+        .collect();
+    out.extend(REAL_CLIPS.iter().map(|(name, dir)| BenchClip {
+        name: (*name).to_owned(),
+        family: Family::Real,
+        split: Split::Dev,
+        dir: repo_root().join(dir),
+    }));
+    out.retain(|c| wanted.is_none_or(|w| c.split == w) && clip.is_none_or(|n| c.name.contains(n)));
+    Ok(out)
+}
+
+/// Scores that add up over clips.
+pub trait Merge: Default + Clone {
+    /// Adds another's samples.
+    fn merge_from(&mut self, other: &Self);
+}
+
+impl Merge for videomocap_testkit::eval::Accuracy {
+    fn merge_from(&mut self, other: &Self) {
+        self.merge(other);
+    }
+}
+
+impl Merge for videomocap_testkit::eval::pose3d::Pose3dScore {
+    fn merge_from(&mut self, other: &Self) {
+        self.merge(other);
+    }
+}
+
+impl Merge for videomocap_testkit::eval::volume::VolumeScore {
+    fn merge_from(&mut self, other: &Self) {
+        self.merge(other);
+    }
+}
+
+impl<A: Merge, B: Merge> Merge for (A, B) {
+    fn merge_from(&mut self, other: &Self) {
+        self.0.merge_from(&other.0);
+        self.1.merge_from(&other.1);
+    }
+}
+
+impl<T: Merge, const N: usize> Merge for [T; N]
+where
+    [T; N]: Default,
+{
+    fn merge_from(&mut self, other: &Self) {
+        for (a, b) in self.iter_mut().zip(other) {
+            a.merge_from(b);
+        }
+    }
+}
+
+/// A score per (split, family) and per split over all synthetic clips.
+#[derive(Debug, Clone, Default)]
+pub struct Tally<T> {
+    cells: BTreeMap<(Split, Option<Family>), T>,
+}
+
+impl<T: Merge> Tally<T> {
+    /// Adds a clip's score to its family and, for synthetic clips, to its split's overall.
+    pub fn add(&mut self, clip: &BenchClip, score: &T) {
+        self.cells
+            .entry((clip.split, Some(clip.family)))
+            .or_default()
+            .merge_from(score);
+        if clip.family != Family::Real {
+            self.cells
+                .entry((clip.split, None))
+                .or_default()
+                .merge_from(score);
+        }
+    }
+
+    /// The score of a split's family (`None`: all its synthetic clips).
+    pub fn get(&self, split: Split, family: Option<Family>) -> Option<&T> {
+        self.cells.get(&(split, family))
+    }
+
+    /// One line per family that has clips and one overall, `dev` and `test` side by side: `cell`
+    /// formats a score into a fixed-width column (`width` characters, blank where a split has no
+    /// clip of the family).
+    pub fn lines(&self, width: usize, cell: impl Fn(&T) -> String) -> Vec<String> {
+        let rows = Family::ALL
+            .iter()
+            .map(|f| (f.name(), Some(*f)))
+            .chain(std::iter::once(("synthetic overall", None)));
+        rows.filter(|(_, family)| {
+            [Split::Dev, Split::Test]
+                .iter()
+                .any(|s| self.get(*s, *family).is_some())
+        })
+        .map(|(name, family)| {
+            let col = |split| {
+                self.get(split, family)
+                    .map_or_else(|| format!("{:width$}", ""), &cell)
+            };
+            format!("{name:<18} | {} | {}", col(Split::Dev), col(Split::Test))
+        })
+        .collect()
+    }
+
+    /// The table's heading: the split names over columns of `width` characters, then the
+    /// columns' own heading.
+    pub fn heading(width: usize, columns: &str) -> Vec<String> {
+        vec![
+            format!("{:<18} | {:<width$} | {:<width$}", "", "dev", "test"),
+            format!("{:<18} | {columns:<width$} | {columns:<width$}", "family"),
+        ]
+    }
+
+    /// Every cell as JSON: `{"dev": {"walk/run": …, "overall": …}, "test": …}`.
+    pub fn json(&self, value: impl Fn(&T) -> serde_json::Value) -> serde_json::Value {
+        let mut out = serde_json::Map::new();
+        for split in [Split::Dev, Split::Test] {
+            let mut m = serde_json::Map::new();
+            for ((s, family), v) in &self.cells {
+                if *s == split {
+                    m.insert(
+                        family.map_or("synthetic overall", Family::name).to_owned(),
+                        value(v),
+                    );
+                }
+            }
+            out.insert(split.name().to_owned(), serde_json::Value::Object(m));
+        }
+        serde_json::Value::Object(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use videomocap_testkit::eval::Accuracy;
+
+    fn clip(family: Family, split: Split) -> BenchClip {
+        BenchClip {
+            name: format!("{family:?}"),
+            family,
+            split,
+            dir: PathBuf::new(),
+        }
+    }
+
+    fn accuracy(error_px: f64, samples: usize) -> Accuracy {
+        let mut a = Accuracy::default();
+        for _ in 0..samples {
+            a.add(error_px, 100.0);
+        }
+        a
+    }
+
+    #[test]
+    fn the_tally_keeps_splits_apart_and_the_real_clips_out_of_the_synthetic_overall() {
+        let mut t: Tally<Accuracy> = Tally::default();
+        t.add(&clip(Family::WalkRun, Split::Dev), &accuracy(10.0, 4));
+        t.add(&clip(Family::Dance, Split::Test), &accuracy(50.0, 4));
+        t.add(&clip(Family::Real, Split::Dev), &accuracy(90.0, 4));
+        let dev = t.get(Split::Dev, None).unwrap();
+        assert_eq!(dev.count, 4);
+        assert!((dev.mean_px() - 10.0).abs() < 1e-9);
+        assert!((t.get(Split::Test, None).unwrap().mean_px() - 50.0).abs() < 1e-9);
+        assert!(t.get(Split::Test, Some(Family::WalkRun)).is_none());
+        let lines = t.lines(8, |a| format!("{:>8.1}", a.mean_px()));
+        // walk/run, dance, real and the overall; no line for the families without clips.
+        assert_eq!(lines.len(), 4, "{lines:#?}");
+        assert!(lines[0].starts_with("walk/run") && lines[0].contains("10.0"));
+        assert!(lines[3].starts_with("synthetic overall"));
+        let json = t.json(|a| serde_json::json!(a.mean_px()));
+        assert_eq!(json["test"]["dance"], serde_json::json!(50.0));
+        assert_eq!(json["dev"]["real"], serde_json::json!(90.0));
+    }
+}

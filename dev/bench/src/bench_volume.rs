@@ -1,0 +1,451 @@
+//! `videomocap bench volume`: the second pipeline on synthetic volume sequences (the paper's
+//! marching, waving and jumping jacks, plus real motion capture) at several voxel sizes —
+//! topology, joint error against the truth, label consistency — the same motions carved from
+//! 4 and 8 synthetic silhouettes (and, per split, the suite's takes from clean and faulty ones),
+//! and the time per frame at
+//! N = 3k, 10k and 30k points on one core with Isomap's share.
+
+use crate::args::{BenchArgs, GlobalArgs};
+use crate::bench_suite::{BenchClip, Tally, parse_split};
+use crate::{ExitError, say};
+use rayon::prelude::*;
+use std::time::Instant;
+use videomocap_core::skeleton::SubjectModel;
+use videomocap_testkit::eval::suite::{Split, Suite};
+use videomocap_testkit::eval::volume::{CarveCase, VolumeScore, carve_and_score, score_volume};
+use videomocap_testkit::repo_root;
+use videomocap_testkit::synth::{
+    Motion, ProceduralMotion, SilhouetteFaults, SynthParams, VoxelParams, from_bvh, load_motion,
+    procedural, stature_of, subject_stature, volume_truth, voxelise,
+};
+use videomocap_volume::{VolumeParams, assemble, five_limb_frames, process_frame};
+
+/// Frames per sequence (the paper's sequences had about 50).
+const FRAMES: usize = 50;
+/// Frame rate of the sequences (the paper captured at about 10 Hz).
+const FPS: f64 = 15.0;
+
+fn motions() -> Result<Vec<(String, Motion, bool)>, ExitError> {
+    let subject = SubjectModel::default();
+    let mut out = Vec::new();
+    for kind in [
+        ProceduralMotion::March,
+        ProceduralMotion::Wave,
+        ProceduralMotion::JumpingJacks,
+    ] {
+        out.push((
+            kind.name().to_owned(),
+            procedural(kind, &subject, FRAMES, FPS),
+            true,
+        ));
+    }
+    out.push((
+        "walk (procedural)".to_owned(),
+        procedural(ProceduralMotion::Walk, &subject, FRAMES, FPS),
+        false,
+    ));
+    let data = repo_root().join("tests/data");
+    for (file, start, label) in [
+        ("cmu_02_01_walk.bvh", 0.5, "CMU 02_01 walk"),
+        ("cmu_02_03_run.bvh", 0.3, "CMU 02_03 run"),
+        ("cmu_06_03_dribble.bvh", 1.0, "CMU 06_03 dribble"),
+        ("cmu_60_02_dance.bvh", 2.0, "CMU 60_02 dance"),
+    ] {
+        let m = from_bvh(&data.join(file), start, FRAMES, FPS).map_err(ExitError::failed)?;
+        out.push((label.to_owned(), m, false));
+    }
+    Ok(out)
+}
+
+struct Row {
+    name: String,
+    voxel_mm: f64,
+    points: f64,
+    score: VolumeScore,
+    sides: String,
+}
+
+fn run_sequence(
+    name: &str,
+    motion: &Motion,
+    stature: f64,
+    voxel: VoxelParams,
+    params: &VolumeParams,
+) -> Row {
+    let clouds: Vec<_> = motion
+        .frames
+        .par_iter()
+        .enumerate()
+        .map(|(i, j)| {
+            let mut rng =
+                <rand::rngs::StdRng as rand::SeedableRng>::seed_from_u64(voxel.seed + i as u64);
+            voxelise(j, stature, &voxel, &mut rng)
+        })
+        .collect();
+    let results: Vec<_> = clouds
+        .par_iter()
+        .map(|c| process_frame(c, params))
+        .collect();
+    let names: Vec<String> = (0..results.len()).map(|i| format!("frame {i}")).collect();
+    let assembled = assemble(&results, &names, motion.fps);
+    let ok = five_limb_frames(&results);
+    let score = score_volume(&volume_truth(motion), &assembled.skeleton, ok);
+    Row {
+        name: name.to_owned(),
+        voxel_mm: voxel.voxel_m * 1000.0,
+        points: clouds.iter().map(Vec::len).sum::<usize>() as f64 / clouds.len().max(1) as f64,
+        score,
+        sides: format!("{:?}", assembled.sides_from).to_lowercase(),
+    }
+}
+
+/// One split's column of the suite table: topology, the error with sides as reported (in mm and
+/// voxel sizes), sides right, labels consistent.
+fn suite_cell(s: &VolumeScore, voxel_mm: f64) -> String {
+    format!(
+        "{:>6.1}% {:>6.1} {:>5.2} {:>6.1}% {:>6.1}%",
+        100.0 * s.topology(),
+        s.mean_reported_mm(),
+        s.mean_reported_mm() / voxel_mm,
+        100.0 * s.sides_right_share(),
+        100.0 * s.consistency()
+    )
+}
+
+/// The voxelisations of the suite's takes: 30, 40 and 50 mm clean, and 40 mm with noise voxels
+/// and holes.
+const SUITE_VOXELS: [(f64, usize, f64); 4] = [
+    (0.03, 0, 0.0),
+    (0.04, 0, 0.0),
+    (0.05, 0, 0.0),
+    (0.04, 200, 0.05),
+];
+
+/// The volume pipeline on every take of suite v3 of `split` (`None`: both; its first clip's
+/// body and start, [`FRAMES`] frames at [`FPS`] fps) at each of [`SUITE_VOXELS`], dev and test
+/// side by side per family; returns the same as JSON.
+fn suite_takes(
+    params: &VolumeParams,
+    split: Option<Split>,
+    only: Option<&str>,
+    global: &GlobalArgs,
+    lines: &mut Vec<String>,
+) -> Result<serde_json::Value, ExitError> {
+    let suite = Suite::load(&repo_root()).map_err(ExitError::failed)?;
+    let mut takes = Vec::new();
+    let mut seen = std::collections::BTreeSet::new();
+    for clip in &suite.clips {
+        if split.is_some_and(|s| s != clip.split)
+            || only.is_some_and(|o| !clip.take.contains(o))
+            || !seen.insert(clip.take.clone())
+        {
+            continue;
+        }
+        let synth = SynthParams {
+            frames: FRAMES,
+            fps: FPS as u32,
+            ..clip.params.clone()
+        };
+        let motion = load_motion(&synth).map_err(ExitError::failed)?;
+        let stature = subject_stature(&synth, &motion);
+        let bench = BenchClip {
+            name: clip.name.clone(),
+            family: clip.family,
+            split: clip.split,
+            dir: Default::default(),
+        };
+        takes.push((clip.take.clone(), bench, motion, stature));
+    }
+    let mut json = serde_json::Map::new();
+    for (voxel_m, noise_voxels, hole_fraction) in SUITE_VOXELS {
+        let voxel = VoxelParams {
+            voxel_m,
+            noise_voxels,
+            hole_fraction,
+            ..VoxelParams::default()
+        };
+        let voxel_mm = voxel_m * 1000.0;
+        let label = if noise_voxels > 0 {
+            format!(
+                "{voxel_mm:.0} mm, {noise_voxels} noise voxels, {:.0} % holes",
+                hole_fraction * 100.0
+            )
+        } else {
+            format!("{voxel_mm:.0} mm")
+        };
+        let mut tally: Tally<VolumeScore> = Tally::default();
+        let mut per_take = serde_json::Map::new();
+        for (take, bench, motion, stature) in &takes {
+            say(global, &format!("volumes of take {take} at {label} …"));
+            let r = run_sequence(take, motion, *stature, voxel, params);
+            tally.add(bench, &r.score);
+            per_take.insert(
+                take.clone(),
+                serde_json::json!({
+                    "curve": r.score.topology(), "reported_mm": r.score.mean_reported_mm(),
+                    "matched_once_mm": r.score.mean_mm(), "sides_right": r.score.sides_right_share(),
+                    "family": bench.family.name(), "split": bench.split.name(),
+                }),
+            );
+        }
+        let title = format!(
+            "suite v3 takes at {label} (the bodies of their first clips, {FRAMES} frames at {FPS} fps): frames with a five-limb curve, mean error with left and right as reported (mm, voxel sizes), sides right, labels consistent"
+        );
+        push_table(lines, &mut json, &title, &label, &tally, per_take, voxel_mm);
+    }
+    // Carved from silhouettes: 4 and 8 clean views, and 4 views with the faults of real
+    // segmentation (every mask must hold a voxel, or one may miss it).
+    let faulty = CarveCase {
+        faults: SilhouetteFaults::typical(),
+        ..CarveCase::clean(4, 0.04)
+    };
+    let cases = [
+        ("4 views", CarveCase::clean(4, 0.04)),
+        ("8 views", CarveCase::clean(8, 0.04)),
+        ("4 faulty views", faulty.clone()),
+        (
+            "4 faulty views, 3 votes",
+            CarveCase {
+                min_votes: Some(3),
+                ..faulty
+            },
+        ),
+    ];
+    for (label, case) in cases {
+        let mut tally: Tally<VolumeScore> = Tally::default();
+        let mut per_take = serde_json::Map::new();
+        for (take, bench, motion, _) in &takes {
+            say(global, &format!("take {take} carved from {label} …"));
+            let r = carve_and_score(motion, &case, params).map_err(ExitError::failed)?;
+            tally.add(bench, &r.score);
+            per_take.insert(
+                take.clone(),
+                serde_json::json!({
+                    "curve": r.score.topology(), "reported_mm": r.score.mean_reported_mm(),
+                    "sides_right": r.score.sides_right_share(), "voxels": r.voxels,
+                    "dropped_voxels": r.dropped,
+                    "family": bench.family.name(), "split": bench.split.name(),
+                }),
+            );
+        }
+        let what = if case.faults.any() {
+            "; faults: edges eroded and dilated 2 px on two views, the right forearm missing on one, a shadow at the feet, a second person 1.2 m away; the blob nearest the person kept"
+        } else {
+            ""
+        };
+        let title = format!(
+            "suite v3 takes carved at 40 mm from {label} (640×480 cameras on a ring{what})"
+        );
+        let key = format!("carved {label}");
+        push_table(lines, &mut json, &title, &key, &tally, per_take, 40.0);
+    }
+    Ok(serde_json::Value::Object(json))
+}
+
+/// One table of the suite's takes: `title`, the family rows of `tally` (voxel sizes of
+/// `voxel_mm`) into `lines`, and under `key` (and `key` + " takes" for `per_take`) into `json`.
+fn push_table(
+    lines: &mut Vec<String>,
+    json: &mut serde_json::Map<String, serde_json::Value>,
+    title: &str,
+    key: &str,
+    tally: &Tally<VolumeScore>,
+    per_take: serde_json::Map<String, serde_json::Value>,
+    voxel_mm: f64,
+) {
+    const WIDTH: usize = 36;
+    lines.push(title.to_owned());
+    lines.extend(Tally::<VolumeScore>::heading(
+        WIDTH,
+        "  curve     mm voxel  sides labels",
+    ));
+    lines.extend(tally.lines(WIDTH, |s| suite_cell(s, voxel_mm)));
+    lines.push(String::new());
+    json.insert(format!("{key} takes"), serde_json::Value::Object(per_take));
+    json.insert(
+        key.to_owned(),
+        tally.json(|s| {
+            serde_json::json!({
+                "topology": s.topology(), "reported_mm": s.mean_reported_mm(),
+                "voxel_sizes": s.mean_reported_mm() / voxel_mm,
+                "sides_right": s.sides_right_share(),
+                "labels_consistent": s.consistency(),
+                "matched_once_mm": s.mean_mm(),
+            })
+        }),
+    );
+}
+
+/// Runs the volume benchmark and prints its tables.
+pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+    let params = VolumeParams::default();
+    // One split: only the suite's takes (the other tables have no split).
+    let split = parse_split(&a.split)?;
+    if split.is_some() {
+        let mut lines = Vec::new();
+        let suite_json = suite_takes(&params, split, a.clip.as_deref(), global, &mut lines)?;
+        print_tables(global, suite_json, &lines);
+        return Ok(());
+    }
+    let motions = motions()?;
+    let mut lines = Vec::new();
+    lines.push(format!(
+        "Volume pipeline accuracy ({FRAMES} frames per sequence at {FPS} fps; error: left/right matched once per sequence, and per frame)"
+    ));
+    lines.push(format!(
+        "{:<20} {:>6} {:>7} {:>9} {:>9} {:>9} {:>8} {:>10} {:>9}",
+        "sequence",
+        "voxel",
+        "points",
+        "topology",
+        "mean mm",
+        "voxels",
+        "frame mm",
+        "labels ok",
+        "sides"
+    ));
+    let mut paper = VolumeScore::default();
+    let mut paper_voxels = (0.0, 0usize);
+    let mut others = VolumeScore::default();
+    for voxel_m in [0.03, 0.04, 0.05] {
+        for (name, motion, is_paper) in &motions {
+            say(
+                global,
+                &format!("{name}, {:.0} mm voxels …", voxel_m * 1000.0),
+            );
+            let voxel = VoxelParams {
+                voxel_m,
+                ..VoxelParams::default()
+            };
+            let r = run_sequence(name, motion, stature_of(motion), voxel, &params);
+            let s = &r.score;
+            lines.push(format!(
+                "{:<20} {:>4.0}mm {:>7.0} {:>8.1}% {:>9.1} {:>9.2} {:>8.1} {:>9.1}% {:>9}",
+                r.name,
+                r.voxel_mm,
+                r.points,
+                100.0 * s.topology(),
+                s.mean_mm(),
+                s.mean_mm() / r.voxel_mm,
+                s.mean_frame_matched_mm(),
+                100.0 * s.consistency(),
+                r.sides
+            ));
+            if *is_paper {
+                paper.merge(s);
+                paper_voxels.0 += s.mean_mm() / r.voxel_mm;
+                paper_voxels.1 += 1;
+            } else {
+                others.merge(s);
+            }
+        }
+    }
+    lines.push(format!(
+        "paper's three motions, all voxel sizes: topology {:.1}%, mean {:.1} mm = {:.2} voxel sizes (mean over sequences), labels consistent {:.1}%",
+        100.0 * paper.topology(),
+        paper.mean_mm(),
+        paper_voxels.0 / paper_voxels.1.max(1) as f64,
+        100.0 * paper.consistency()
+    ));
+    lines.push(format!(
+        "other motions, all voxel sizes: topology {:.1}%, mean {:.1} mm, labels consistent {:.1}%",
+        100.0 * others.topology(),
+        others.mean_mm(),
+        100.0 * others.consistency()
+    ));
+    lines.push(String::new());
+    let suite_json = suite_takes(&params, None, None, global, &mut lines)?;
+
+    // Carved from silhouettes (paper §2): the visual hull is fatter than the body and fills
+    // gaps a camera cannot see through.
+    lines.push(
+        "Carved from silhouettes (40 mm voxels; synthetic 640×480 cameras spread over half a turn, 20° down; a voxel stays when every mask holds it)".to_owned(),
+    );
+    lines.push(format!(
+        "{:<20} {:>6} {:>9} {:>9} {:>9} {:>9} {:>10}",
+        "sequence", "views", "voxels", "topology", "mean mm", "voxels", "labels ok"
+    ));
+    for (name, motion, is_paper) in &motions {
+        if !*is_paper {
+            continue;
+        }
+        for views in [4, 8] {
+            say(global, &format!("{name} carved from {views} views …"));
+            let r = carve_and_score(motion, &CarveCase::clean(views, 0.04), &params)
+                .map_err(ExitError::failed)?;
+            let (s, voxels) = (r.score, r.voxels);
+            lines.push(format!(
+                "{:<20} {:>6} {:>9.0} {:>8.1}% {:>9.1} {:>9.2} {:>9.1}%",
+                name,
+                views,
+                voxels,
+                100.0 * s.topology(),
+                s.mean_mm(),
+                s.mean_mm() / 40.0,
+                100.0 * s.consistency()
+            ));
+        }
+    }
+    lines.push(String::new());
+
+    // Speed on one core: voxel sizes chosen so that a marching frame has about N points.
+    let march = &motions[0].1;
+    let stature = stature_of(march);
+    let mut rng = <rand::rngs::StdRng as rand::SeedableRng>::seed_from_u64(3);
+    let at_40 = voxelise(&march.frames[0], stature, &VoxelParams::default(), &mut rng).len();
+    lines.push("Speed on one core (marching, 10 frames each)".to_owned());
+    lines.push(format!(
+        "{:>8} {:>8} {:>12} {:>12} {:>10} {:>9}",
+        "N target", "voxel", "points", "ms / frame", "Isomap", "topology"
+    ));
+    for target in [3_000.0, 10_000.0, 30_000.0] {
+        let voxel_m = 0.04 * (at_40 as f64 / target).cbrt();
+        let voxel = VoxelParams {
+            voxel_m,
+            ..VoxelParams::default()
+        };
+        let clouds: Vec<_> = march
+            .frames
+            .iter()
+            .step_by(5)
+            .take(10)
+            .map(|j| voxelise(j, stature, &voxel, &mut rng))
+            .collect();
+        say(global, &format!("speed at N ≈ {target:.0} …"));
+        let (mut total, mut iso, mut ok) = (0.0, 0.0, 0);
+        for c in &clouds {
+            let t0 = Instant::now();
+            let r = process_frame(c, &params);
+            total += t0.elapsed().as_secs_f64();
+            if let Ok(r) = r {
+                iso += r.seconds[0];
+                ok += 1;
+            }
+        }
+        let n = clouds.len().max(1) as f64;
+        lines.push(format!(
+            "{:>8.0} {:>6.1}mm {:>12.0} {:>12.1} {:>9.0}% {:>6}/{}",
+            target,
+            voxel_m * 1000.0,
+            clouds.iter().map(Vec::len).sum::<usize>() as f64 / n,
+            1000.0 * total / n,
+            100.0 * iso / total.max(1e-12),
+            ok,
+            clouds.len()
+        ));
+    }
+    print_tables(global, suite_json, &lines);
+    Ok(())
+}
+
+/// Prints the tables, or with `--json` the suite's figures and the tables as JSON.
+fn print_tables(global: &GlobalArgs, suite_json: serde_json::Value, lines: &[String]) {
+    if global.json {
+        println!(
+            "{}",
+            serde_json::json!({"suite": suite_json, "table": lines})
+        );
+    } else {
+        println!("{}", lines.join("\n"));
+    }
+}

@@ -1,0 +1,44 @@
+//! `videomocap-bench`: videomocap's developer tool. The benchmarks (every table of the README
+//! and `docs/method.md`), the synthetic renderer as a command, scoring against its ground truth
+//! and the crash-safety writer. Built from the repository, never installed.
+
+mod args;
+mod bench;
+mod bench_correct;
+mod bench_lift;
+mod bench_opencv;
+mod bench_scrub;
+mod bench_suite;
+mod bench_track;
+mod bench_volume;
+mod score;
+mod stress_write;
+mod synth;
+
+use args::{Cli, Command};
+use clap::Parser;
+use std::process::ExitCode;
+use videomocap::cli::{ExitError, message_with_causes, progress_bar, say};
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let global = &cli.global;
+    let result = match &cli.command {
+        Command::Track(a) => bench::run("track", a, global),
+        Command::Correct(a) => bench::run("correct", a, global),
+        Command::Lift(a) => bench::run("lift", a, global),
+        Command::Volume(a) => bench::run("volume", a, global),
+        Command::Scrub(a) => bench::run("scrub", a, global),
+        Command::Speed { what, args } => bench::run(what, args, global),
+        Command::Synth(a) => synth::run(a, global),
+        Command::Score { tracks, reference } => score::run(tracks, reference, global),
+        Command::StressWrite(a) => stress_write::run(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {}", message_with_causes(&e.error));
+            ExitCode::from(e.code)
+        }
+    }
+}
