@@ -167,8 +167,9 @@ def main():
         else:
             entry["procedural"] = take
         takes.append(entry)
-    suite = {"format": "videomocap.suite", "version": 3,
-             "note": "Written by scripts/make_suite.py (seed 64); split by take, fixed here.",
+    suite = {"format": "videomocap.suite", "version": 4, "body": "mesh",
+             "note": "Written by scripts/make_suite.py (seed 64); split by take, fixed here. v4 "
+                     "(2026-11-28): v3's takes, split and clips, the body MakeHuman's skinned mesh.",
              "takes": takes, "clips": clips}
     with open(os.path.join(OUT, "suite.json"), "w") as f:
         json.dump(suite, f, indent=1)

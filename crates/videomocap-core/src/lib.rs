@@ -3,7 +3,8 @@
 //! Data flows one way: [`video`] (frame sources) → [`track`] (2D: marks → tracks) → [`lift`]
 //! (calibration, 3D skeleton) → [`export`] (BVH, CSV, TRC), with [`skeleton`] (joints, bones,
 //! proportions), [`camera`], [`formats`] (the versioned files) and [`bvh`] (the BVH reader)
-//! shared by all, and [`project`] (a user's saved work). The point-volume pipeline is the
+//! shared by all, and [`project`] (a user's saved work). [`network`] runs the pose network
+//! whose joints the tracker weighs as evidence beside its own. The point-volume pipeline is the
 //! `videomocap-volume` crate beside this one; the desktop app and the command line sit on top
 //! and only call these functions.
 
@@ -15,6 +16,7 @@ pub mod video;
 
 pub mod export;
 pub mod lift;
+pub mod network;
 pub mod project;
 mod setting_range;
 pub mod track;

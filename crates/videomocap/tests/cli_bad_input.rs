@@ -443,7 +443,9 @@ fn help_lists_only_the_users_commands() {
         .unwrap();
     assert!(o.status.success());
     let help = String::from_utf8_lossy(&o.stdout);
-    for command in ["gui", "info", "track", "lift", "export", "run", "volume", "carve"] {
+    for command in [
+        "gui", "info", "track", "lift", "export", "run", "volume", "carve",
+    ] {
         assert!(
             help.lines().any(|l| l.trim_start().starts_with(command)),
             "{command} missing from:\n{help}"

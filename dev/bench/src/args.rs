@@ -48,6 +48,8 @@ pub enum Command {
     /// The desktop app's frame access on a long 1080p clip: open time, random seeks,
     /// scrubbing, peak memory.
     Scrub(BenchArgs),
+    /// VBA alone, the pose network alone and the two together, from the same clicked marks.
+    Learned(BenchArgs),
     /// Decoding (beside the ffmpeg command) and rendering speed.
     Speed {
         /// all, decode or synth.
@@ -104,6 +106,10 @@ pub struct SynthArgs {
     /// Image height, pixels.
     #[arg(long, default_value_t = 480)]
     pub height: u32,
+    /// The body drawn: mesh (MakeHuman's skinned mesh, as suite v4) or capsule (the
+    /// mannequin of suite v3 and the quick tests).
+    #[arg(long, default_value = "mesh")]
+    pub body: String,
     /// Camera view: frontal, oblique, side, raised, behind, low.
     #[arg(long, default_value = "oblique")]
     pub view: String,
@@ -195,6 +201,10 @@ pub struct BenchArgs {
     /// clip of the split).
     #[arg(long)]
     pub clip: Option<String>,
+    /// `learned` only: evidence settings to sweep (dev), `A,B,C,D,E;…` = VBA doubt, network
+    /// doubt, swap cost, motion, key fade frames.
+    #[arg(long)]
+    pub evidence: Option<String>,
     /// `bench lift` only: leave out input (c), the tracker's output (tracking is most of the
     /// bench's time; for quick looks at the lift from true and noisy 2D).
     #[arg(long)]

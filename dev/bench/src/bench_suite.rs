@@ -110,6 +110,17 @@ where
     }
 }
 
+impl<T: Merge + Clone> Merge for Vec<T> {
+    fn merge_from(&mut self, other: &Self) {
+        for (k, b) in other.iter().enumerate() {
+            match self.get_mut(k) {
+                Some(a) => a.merge_from(b),
+                None => self.push(b.clone()),
+            }
+        }
+    }
+}
+
 /// A score per (split, family) and per split over all synthetic clips.
 #[derive(Debug, Clone, Default)]
 pub struct Tally<T> {

@@ -6,7 +6,7 @@
 //! noise; the exact marks as a second condition) by the VBA tracker and by a fixed-template
 //! matcher per joint (the baseline written here: the marked patch of each joint searched around
 //! its last position, no prediction, no model update), and by OpenCV's Lucas–Kanade and CSRT
-//! when Python's OpenCV is present (`bench_opencv`). Tables put dev and test side by side per
+//! when Python's OpenCV is present, and MediaPipe Pose when it is (`bench_baselines`). Tables put dev and test side by side per
 //! clip family. Metrics from [`videomocap_testkit::eval`].
 //!
 //! Speed: frames per second of the tracker at 640×480 and 1080×1920, with frames already in
@@ -203,7 +203,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let mut tally: Tally<TrackScores> = Tally::default();
     let mut lines = vec![
         format!(
-            "suite v3: {} clips ({} dev, {} test) and 2 real clips (dev); marks clicked with {} px of noise unless 'exact'",
+            "suite v4: {} clips ({} dev, {} test) and 2 real clips (dev); marks clicked with {} px of noise unless 'exact'",
             clips.len() - 2,
             clips
                 .iter()
@@ -221,12 +221,14 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let mut rows_json = Vec::new();
     let mut clicked = Vec::new();
     let mut real_limbs: Vec<(String, Accuracy)> = Vec::new();
+    let mut vba_limbs = Vec::new();
     for clip in &clips {
         say(global, &format!("tracking {} …", clip.name));
         let (s, limbs, marks) = score_clip(clip, threads, params)?;
         if clip.family == Family::Real {
             real_limbs.push((clip.name.clone(), limbs));
         }
+        vba_limbs.push(limbs);
         lines.push(format!(
             "{:<26} {:<5} {:<11} {}",
             clip.name,
@@ -261,19 +263,45 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
                 .join(", ")
         ));
     }
-    let opencv = crate::bench_opencv::run(&clips, &clicked, &a.suite_dir, global)?;
+    let opencv = crate::bench_baselines::opencv(&clips, &clicked, &a.suite_dir, global)?;
     if let Some(t) = &opencv {
         lines.push(String::new());
         lines.push(
             "OpenCV from the same clicked marks: Lucas–Kanade (PCK@0.2, lost), CSRT (PCK@0.2, lost; test split and real clips only)".to_owned(),
         );
         lines.extend(Tally::<[Accuracy; 2]>::heading(
-            crate::bench_opencv::WIDTH,
-            crate::bench_opencv::COLUMNS,
+            crate::bench_baselines::OPENCV_WIDTH,
+            crate::bench_baselines::OPENCV_COLUMNS,
         ));
-        lines.extend(t.lines(crate::bench_opencv::WIDTH, crate::bench_opencv::cell));
+        lines.extend(t.lines(
+            crate::bench_baselines::OPENCV_WIDTH,
+            crate::bench_baselines::opencv_cell,
+        ));
     } else {
         lines.push("(OpenCV baselines: python3 with cv2 not found; `python3 -m pip install opencv-contrib-python-headless numpy` adds them)".to_owned());
+    }
+    let mediapipe = crate::bench_baselines::mediapipe(&clips, &vba_limbs, &a.suite_dir, global)?;
+    if let Some((t, per_clip)) = &mediapipe {
+        lines.push(String::new());
+        lines.push(
+            "VBA alone (clicked marks) against the network alone (MediaPipe Pose 0.10.21, its own detector, no marks), PCK@0.2 of the 13 limb joints; MediaPipe's lost share and its 16 joints (neck, chest, pelvis and head top derived: scripts/mediapipe_baseline.py)".to_owned(),
+        );
+        lines.extend(Tally::<crate::bench_baselines::Learned>::heading(
+            crate::bench_baselines::LEARNED_WIDTH,
+            crate::bench_baselines::LEARNED_COLUMNS,
+        ));
+        lines.extend(t.lines(
+            crate::bench_baselines::LEARNED_WIDTH,
+            crate::bench_baselines::learned_cell,
+        ));
+        for (name, s) in per_clip.iter().filter(|(n, _)| n.starts_with("real")) {
+            lines.push(format!(
+                "{name:<18} |{}",
+                crate::bench_baselines::learned_cell(s)
+            ));
+        }
+    } else {
+        lines.push("(MediaPipe baseline: python3 with mediapipe not found; `python3 -m pip install mediapipe==0.10.21` adds it)".to_owned());
     }
 
     // Speed.
@@ -355,6 +383,11 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
                     .iter()
                     .map(|(name, a)| serde_json::json!({"clip": name, "vba": accuracy_json(a)}))
                     .collect::<Vec<_>>(),
+                "mediapipe": mediapipe.as_ref().map(|(t, _)| t.json(|s| serde_json::json!({
+                    "vba_limbs": accuracy_json(&s[0]),
+                    "mediapipe_limbs": accuracy_json(&s[1]),
+                    "mediapipe_all": accuracy_json(&s[2]),
+                }))),
                 "opencv": opencv.map(|t| serde_json::json!({
                     "lucas_kanade": t.json(|s| accuracy_json(&s[0])),
                     "csrt": t.json(|s| accuracy_json(&s[1])),

@@ -4,9 +4,10 @@
 
 mod args;
 mod bench;
+mod bench_baselines;
 mod bench_correct;
+mod bench_learned;
 mod bench_lift;
-mod bench_opencv;
 mod bench_scrub;
 mod bench_suite;
 mod bench_track;
@@ -29,6 +30,7 @@ fn main() -> ExitCode {
         Command::Lift(a) => bench::run("lift", a, global),
         Command::Volume(a) => bench::run("volume", a, global),
         Command::Scrub(a) => bench::run("scrub", a, global),
+        Command::Learned(a) => bench_learned::run(a, global),
         Command::Speed { what, args } => bench::run(what, args, global),
         Command::Synth(a) => synth::run(a, global),
         Command::Score { tracks, reference } => score::run(tracks, reference, global),

@@ -7,8 +7,8 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use videomocap_core::camera::PinholeCamera;
 use videomocap_testkit::synth::{
-    MotionSource, ProceduralMotion, SensorEffects, SilhouetteFaults, SynthError, SynthParams,
-    VideoOutput, View, VoxelParams, load_motion, render_clip, write_carving_setup,
+    MotionSource, ProceduralMotion, SensorEffects, SilhouetteFaults, Surface, SynthError,
+    SynthParams, VideoOutput, View, VoxelParams, load_motion, render_clip, write_carving_setup,
     write_volume_sequence,
 };
 
@@ -78,6 +78,15 @@ pub fn params_from_args(a: &SynthArgs) -> Result<SynthParams, ExitError> {
             VideoOutput::PngSequence
         } else {
             VideoOutput::Mp4
+        },
+        surface: match a.body.as_str() {
+            "mesh" => Surface::Mesh,
+            "capsule" => Surface::Capsules,
+            other => {
+                return Err(ExitError::bad_input(anyhow!(
+                    "--body {other}: expected mesh or capsule"
+                )));
+            }
         },
         ..SynthParams::default()
     })

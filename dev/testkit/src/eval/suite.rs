@@ -1,4 +1,5 @@
-//! The benchmark suite (v3): synthetic clips rendered from every bundled motion-capture take and
+//! The benchmark suite (v4): synthetic clips of people (MakeHuman's skinned mesh; v3 drew
+//! mannequins from the same parameters) rendered from every bundled motion-capture take and
 //! the procedural motions, on varied bodies, annotators, views, clothes and scenes, split by take
 //! into `dev` (tune here) and `test` (read when a change is done); plus the two real clips.
 //!
@@ -9,7 +10,8 @@
 
 use crate::synth::{
     Appearance, BodyShape, Clothes, Framing, JointDefinitions, MotionSource, ProceduralMotion,
-    SensorEffects, SynthError, SynthParams, VideoOutput, View, background, framing, render_clip,
+    SensorEffects, Surface, SynthError, SynthParams, VideoOutput, View, background, framing,
+    render_clip,
 };
 use nalgebra::Point2;
 use rand::SeedableRng;
@@ -104,6 +106,8 @@ impl Family {
 struct SuiteFile {
     format: String,
     version: u32,
+    /// `mesh` (v4) or `capsule` (the mannequin of v3).
+    body: String,
     takes: Vec<TakeEntry>,
     clips: Vec<ClipEntry>,
 }
@@ -190,12 +194,17 @@ impl Suite {
             path: path.clone(),
             source,
         })?;
-        if file.format != "videomocap.suite" || file.version != 3 {
+        if file.format != "videomocap.suite" || file.version != 4 {
             return Err(invalid(format!(
-                "expected format videomocap.suite version 3, found {} version {}",
+                "expected format videomocap.suite version 4, found {} version {}",
                 file.format, file.version
             )));
         }
+        let surface = match file.body.as_str() {
+            "mesh" => Surface::Mesh,
+            "capsule" => Surface::Capsules,
+            other => return Err(invalid(format!("body {other}: expected mesh or capsule"))),
+        };
         let data = path.parent().unwrap_or(root).to_owned();
         let mut clips = Vec::with_capacity(file.clips.len());
         for c in &file.clips {
@@ -217,7 +226,7 @@ impl Suite {
                     return Err(invalid(format!("clip {}: no motion file", c.name)));
                 }
             };
-            let params = clip_params(c, motion, root).map_err(invalid)?;
+            let params = clip_params(c, motion, surface, root).map_err(invalid)?;
             clips.push(SuiteClip {
                 name: c.name.clone(),
                 take: c.take.clone(),
@@ -239,7 +248,7 @@ impl Suite {
         let mut out = Vec::with_capacity(self.clips.len());
         for clip in &self.clips {
             let folder = dir.join(&clip.name);
-            let stamp = format!("suite v3: {:?}\n", clip.params);
+            let stamp = format!("suite v4: {:?}\n", clip.params);
             let current = std::fs::read_to_string(folder.join(SPEC_FILE)).is_ok_and(|s| s == stamp)
                 && folder.join("gt.json").is_file();
             if !current {
@@ -272,7 +281,12 @@ const SPEC_FILE: &str = "suite_spec.txt";
 pub const SUITE_INDEX: &str = "clips.txt";
 
 /// The render parameters of one clip of the file.
-fn clip_params(c: &ClipEntry, motion: MotionSource, root: &Path) -> Result<SynthParams, String> {
+fn clip_params(
+    c: &ClipEntry,
+    motion: MotionSource,
+    surface: Surface,
+    root: &Path,
+) -> Result<SynthParams, String> {
     let view =
         View::from_name(&c.view).ok_or_else(|| format!("clip {}: view {}", c.name, c.view))?;
     let clothes = Clothes::from_name(&c.clothes)
@@ -316,6 +330,7 @@ fn clip_params(c: &ClipEntry, motion: MotionSource, root: &Path) -> Result<Synth
         appearance: Appearance::drawn(clothes, c.loose, &bg, c.seed),
         distractor: c.distractor.then_some(c.seed.wrapping_add(1)),
         motion_blur: c.motion_blur,
+        surface,
     })
 }
 

@@ -51,6 +51,10 @@ pub struct Appearance {
     pub hair: [f64; 3],
     /// Radius factor of clothed parts (1 = fitted, 1.3 = loose).
     pub looseness: f64,
+    /// Sleeves to the wrists (else to the elbows), on the mesh body.
+    pub long_sleeves: bool,
+    /// Shorts (else trousers to the ankles), on the mesh body.
+    pub shorts: bool,
 }
 
 impl Default for Appearance {
@@ -71,6 +75,8 @@ impl Default for Appearance {
             face: [224.0, 172.0, 140.0],
             hair: [60.0, 42.0, 30.0],
             looseness: 1.0,
+            long_sleeves: false,
+            shorts: false,
         }
     }
 }
@@ -174,6 +180,8 @@ impl Appearance {
             face: skin.map(|c| (c * 1.05).min(255.0)),
             hair: HAIR[rng.random_range(0..HAIR.len())],
             looseness: if loose { 1.3 } else { 1.0 },
+            long_sleeves: rng.random_bool(0.5),
+            shorts: rng.random_bool(0.3),
         }
     }
 

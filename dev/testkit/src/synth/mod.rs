@@ -7,6 +7,7 @@ mod appearance;
 mod body;
 mod faults;
 mod ground_truth;
+mod mesh;
 mod motion;
 mod render;
 mod volume;
@@ -15,10 +16,11 @@ pub use appearance::{Appearance, Cloth, Clothes, Pattern};
 pub use body::{BodyShape, JointDefinitions, retarget, shoulder_girdle};
 pub use faults::SilhouetteFaults;
 pub use ground_truth::{GroundTruth, GroundTruthFrame};
+pub use mesh::MeshError;
 pub use motion::{
     Motion, ProceduralMotion, from_bvh, normalise_orientation, procedural, stature_of,
 };
-pub use render::{Figure, Rendered, SensorEffects, background, render_frame};
+pub use render::{Figure, Rendered, SensorEffects, Surface, background, render_frame};
 pub use volume::{
     VoxelParams, ring_cameras, silhouette, truth as volume_truth, voxelise, write_carving_setup,
     write_volume_sequence,
@@ -141,6 +143,8 @@ pub struct SynthParams {
     pub distractor: Option<u64>,
     /// Motion blur: each frame the mean of three instants a third of a frame apart.
     pub motion_blur: bool,
+    /// The subject's body (and the second person's): the mannequin or the skinned mesh.
+    pub surface: Surface,
 }
 
 impl Default for SynthParams {
@@ -170,6 +174,7 @@ impl Default for SynthParams {
             appearance: Appearance::default(),
             distractor: None,
             motion_blur: false,
+            surface: Surface::Capsules,
         }
     }
 }
@@ -192,6 +197,8 @@ pub enum SynthError {
     Background { path: PathBuf, message: String },
     #[error("bad parameters: {0}")]
     Params(String),
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
     #[error("cancelled")]
     Cancelled,
 }
@@ -471,6 +478,7 @@ pub fn render_clip(
                     points,
                     stature_m: *stature,
                     appearance: *appearance,
+                    surface: params.surface,
                 })
             })
             .collect();
@@ -478,14 +486,15 @@ pub fn render_clip(
             points: &cam_pts,
             stature_m: stature,
             appearance: params.appearance,
+            surface: params.surface,
         };
         let t0 = std::time::Instant::now();
         let r = if params.motion_blur {
             blurred_frame(
                 &camera, &motion, i, &placement, subject, &others, &bg, params,
-            )
+            )?
         } else {
-            render_frame(&camera, &subject, &others, &bg, &params.effects, i)
+            render_frame(&camera, &subject, &others, &bg, &params.effects, i)?
         };
         render_s += t0.elapsed().as_secs_f64();
         sink.write(i, &r.image)?;
@@ -594,7 +603,7 @@ fn blurred_frame(
     others: &[Figure],
     bg: &image::RgbImage,
     params: &SynthParams,
-) -> Rendered {
+) -> Result<Rendered, SynthError> {
     let still = SensorEffects {
         noise_sigma: 0.0,
         flicker: 0.0,
@@ -609,7 +618,7 @@ fn blurred_frame(
             motion.frames[a][j] + (motion.frames[b][j] - motion.frames[a][j]) * k
         }))
     };
-    let mut middle = render_frame(camera, &subject, others, bg, &still, i);
+    let mut middle = render_frame(camera, &subject, others, bg, &still, i)?;
     let mut sum: Vec<u32> = middle
         .image
         .as_raw()
@@ -622,7 +631,7 @@ fn blurred_frame(
             points: &points,
             ..subject
         };
-        let r = render_frame(camera, &shifted, others, bg, &still, i);
+        let r = render_frame(camera, &shifted, others, bg, &still, i)?;
         for (s, &v) in sum.iter_mut().zip(r.image.as_raw()) {
             *s += u32::from(v);
         }
@@ -631,7 +640,7 @@ fn blurred_frame(
         *p = ((s + 1) / 3) as u8;
     }
     render::apply_effects(&mut middle.image, &params.effects, i);
-    middle
+    Ok(middle)
 }
 
 fn round4(v: f64) -> f64 {

@@ -3,6 +3,7 @@
 //! camera; optional sensor noise and brightness flicker.
 
 use super::appearance::{Appearance, Material, value_noise};
+use super::mesh::MeshError;
 use image::{Rgb, RgbImage};
 use nalgebra::{Point2, Point3, Vector3};
 use rand::{Rng, SeedableRng};
@@ -442,7 +443,17 @@ pub struct Rendered {
     pub visible: PerJoint<bool>,
 }
 
-/// One person to draw: joints in camera space, stature, clothes.
+/// What a person's body is drawn as.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Surface {
+    /// The mannequin: tapered capsules and an ellipsoid head, ray-cast (quick tests).
+    #[default]
+    Capsules,
+    /// MakeHuman's skinned mesh, rasterised (benchmark suite v4, `synth`'s default).
+    Mesh,
+}
+
+/// One person to draw: joints in camera space, stature, clothes, body.
 #[derive(Debug, Clone, Copy)]
 pub struct Figure<'a> {
     /// The 16 joints in camera space, metres.
@@ -451,6 +462,8 @@ pub struct Figure<'a> {
     pub stature_m: f64,
     /// Clothes, skin and hair.
     pub appearance: Appearance,
+    /// The body drawn.
+    pub surface: Surface,
 }
 
 /// Renders the subject over `background`, with `others` (people or things moving behind it)
@@ -462,14 +475,12 @@ pub fn render_frame(
     background: &RgbImage,
     effects: &SensorEffects,
     frame_index: usize,
-) -> Rendered {
+) -> Result<Rendered, MeshError> {
     let mut image = background.clone();
     for other in others {
-        let body = Body::dressed(other.points, other.stature_m, other.appearance);
-        paint(camera, &body, &mut image);
+        draw(camera, other, &mut image)?;
     }
-    let body = Body::dressed(subject.points, subject.stature_m, subject.appearance);
-    let depth = paint(camera, &body, &mut image);
+    let (body, depth) = draw(camera, subject, &mut image)?;
     apply_effects(&mut image, effects, frame_index);
     let points = subject.points;
     let (w, h) = (camera.width, camera.height);
@@ -485,11 +496,32 @@ pub fn render_frame(
         // plus 3 cm in front of it).
         surface >= points[j].z - body.joint_radius[j] - 0.03
     });
-    Rendered {
+    Ok(Rendered {
         image,
         points2d,
         visible,
-    }
+    })
+}
+
+/// Draws `figure` over `image`; its mannequin (whose joint radii the visibility test reads)
+/// and its depth per pixel.
+fn draw(
+    camera: &PinholeCamera,
+    figure: &Figure,
+    image: &mut RgbImage,
+) -> Result<(Body, Vec<f64>), MeshError> {
+    let body = Body::dressed(figure.points, figure.stature_m, figure.appearance);
+    let depth = match figure.surface {
+        Surface::Capsules => paint(camera, &body, image),
+        Surface::Mesh => super::mesh::paint(
+            camera,
+            figure.points,
+            figure.stature_m,
+            &figure.appearance,
+            image,
+        )?,
+    };
+    Ok((body, depth))
 }
 
 /// Draws `body` over `image` (z-buffered against itself) and returns its depth per pixel

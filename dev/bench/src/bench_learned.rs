@@ -1,0 +1,218 @@
+//! `videomocap-bench learned`: VBA alone, the pose network alone and the two together, from the
+//! same clicked marks, on the suite's clips and the real ones; PCK@0.2 and lost share of the 13
+//! limb joints and of all 16, and the network's time per frame.
+//!
+//! - VBA alone: the tracker from the clicked marks.
+//! - The network alone: each frame cropped around the network's own previous pose (the clicked
+//!   marks on the first frame), its joints as it maps them (`network`), no VBA.
+//! - Together: VBA's tracks with the network's evidence weighed in (`track::weigh`), the crops
+//!   following the network's own previous pose from the marks (VBA's body where it finds no
+//!   person).
+//!
+//! `--evidence A,B,C,D,E[;…]` (dev only, for sweeps) weighs with other settings
+//! (`EvidenceParams`: VBA doubt, network doubt, swap cost, motion, key fade frames).
+
+use crate::args::{BenchArgs, GlobalArgs};
+use crate::bench_suite::{BenchClip, Tally, bench_clips};
+use crate::bench_track::{threads_and_settings, track_opened};
+use crate::{ExitError, say};
+use anyhow::anyhow;
+use nalgebra::Point2;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+use videomocap_core::formats::{KeyFrames, Marks, Tracks2d};
+use videomocap_core::network::{Crop, PoseNetwork};
+use videomocap_core::skeleton::PerJoint;
+use videomocap_core::track::{EvidenceParams, run_network, weigh};
+use videomocap_core::video::{OpenOptions, Video};
+use videomocap_testkit::eval::suite::{CLICK_NOISE_PX, clicked_marks};
+use videomocap_testkit::eval::{Accuracy, ClipScore, score_positions, score_tracks};
+use videomocap_testkit::synth::GroundTruth;
+
+/// Limb joints and all 16 of one method.
+type Pair = [Accuracy; 2];
+
+/// One clip's scores: VBA alone, the network alone, then together for each setting swept.
+type Scores = Vec<Pair>;
+
+fn pair(s: &ClipScore) -> Pair {
+    [s.limbs(), s.overall]
+}
+
+/// Reads `--evidence`.
+fn sweep(text: Option<&str>) -> Result<Vec<EvidenceParams>, ExitError> {
+    let Some(text) = text else {
+        return Ok(vec![EvidenceParams::default()]);
+    };
+    text.split(';')
+        .map(|set| {
+            let v: Vec<f64> = set
+                .split(',')
+                .map(|x| x.trim().parse::<f64>())
+                .collect::<Result<_, _>>()
+                .map_err(|e| ExitError::bad_input(anyhow!("--evidence {set}: {e}")))?;
+            let [vba_doubt, net_doubt, swap_cost, motion, key_fade_frames] = v[..] else {
+                return Err(ExitError::bad_input(anyhow!(
+                    "--evidence {set}: expected five numbers"
+                )));
+            };
+            Ok(EvidenceParams {
+                vba_doubt,
+                net_doubt,
+                swap_cost,
+                motion,
+                key_fade_frames,
+            })
+        })
+        .collect()
+}
+
+/// One frame's joints: (frame, positions).
+type Positions = (usize, PerJoint<Point2<f64>>);
+
+/// The network alone: crops following its own previous pose from the clicked marks.
+fn network_alone(
+    video: &mut Video,
+    marks: &Marks,
+    network: &PoseNetwork,
+) -> Result<Vec<Positions>, ExitError> {
+    let mut body = marks.points;
+    let mut out = Vec::new();
+    for index in 0..video.info().frame_count {
+        let frame = video.frame(index).map_err(ExitError::failed)?;
+        let Some(crop) = Crop::around(&body) else {
+            break;
+        };
+        let pose = network
+            .run(&frame.image, &crop)
+            .map_err(ExitError::failed)?;
+        if pose.presence >= 0.5 {
+            body = pose.joints.map(|_, j| j.pos);
+            out.push((index, body));
+        } else {
+            // No person: every joint lost on this frame; the crop stays where it was.
+            out.push((index, PerJoint::from_fn(|_| Point2::new(-1.0e4, -1.0e4))));
+        }
+    }
+    Ok(out)
+}
+
+/// Runs the comparison and prints its tables.
+pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+    let (threads, params) = threads_and_settings(a)?;
+    let settings = sweep(a.evidence.as_deref())?;
+    let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;
+    let network = PoseNetwork::bundled().map_err(ExitError::failed)?;
+    let mut tally: Tally<Scores> = Tally::default();
+    let mut lines = vec![format!(
+        "{:<26} {:<5} limbs PCK@0.2: {:>6} {:>6} {:>9}",
+        "clip", "split", "VBA", "net", "together"
+    )];
+    let (mut net_seconds, mut net_frames) = (0.0, 0usize);
+    for clip in &clips {
+        say(global, &format!("{} …", clip.name));
+        let s = score_clip(clip, threads, params, &network, &settings, &mut net_seconds)?;
+        net_frames += count_frames(clip)?;
+        lines.push(format!(
+            "{:<26} {:<5}               {:>6.3} {:>6.3} {:>9.3}",
+            clip.name,
+            clip.split.name(),
+            s[0][0].pck02(),
+            s[1][0].pck02(),
+            s[2][0].pck02()
+        ));
+        tally.add(clip, &s);
+    }
+    lines.push(String::new());
+    lines.push(format!(
+        "13 limb joints, PCK@0.2 / lost; marks clicked with {CLICK_NOISE_PX} px of noise; together with {:?}",
+        settings[0]
+    ));
+    lines.extend(Tally::<Scores>::heading(WIDTH, COLUMNS));
+    lines.extend(tally.lines(WIDTH, |s| cell(s, 0, 2)));
+    lines.push(String::new());
+    lines.push("all 16 joints, PCK@0.2 / lost".to_owned());
+    lines.extend(Tally::<Scores>::heading(WIDTH, COLUMNS));
+    lines.extend(tally.lines(WIDTH, |s| cell(s, 1, 2)));
+    if settings.len() > 1 {
+        lines.push(String::new());
+        lines.push("together, each setting swept (13 limb joints, PCK@0.2 / lost)".to_owned());
+        for (k, p) in settings.iter().enumerate() {
+            let line = tally.lines(WIDTH, |s| cell(s, 0, 2 + k));
+            if let Some(overall) = line.last() {
+                lines.push(format!("{p:?}"));
+                lines.push(overall.clone());
+            }
+        }
+    }
+    lines.push(String::new());
+    lines.push(format!(
+        "the network (crops following the subject, one after the other): {:.1} ms a frame ({:.1} frames/s), crops 256×256",
+        1000.0 * net_seconds / net_frames.max(1) as f64,
+        net_frames as f64 / net_seconds.max(1e-9)
+    ));
+    for l in lines {
+        println!("{l}");
+    }
+    Ok(())
+}
+
+/// Width of [`cell`].
+const WIDTH: usize = 38;
+/// The columns of [`cell`].
+const COLUMNS: &str = "  VBA   lost    net   lost  together";
+
+/// One split's column: VBA, the network and together (`k`-th setting), accuracy `which`
+/// (0 limbs, 1 all).
+fn cell(s: &Scores, which: usize, together: usize) -> String {
+    let t = s.get(together).map_or(Accuracy::default(), |p| p[which]);
+    format!(
+        "{:>5.3} {:>5.1}% {:>6.3} {:>5.1}% {:>5.3} {:>3.0}%",
+        s[0][which].pck02(),
+        100.0 * s[0][which].lost(),
+        s[1][which].pck02(),
+        100.0 * s[1][which].lost(),
+        t.pck02(),
+        100.0 * t.lost()
+    )
+}
+
+fn count_frames(clip: &BenchClip) -> Result<usize, ExitError> {
+    Ok(GroundTruth::load(&clip.dir.join("gt.json"))
+        .map_err(ExitError::failed)?
+        .frames
+        .len())
+}
+
+fn score_clip(
+    clip: &BenchClip,
+    threads: usize,
+    params: videomocap_core::track::TrackerParams,
+    network: &PoseNetwork,
+    settings: &[EvidenceParams],
+    net_seconds: &mut f64,
+) -> Result<Scores, ExitError> {
+    let gt = GroundTruth::load(&clip.dir.join("gt.json")).map_err(ExitError::failed)?;
+    let marks = Marks::load(&clip.dir.join("marks.json")).map_err(ExitError::failed)?;
+    let clicked = clicked_marks(&marks, CLICK_NOISE_PX, &clip.name);
+    let mut video = Video::open(&clip.dir.join("video.mp4"), &OpenOptions::default())
+        .map_err(ExitError::failed)?;
+    let vba: Tracks2d = track_opened(&mut video, &clicked, threads, params)?;
+    let keys = KeyFrames::from_marks(&clicked);
+    let t0 = Instant::now();
+    let net = run_network(&mut video, &vba, network, &keys, &AtomicBool::new(false))
+        .map_err(ExitError::failed)?;
+    *net_seconds += t0.elapsed().as_secs_f64();
+    let alone = network_alone(&mut video, &clicked, network)?;
+    let mut scores = vec![
+        pair(&score_tracks(&gt, &vba).map_err(ExitError::failed)?),
+        pair(&score_positions(&gt, alone.into_iter()).map_err(ExitError::failed)?),
+    ];
+    for p in settings {
+        let together = weigh(&vba, &net, &keys, p);
+        scores.push(pair(
+            &score_tracks(&gt, &together).map_err(ExitError::failed)?,
+        ));
+    }
+    Ok(scores)
+}
