@@ -97,7 +97,10 @@ fn trunk_frame(j: &PerJoint<NetJoint>) -> Option<(Rotation2<f64>, f64)> {
 }
 
 /// Per joint, the mean offset from the network's landmark to the user's joint over the key
-/// frames, in the trunk's frame over the torso length.
+/// frames, in the trunk's frame over the torso length: for the trunk, the shoulders and the
+/// hips, which a user marks elsewhere than the network puts them; none for the elbows, wrists,
+/// knees and ankles, which sit where the network's do (an offset read on one frame and turned
+/// with the trunk moved them off; dev 0.829 → see `docs/method.md`).
 fn key_offsets(net: &NetworkFrames, tracks: &Tracks2d, keys: &KeyFrames) -> PerJoint<Vector2<f64>> {
     let mut sum = PerJoint::from_fn(|_| (Vector2::zeros(), 0.0));
     for (frame, joints) in &keys.frames {
@@ -110,7 +113,7 @@ fn key_offsets(net: &NetworkFrames, tracks: &Tracks2d, keys: &KeyFrames) -> PerJ
         let Some((rot, torso)) = trunk_frame(pose) else {
             continue;
         };
-        for j in Joint::ALL {
+        for j in Joint::ALL.into_iter().filter(|&j| carries_offset(j)) {
             if let Some(mark) = joints[j] {
                 let local = rot.inverse() * (mark - pose[j].pos) / torso;
                 sum[j].0 += local;
@@ -119,6 +122,15 @@ fn key_offsets(net: &NetworkFrames, tracks: &Tracks2d, keys: &KeyFrames) -> PerJ
         }
     }
     sum.map(|_, &(s, n)| if n > 0.0 { s / n } else { Vector2::zeros() })
+}
+
+/// Whether the network's joint is defined elsewhere than the user's (see [`key_offsets`]).
+fn carries_offset(j: Joint) -> bool {
+    use Joint::*;
+    matches!(
+        j,
+        HeadTop | Neck | Chest | Pelvis | LeftShoulder | RightShoulder | LeftHip | RightHip
+    )
 }
 
 /// The joint on the body's other side (itself for the trunk's).
