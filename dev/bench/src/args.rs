@@ -201,8 +201,8 @@ pub struct BenchArgs {
     /// clip of the split).
     #[arg(long)]
     pub clip: Option<String>,
-    /// `learned` only: evidence settings to sweep (dev), `A,B,C,D,E;…` = VBA doubt, network
-    /// doubt, swap cost, motion, key fade frames.
+    /// `learned` only: evidence settings to sweep (dev), `A,B,C,D,E,F;…` = VBA doubt, network
+    /// doubt, swap cost, motion, key fade frames, jump cap (torso lengths).
     #[arg(long)]
     pub evidence: Option<String>,
     /// `bench lift` only: leave out input (c), the tracker's output (tracking is most of the

@@ -9,8 +9,8 @@
 //!   following the network's own previous pose from the marks (VBA's body where it finds no
 //!   person).
 //!
-//! `--evidence A,B,C,D,E[;…]` (dev only, for sweeps) weighs with other settings
-//! (`EvidenceParams`: VBA doubt, network doubt, swap cost, motion, key fade frames).
+//! `--evidence A,B,C,D,E,F[;…]` (dev only, for sweeps) weighs with other settings
+//! (`EvidenceParams`: VBA doubt, network doubt, swap cost, motion, key fade frames, jump cap).
 
 use crate::args::{BenchArgs, GlobalArgs};
 use crate::bench_suite::{BenchClip, Tally, bench_clips};
@@ -51,9 +51,17 @@ fn sweep(text: Option<&str>) -> Result<Vec<EvidenceParams>, ExitError> {
                 .map(|x| x.trim().parse::<f64>())
                 .collect::<Result<_, _>>()
                 .map_err(|e| ExitError::bad_input(anyhow!("--evidence {set}: {e}")))?;
-            let [vba_doubt, net_doubt, swap_cost, motion, key_fade_frames] = v[..] else {
+            let [
+                vba_doubt,
+                net_doubt,
+                swap_cost,
+                motion,
+                key_fade_frames,
+                jump_cap_torso,
+            ] = v[..]
+            else {
                 return Err(ExitError::bad_input(anyhow!(
-                    "--evidence {set}: expected five numbers"
+                    "--evidence {set}: expected six numbers"
                 )));
             };
             Ok(EvidenceParams {
@@ -62,6 +70,7 @@ fn sweep(text: Option<&str>) -> Result<Vec<EvidenceParams>, ExitError> {
                 swap_cost,
                 motion,
                 key_fade_frames,
+                jump_cap_torso,
             })
         })
         .collect()

@@ -17,28 +17,32 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// How the evidence is weighed. Costs are in the unit of one torso² of motion between frames.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EvidenceParams {
-    /// Weight of VBA's doubt (1 − its reliability). Default 0.5 (dev sweep, `docs/method.md`).
+    /// Weight of VBA's doubt (1 − its reliability). Default 2 (dev sweep, `docs/method.md`).
     pub vba_doubt: f64,
-    /// Weight of the network's doubt (1 − its confidence). Default 1.
+    /// Weight of the network's doubt (1 − its confidence). Default 0.5.
     pub net_doubt: f64,
     /// Extra cost of taking the network's other-side joint (a left/right swap of its own).
-    /// Default 0.3.
+    /// Default 1.
     pub swap_cost: f64,
     /// Weight of a joint's squared move between frames, per torso². Default 4.
     pub motion: f64,
     /// Frames over which a key's certainty fades for VBA (its track is exact at the key).
     /// Default 8.
     pub key_fade_frames: f64,
+    /// Moves longer than this (torso lengths) cost no more: a switch between two candidates
+    /// far apart is one jump, not a reason to stay with a track that drifted. Default 0.5.
+    pub jump_cap_torso: f64,
 }
 
 impl Default for EvidenceParams {
     fn default() -> Self {
         EvidenceParams {
-            vba_doubt: 0.5,
-            net_doubt: 1.0,
-            swap_cost: 0.3,
+            vba_doubt: 2.0,
+            net_doubt: 0.5,
+            swap_cost: 1.0,
             motion: 4.0,
             key_fade_frames: 8.0,
+            jump_cap_torso: 0.5,
         }
     }
 }
@@ -233,7 +237,7 @@ pub fn weigh(
             })
             .collect();
         let torso: Vec<f64> = tracks.frames.iter().map(|f| f.torso_px()).collect();
-        let chosen = choose(&candidates, &torso, params.motion);
+        let chosen = choose(&candidates, &torso, params);
         for (t, c) in chosen.into_iter().enumerate() {
             if c.from_network {
                 out.frames[t].points[j] = TrackedPoint {
@@ -248,8 +252,8 @@ pub fn weigh(
 }
 
 /// The cheapest path through the candidates (Viterbi): each candidate's own cost plus
-/// `motion` × the squared move between frames over the torso.
-fn choose(candidates: &[Vec<Candidate>], torso: &[f64], motion: f64) -> Vec<Candidate> {
+/// `motion` × the squared move (capped at `jump_cap_torso`) between frames over the torso.
+fn choose(candidates: &[Vec<Candidate>], torso: &[f64], params: &EvidenceParams) -> Vec<Candidate> {
     let n = candidates.len();
     if n == 0 {
         return Vec::new();
@@ -265,8 +269,8 @@ fn choose(candidates: &[Vec<Candidate>], torso: &[f64], motion: f64) -> Vec<Cand
                 .iter()
                 .enumerate()
                 .map(|(k, p)| {
-                    let d = (c.pos - p.pos).norm() / scale;
-                    (cost[t - 1][k] + motion * d * d, k)
+                    let d = ((c.pos - p.pos).norm() / scale).min(params.jump_cap_torso);
+                    (cost[t - 1][k] + params.motion * d * d, k)
                 })
                 .fold((f64::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a });
             row.push(best + c.cost);
