@@ -12,21 +12,11 @@ use videomocap_core::video::{OpenOptions, Video};
 use videomocap_testkit::eval::{ClipScore, score_tracks};
 use videomocap_testkit::synth::{
     GroundTruth, MotionSource, ProceduralMotion, SynthParams, VideoOutput, View, render_clip,
+    render_small_clip,
 };
 
 fn render(dir: &Path, motion: ProceduralMotion, frames: usize, view: View) {
-    let params = SynthParams {
-        motion: MotionSource::Procedural(motion),
-        frames,
-        view,
-        width: 320,
-        height: 240,
-        focal_px: 300.0,
-        person_px: 200.0,
-        output: VideoOutput::PngSequence,
-        ..SynthParams::default()
-    };
-    render_clip(&params, dir, &mut |_, _| {}, &AtomicBool::new(false)).unwrap();
+    render_small_clip(dir, motion, frames, view).unwrap();
 }
 
 /// A motion-capture file of `tests/data`, from its start.

@@ -1,27 +1,13 @@
 //! `videomocap track` end to end: marks, keys with a correction, and a project re-tracked.
 
 use assert_cmd::Command;
-use std::sync::atomic::AtomicBool;
 use videomocap_core::formats::{Marks, Tracks2d};
 use videomocap_core::skeleton::Joint;
-use videomocap_testkit::synth::{
-    MotionSource, ProceduralMotion, SynthParams, VideoOutput, View, render_clip,
-};
+use videomocap_testkit::synth::{ProceduralMotion, View, render_small_clip};
 
 /// A 320×240 PNG sequence of `frames` frames of `motion` seen from `view`, with its marks.
 fn render(dir: &std::path::Path, motion: ProceduralMotion, frames: usize, view: View) {
-    let params = SynthParams {
-        motion: MotionSource::Procedural(motion),
-        frames,
-        view,
-        width: 320,
-        height: 240,
-        focal_px: 300.0,
-        person_px: 200.0,
-        output: VideoOutput::PngSequence,
-        ..SynthParams::default()
-    };
-    render_clip(&params, dir, &mut |_, _| {}, &AtomicBool::new(false)).unwrap();
+    render_small_clip(dir, motion, frames, view).unwrap();
 }
 
 #[test]

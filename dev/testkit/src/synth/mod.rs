@@ -651,6 +651,28 @@ fn round6(v: f64) -> f64 {
     (v * 1e6).round() / 1e6
 }
 
+/// A quick test's clip in `dir`: `frames` frames of `motion` seen from `view`, 320×240 PNGs,
+/// focal 300 px, the person 200 px tall, the mannequin (with `gt.json` and `marks.json`).
+pub fn render_small_clip(
+    dir: &Path,
+    motion: ProceduralMotion,
+    frames: usize,
+    view: View,
+) -> Result<SynthResult, SynthError> {
+    let params = SynthParams {
+        motion: MotionSource::Procedural(motion),
+        frames,
+        view,
+        width: 320,
+        height: 240,
+        focal_px: 300.0,
+        person_px: 200.0,
+        output: VideoOutput::PngSequence,
+        ..SynthParams::default()
+    };
+    render_clip(&params, dir, &mut |_, _| {}, &AtomicBool::new(false))
+}
+
 /// Writes frames to an MP4 or a PNG directory.
 enum FrameSink {
     Mp4(videomocap_core::video::Mp4Writer),
