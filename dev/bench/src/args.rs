@@ -205,6 +205,15 @@ pub struct BenchArgs {
     /// doubt, swap cost, motion, key fade frames, jump cap (torso lengths).
     #[arg(long)]
     pub evidence: Option<String>,
+    /// `learned` only: keep each clip's VBA tracks and network output in its folder
+    /// (`learned-vba.json`, `learned-net.json`) and read them back when there, for sweeps of the weighing alone.
+    /// Stale after any change to the tracker or the network: delete the files then.
+    #[arg(long)]
+    pub reuse: bool,
+    /// `correct` only: track as the product does, with the pose network's evidence (without
+    /// it, VBA alone).
+    #[arg(long)]
+    pub network: bool,
     /// `bench lift` only: leave out input (c), the tracker's output (tracking is most of the
     /// bench's time; for quick looks at the lift from true and noisy 2D).
     #[arg(long)]

@@ -54,6 +54,7 @@ fn correct_clip(
     rounds: usize,
     threads: usize,
     params: TrackerParams,
+    network: Option<std::sync::Arc<videomocap_core::network::PoseNetwork>>,
 ) -> Result<Rounds, ExitError> {
     let dir = &clip.dir;
     let gt = GroundTruth::load(&dir.join("gt.json")).map_err(ExitError::failed)?;
@@ -66,13 +67,14 @@ fn correct_clip(
         Video::open(&dir.join("video.mp4"), &OpenOptions::default()).map_err(ExitError::failed)?;
     let first = track_video(
         &mut video,
-        &TrackJob::from_marks(&marks, params, threads),
+        &TrackJob::from_marks(&marks, params, threads).with_network(network.clone()),
         &mut |_| {},
         &AtomicBool::new(false),
     )
     .map_err(ExitError::failed)?;
     let mut tracks = first.tracks;
     let background = first.background;
+    let mut seen = first.network;
     let mut keys = KeyFrames::from_marks(&marks);
     let mut done = BTreeSet::from([marks.frame]);
     let score = |tracks: &Tracks2d| -> Result<Accuracy, ExitError> {
@@ -109,6 +111,8 @@ fn correct_clip(
             from: Some(c.frame),
             previous: Some(tracks),
             background: background.clone(),
+            network: network.clone(),
+            previous_network: seen.take(),
         };
         // The re-track changes nothing before this (those frames stay drawn as they were).
         let low = keys.earliest_changed_by(c.frame);
@@ -127,9 +131,10 @@ fn correct_clip(
                 }
             }
         };
-        tracks = track_video(&mut video, &job, &mut on_progress, &AtomicBool::new(false))
-            .map_err(ExitError::failed)?
-            .tracks;
+        let result = track_video(&mut video, &job, &mut on_progress, &AtomicBool::new(false))
+            .map_err(ExitError::failed)?;
+        tracks = result.tracks;
+        seen = result.network;
         out.redraw_s
             .push(arrived_s.unwrap_or_else(|| started.elapsed().as_secs_f64()));
         out.scores.push(score(&tracks)?);
@@ -172,13 +177,21 @@ fn cell(s: &[Accuracy; 3]) -> String {
 pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let (threads, params) = threads_and_settings(a)?;
     let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;
+    let network = a
+        .network
+        .then(|| {
+            videomocap_core::network::PoseNetwork::bundled()
+                .map(|n| std::sync::Arc::new(n.with_threads(threads)))
+        })
+        .transpose()
+        .map_err(ExitError::failed)?;
     let mut results = Vec::with_capacity(clips.len());
     let mut tally: Tally<[Accuracy; 3]> = Tally::default();
     for clip in &clips {
         say(global, &format!("correcting {}", clip.name));
         let gt = GroundTruth::load(&clip.dir.join("gt.json")).map_err(ExitError::failed)?;
         let budget = gt.frames.len().div_ceil(FRAMES_PER_CORRECTION).max(1);
-        let r = correct_clip(clip, budget, threads, params)?;
+        let r = correct_clip(clip, budget, threads, params, network.clone())?;
         tally.add(clip, &[r.scores[0], *at_round(&r, budget), r.template]);
         results.push((budget, r));
     }
@@ -188,7 +201,12 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
              joint over 0.2 torso off, drags every joint there over 0.1 torso off onto the \
              reference and re-tracks; one round per {FRAMES_PER_CORRECTION} \
              frames of clip. Columns: PCK@0.2 and lost before any correction, then after them, then \
-             the fixed template's PCK@0.2 from the same marks (uncorrected)"
+             the fixed template's PCK@0.2 from the same marks (uncorrected). Tracker: {}",
+            if a.network {
+                "VBA with the pose network's evidence (--network, the product's default)"
+            } else {
+                "VBA alone"
+            }
         ),
         String::new(),
     ];

@@ -3,11 +3,12 @@
 //! limb joints and of all 16, and the network's time per frame.
 //!
 //! - VBA alone: the tracker from the clicked marks.
-//! - The network alone: each frame cropped around the network's own previous pose (the clicked
-//!   marks on the first frame), its joints as it maps them (`network`), no VBA.
-//! - Together: VBA's tracks with the network's evidence weighed in (`track::weigh`), the crops
-//!   following the network's own previous pose from the marks (VBA's body where it finds no
-//!   person).
+//! - The network alone: each frame cropped where the network proposed on the frame before (its
+//!   tracking region; the clicked marks on the first frame), its joints as it maps them
+//!   (`network`), no VBA.
+//! - Together: what the product tracks, `track_video` with the network (VBA's passes, the
+//!   network's evidence weighed in, then weak runs filled); with `--evidence`, each setting of
+//!   the weighing (`track::weigh`) applied to VBA's finished tracks besides.
 //!
 //! `--evidence A,B,C,D,E,F[;…]` (dev only, for sweeps) weighs with other settings
 //! (`EvidenceParams`: VBA doubt, network doubt, swap cost, motion, key fade frames, jump cap).
@@ -18,12 +19,15 @@ use crate::bench_track::{threads_and_settings, track_opened};
 use crate::{ExitError, say};
 use anyhow::anyhow;
 use nalgebra::Point2;
+use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
-use videomocap_core::formats::{KeyFrames, Marks, Tracks2d};
+use videomocap_core::formats::{KeyFrames, Marks, PointSource, Tracks2d};
 use videomocap_core::network::{Crop, PoseNetwork};
-use videomocap_core::skeleton::PerJoint;
-use videomocap_core::track::{EvidenceParams, run_network, weigh};
+use videomocap_core::skeleton::{Joint, PerJoint};
+use videomocap_core::track::{
+    EvidenceParams, NetworkFrames, TrackJob, run_network, track_video, weigh,
+};
 use videomocap_core::video::{OpenOptions, Video};
 use videomocap_testkit::eval::suite::{CLICK_NOISE_PX, clicked_marks};
 use videomocap_testkit::eval::{Accuracy, ClipScore, score_positions, score_tracks};
@@ -32,8 +36,55 @@ use videomocap_testkit::synth::GroundTruth;
 /// Limb joints and all 16 of one method.
 type Pair = [Accuracy; 2];
 
-/// One clip's scores: VBA alone, the network alone, then together for each setting swept.
-type Scores = Vec<Pair>;
+/// One clip's scores (VBA alone, the network alone, together, then each setting swept) and
+/// how well VBA's and together's reliabilities point at their errors.
+type Scores = (Vec<Pair>, [Pointing; 2]);
+
+/// Joint-frames (keys left out) more than 0.2 torso off, shown weak (reliability under the
+/// tracker's weak threshold, or not tracked: interpolated, lost, off the frame), and both.
+#[derive(Debug, Clone, Copy, Default)]
+struct Pointing {
+    off: usize,
+    shown: usize,
+    both: usize,
+}
+
+impl crate::bench_suite::Merge for Pointing {
+    fn merge_from(&mut self, o: &Self) {
+        self.off += o.off;
+        self.shown += o.shown;
+        self.both += o.both;
+    }
+}
+
+impl Pointing {
+    fn of(gt: &GroundTruth, tracks: &Tracks2d, keys: &KeyFrames, weak: f32) -> Pointing {
+        let mut p = Pointing::default();
+        for (g, f) in gt.frames.iter().zip(&tracks.frames) {
+            let at = |j: Joint| Point2::new(g.points2d[j.index()][0], g.points2d[j.index()][1]);
+            let torso = (at(Joint::Neck) - at(Joint::Pelvis)).norm().max(1.0);
+            for j in Joint::ALL.into_iter().filter(|&j| !keys.is_key(f.index, j)) {
+                let q = f.points[j];
+                let off = (q.pos - at(j)).norm() > 0.2 * torso;
+                let shown = q.source != PointSource::Tracked || q.confidence < weak;
+                p.off += usize::from(off);
+                p.shown += usize::from(shown);
+                p.both += usize::from(off && shown);
+            }
+        }
+        p
+    }
+
+    /// Recall and precision.
+    fn cell(&self) -> String {
+        let share = |a: usize, b: usize| a as f64 / b.max(1) as f64;
+        format!(
+            "{:>6.2} {:>9.2}",
+            share(self.both, self.off),
+            share(self.both, self.shown)
+        )
+    }
+}
 
 fn pair(s: &ClipScore) -> Pair {
     [s.limbs(), s.overall]
@@ -79,25 +130,23 @@ fn sweep(text: Option<&str>) -> Result<Vec<EvidenceParams>, ExitError> {
 /// One frame's joints: (frame, positions).
 type Positions = (usize, PerJoint<Point2<f64>>);
 
-/// The network alone: crops following its own previous pose from the clicked marks.
+/// The network alone: crops where it proposed on the frame before, from the clicked marks.
 fn network_alone(
     video: &mut Video,
     marks: &Marks,
     network: &PoseNetwork,
 ) -> Result<Vec<Positions>, ExitError> {
-    let mut body = marks.points;
+    let mut crop = Crop::around(&marks.points);
     let mut out = Vec::new();
     for index in 0..video.info().frame_count {
         let frame = video.frame(index).map_err(ExitError::failed)?;
-        let Some(crop) = Crop::around(&body) else {
+        let Some(c) = crop else {
             break;
         };
-        let pose = network
-            .run(&frame.image, &crop)
-            .map_err(ExitError::failed)?;
+        let pose = network.run(&frame.image, &c).map_err(ExitError::failed)?;
         if pose.presence >= 0.5 {
-            body = pose.joints.map(|_, j| j.pos);
-            out.push((index, body));
+            out.push((index, pose.joints.map(|_, j| j.pos)));
+            crop = pose.next_crop.or(crop);
         } else {
             // No person: every joint lost on this frame; the crop stays where it was.
             out.push((index, PerJoint::from_fn(|_| Point2::new(-1.0e4, -1.0e4))));
@@ -111,7 +160,11 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let (threads, params) = threads_and_settings(a)?;
     let settings = sweep(a.evidence.as_deref())?;
     let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;
-    let network = PoseNetwork::bundled().map_err(ExitError::failed)?;
+    let network = Arc::new(
+        PoseNetwork::bundled()
+            .map_err(ExitError::failed)?
+            .with_threads(threads),
+    );
     let mut tally: Tally<Scores> = Tally::default();
     let mut lines = vec![format!(
         "{:<26} {:<5} limbs PCK@0.2: {:>6} {:>6} {:>9}",
@@ -120,34 +173,58 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let (mut net_seconds, mut net_frames) = (0.0, 0usize);
     for clip in &clips {
         say(global, &format!("{} …", clip.name));
-        let s = score_clip(clip, threads, params, &network, &settings, &mut net_seconds)?;
+        let s = score_clip(
+            clip,
+            threads,
+            params,
+            network.clone(),
+            &settings,
+            &mut net_seconds,
+            a.reuse,
+        )?;
         net_frames += count_frames(clip)?;
         lines.push(format!(
             "{:<26} {:<5}               {:>6.3} {:>6.3} {:>9.3}",
             clip.name,
             clip.split.name(),
-            s[0][0].pck02(),
-            s[1][0].pck02(),
-            s[2][0].pck02()
+            s.0[0][0].pck02(),
+            s.0[1][0].pck02(),
+            s.0[2][0].pck02()
         ));
         tally.add(clip, &s);
     }
     lines.push(String::new());
     lines.push(format!(
-        "13 limb joints, PCK@0.2 / lost; marks clicked with {CLICK_NOISE_PX} px of noise; together with {:?}",
-        settings[0]
+        "13 limb joints, PCK@0.2 / lost; marks clicked with {CLICK_NOISE_PX} px of noise; together: {}",
+        if a.reuse {
+            "the default weighing of the cached tracks"
+        } else {
+            "track_video with the network (the product)"
+        }
     ));
     lines.extend(Tally::<Scores>::heading(WIDTH, COLUMNS));
-    lines.extend(tally.lines(WIDTH, |s| cell(s, 0, 2)));
+    lines.extend(tally.lines(WIDTH, |s| cell(&s.0, 0, 2)));
     lines.push(String::new());
     lines.push("all 16 joints, PCK@0.2 / lost".to_owned());
     lines.extend(Tally::<Scores>::heading(WIDTH, COLUMNS));
-    lines.extend(tally.lines(WIDTH, |s| cell(s, 1, 2)));
+    lines.extend(tally.lines(WIDTH, |s| cell(&s.0, 1, 2)));
+    lines.push(String::new());
+    lines.push(
+        "reliability: of the joint-frames over 0.2 torso off (keys left out), the share shown weak (recall), and of those shown weak, the share off (precision); all 16 joints"
+            .to_owned(),
+    );
+    lines.extend(Tally::<Scores>::heading(
+        WIDTH,
+        "VBA recall precision  together recall precision",
+    ));
+    lines.extend(tally.lines(WIDTH, |s| {
+        format!("{}  {}   ", s.1[0].cell(), s.1[1].cell())
+    }));
     if settings.len() > 1 {
         lines.push(String::new());
         lines.push("together, each setting swept (13 limb joints, PCK@0.2 / lost)".to_owned());
         for (k, p) in settings.iter().enumerate() {
-            let line = tally.lines(WIDTH, |s| cell(s, 0, 2 + k));
+            let line = tally.lines(WIDTH, |s| cell(&s.0, 0, 3 + k));
             if let Some(overall) = line.last() {
                 lines.push(format!("{p:?}"));
                 lines.push(overall.clone());
@@ -173,7 +250,7 @@ const COLUMNS: &str = "  VBA   lost    net   lost  together";
 
 /// One split's column: VBA, the network and together (`k`-th setting), accuracy `which`
 /// (0 limbs, 1 all).
-fn cell(s: &Scores, which: usize, together: usize) -> String {
+fn cell(s: &[Pair], which: usize, together: usize) -> String {
     let t = s.get(together).map_or(Accuracy::default(), |p| p[which]);
     format!(
         "{:>5.3} {:>5.1}% {:>6.3} {:>5.1}% {:>5.3} {:>3.0}%",
@@ -184,6 +261,14 @@ fn cell(s: &Scores, which: usize, together: usize) -> String {
         t.pck02(),
         100.0 * t.lost()
     )
+}
+
+/// What `--reuse` keeps of a clip beside VBA's tracks: the network beside them, the network
+/// alone.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Cached {
+    net: NetworkFrames,
+    alone: Vec<Positions>,
 }
 
 fn count_frames(clip: &BenchClip) -> Result<usize, ExitError> {
@@ -197,31 +282,88 @@ fn score_clip(
     clip: &BenchClip,
     threads: usize,
     params: videomocap_core::track::TrackerParams,
-    network: &PoseNetwork,
+    network: Arc<PoseNetwork>,
     settings: &[EvidenceParams],
     net_seconds: &mut f64,
+    reuse: bool,
 ) -> Result<Scores, ExitError> {
     let gt = GroundTruth::load(&clip.dir.join("gt.json")).map_err(ExitError::failed)?;
     let marks = Marks::load(&clip.dir.join("marks.json")).map_err(ExitError::failed)?;
     let clicked = clicked_marks(&marks, CLICK_NOISE_PX, &clip.name);
-    let mut video = Video::open(&clip.dir.join("video.mp4"), &OpenOptions::default())
-        .map_err(ExitError::failed)?;
-    let vba: Tracks2d = track_opened(&mut video, &clicked, threads, params)?;
     let keys = KeyFrames::from_marks(&clicked);
-    let t0 = Instant::now();
-    let net = run_network(&mut video, &vba, network, &keys, &AtomicBool::new(false))
-        .map_err(ExitError::failed)?;
-    *net_seconds += t0.elapsed().as_secs_f64();
-    let alone = network_alone(&mut video, &clicked, network)?;
+    let (vba_path, net_path) = (
+        clip.dir.join("learned-vba.json"),
+        clip.dir.join("learned-net.json"),
+    );
+    let cached = reuse
+        .then(|| {
+            let vba = Tracks2d::load(&vba_path).ok()?;
+            let bytes = std::fs::read(&net_path).ok()?;
+            let c: Cached = serde_json::from_slice(&bytes).ok()?;
+            Some((vba, c))
+        })
+        .flatten();
+    let (vba, Cached { net, alone }) = match cached {
+        Some(c) => c,
+        None => {
+            let mut video = Video::open(&clip.dir.join("video.mp4"), &OpenOptions::default())
+                .map_err(ExitError::failed)?;
+            let vba: Tracks2d = track_opened(&mut video, &clicked, threads, params)?;
+            let t0 = Instant::now();
+            let net = run_network(
+                &mut video,
+                &vba,
+                &network,
+                &keys,
+                None,
+                &mut || {},
+                &AtomicBool::new(false),
+            )
+            .map_err(ExitError::failed)?;
+            *net_seconds += t0.elapsed().as_secs_f64();
+            let alone = network_alone(&mut video, &clicked, &network)?;
+            let c = Cached { net, alone };
+            if reuse {
+                vba.save(&vba_path).map_err(ExitError::failed)?;
+                let bytes = serde_json::to_vec(&c).map_err(|e| ExitError::failed(anyhow!(e)))?;
+                std::fs::write(&net_path, bytes).map_err(ExitError::failed)?;
+            }
+            (vba, c)
+        }
+    };
+    // Together as the product tracks (`track_video` with the network), unless only the
+    // weighing is swept from the caches.
+    let product = if reuse {
+        weigh(&vba, &net, &keys, &EvidenceParams::default())
+    } else {
+        let mut video = Video::open(&clip.dir.join("video.mp4"), &OpenOptions::default())
+            .map_err(ExitError::failed)?;
+        let job = TrackJob::from_marks(&clicked, params, threads).with_network(Some(network));
+        track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false))
+            .map_err(ExitError::failed)?
+            .tracks
+    };
+    let weak = params.weak_reliability;
+    let pointing = [
+        Pointing::of(&gt, &vba, &keys, weak),
+        Pointing::of(&gt, &product, &keys, weak),
+    ];
     let mut scores = vec![
         pair(&score_tracks(&gt, &vba).map_err(ExitError::failed)?),
         pair(&score_positions(&gt, alone.into_iter()).map_err(ExitError::failed)?),
+        pair(&score_tracks(&gt, &product).map_err(ExitError::failed)?),
     ];
-    for p in settings {
+    for (k, p) in settings.iter().enumerate() {
         let together = weigh(&vba, &net, &keys, p);
+        if reuse && k == 0 {
+            // For looking at the first setting's choices beside the caches.
+            together
+                .save(&clip.dir.join("learned-together.json"))
+                .map_err(ExitError::failed)?;
+        }
         scores.push(pair(
             &score_tracks(&gt, &together).map_err(ExitError::failed)?,
         ));
     }
-    Ok(scores)
+    Ok((scores, pointing))
 }

@@ -398,6 +398,7 @@ impl State {
         ));
         self.project = Some(Project::new(path.to_owned()));
         self.background = None;
+        self.network_seen = None;
         self.results_changed();
         self.status = format!("Opening {}…", path.display());
     }
@@ -411,6 +412,7 @@ impl State {
         self.volume = None;
         self.project = None;
         self.background = None;
+        self.network_seen = None;
         self.project_path = None;
         self.history.clear();
         self.results_changed();

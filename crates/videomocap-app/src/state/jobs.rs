@@ -3,16 +3,32 @@
 //! when their cancel flag is set.
 
 use std::path::PathBuf;
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, channel};
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 use videomocap_core::formats::{FrameTracks, Tracks2d};
 use videomocap_core::lift::{DepthOverrides, LiftJob, LiftOutput, LiftParams, lift};
 use videomocap_core::lift::{SubjectFit, subject_from_height};
+use videomocap_core::network::PoseNetwork;
 use videomocap_core::track::{TrackJob, TrackOutput, track_video};
 use videomocap_core::video::{OpenOptions, Video};
 use videomocap_volume::{Processed, VolumeParams, process_directory};
+
+/// The bundled pose network, loaded once on first use (about a second); `None`, with the
+/// reason on stderr, when it cannot be used: tracking goes on with VBA alone.
+fn pose_network(threads: usize) -> Option<Arc<PoseNetwork>> {
+    static NETWORK: OnceLock<Option<Arc<PoseNetwork>>> = OnceLock::new();
+    NETWORK
+        .get_or_init(|| match PoseNetwork::bundled() {
+            Ok(n) => Some(Arc::new(n.with_threads(threads))),
+            Err(e) => {
+                eprintln!("warning: {e}; tracking with VBA alone");
+                None
+            }
+        })
+        .clone()
+}
 
 /// What a job sends back.
 pub enum JobEvent {
@@ -48,11 +64,14 @@ pub struct Job {
 
 impl Job {
     /// Tracks `video` on a worker thread.
-    pub fn track(video: PathBuf, job: TrackJob, ctx: egui::Context) -> Job {
+    pub fn track(video: PathBuf, mut job: TrackJob, ctx: egui::Context) -> Job {
         let (tx, rx) = channel();
         let cancel = Arc::new(AtomicBool::new(false));
         let flag = cancel.clone();
         std::thread::spawn(move || {
+            if job.params.network && job.network.is_none() {
+                job.network = pose_network(job.threads);
+            }
             let result = Video::open(&video, &OpenOptions::default())
                 .map_err(|e| e.to_string())
                 .and_then(|mut v| {

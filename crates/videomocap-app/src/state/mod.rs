@@ -118,6 +118,9 @@ pub struct State {
     partial: BTreeMap<usize, FrameTracks>,
     /// The background the last tracking run of this video found (a re-track reuses it).
     background: Option<videomocap_core::track::KnownBackground>,
+    /// What the pose network saw in the last tracking run of this video (a re-track runs it
+    /// again only where a crop moved).
+    network_seen: Option<videomocap_core::track::NetworkFrames>,
     spans: Vec<WeakSpan>,
     strips: Option<Strips>,
     choices: Vec<LiftChoices>,
@@ -179,6 +182,7 @@ impl State {
             running: None,
             partial: BTreeMap::new(),
             background: None,
+            network_seen: None,
             spans: Vec::new(),
             strips: None,
             choices: Vec::new(),
@@ -487,6 +491,7 @@ impl State {
     fn set_project(&mut self, p: Project) {
         self.project = Some(p);
         self.background = None;
+        self.network_seen = None;
         self.subject_fit = None;
         self.history.clear();
         self.results_changed();

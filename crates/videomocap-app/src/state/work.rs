@@ -37,6 +37,9 @@ impl State {
             from: from.filter(|_| p.tracks.is_some()),
             previous: p.tracks.as_deref().cloned(),
             background: self.background.clone(),
+            // The network is loaded on the job's thread (see `Job::track`).
+            network: None,
+            previous_network: self.network_seen.clone(),
         };
         self.running = Some(Running {
             job: Job::track(p.video.clone(), job, self.ctx.clone()),
@@ -221,6 +224,7 @@ impl State {
                     p.skeleton = None;
                 }
                 self.background = out.background;
+                self.network_seen = out.network;
                 self.dirty = true;
                 self.autosave();
                 self.results_changed();

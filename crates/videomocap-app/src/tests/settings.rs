@@ -102,12 +102,13 @@ fn the_background_weight_is_an_undoable_tracker_setting() {
     assert_eq!(now(&h), d.arm_foreground, "undone");
 }
 
-/// The tracker's switches (the hip patch, the chain refinement) can each be turned off from the
+/// The tracker's switches (the pose network, the hip patch, the chain refinement) can each be turned off from the
 /// Parameters panel, and each is an undoable project setting.
 #[test]
 fn each_tracker_switch_is_an_undoable_setting() {
     type Get = fn(&TrackerParams) -> bool;
-    let switches: [(&str, Get); 2] = [
+    let switches: [(&str, Get); 3] = [
+        ("use the pose network", |t| t.network),
         ("hold the hips when the back bends", |t| t.hip_patch),
         ("refine each limb as one chain", |t| t.chain_refine),
     ];

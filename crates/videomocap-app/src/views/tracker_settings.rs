@@ -11,6 +11,8 @@ fn on_off(b: bool) -> &'static str {
 /// Edits `t` in place; the caller turns the change into an undoable edit.
 pub fn tracker_settings_ui(ui: &mut egui::Ui, t: &mut TrackerParams) {
     let d = TrackerParams::default();
+    ui.checkbox(&mut t.network, "use the pose network")
+        .on_hover_text(format!("A pose network (BlazePose, run on this computer) looks at every frame around the person you marked; where it sees a joint elsewhere than the tracker and is sure, its place is taken. Your marks and corrections always win. Off: the tracker alone; default {}", on_off(d.network)));
     ui.add(egui::Slider::new(&mut t.weak_reliability, 0.0..=1.0).text("weak below"))
         .on_hover_text(format!("Reliability under which a joint counts as weak (orange) and may be interpolated; default {}", d.weak_reliability));
     ui.add(egui::Slider::new(&mut t.max_gap_s, 0.0..=2.0).text("interpolate up to (s)"))

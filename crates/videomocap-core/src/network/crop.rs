@@ -14,7 +14,7 @@ pub const INPUT_PX: usize = 256;
 const MARGIN: f64 = 1.25;
 
 /// A square region of a frame, turned by `angle_rad`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Crop {
     /// Centre, image pixels.
     pub centre: Point2<f64>,
@@ -26,11 +26,28 @@ pub struct Crop {
 
 impl Crop {
     /// The crop around a body whose joints (image pixels) are `points`: centred on the pelvis,
-    /// up along pelvis → head top, wide enough for the whole body. `None` when the two
-    /// coincide.
+    /// up along pelvis → head top, wide enough for the whole body (every joint within the
+    /// circle the crop is made from, so a body bent over towards the camera, its head near its
+    /// pelvis, is not cut to its trunk). `None` when the head top and pelvis coincide.
     pub fn around(points: &PerJoint<Point2<f64>>) -> Option<Crop> {
         let pelvis = points[Joint::Pelvis];
         let up = points[Joint::HeadTop] - pelvis;
+        let reach = points
+            .iter()
+            .map(|(_, p)| (p - pelvis).norm())
+            .fold(0.0, f64::max);
+        let norm = up.norm();
+        if !(norm.is_finite() && norm > 1.0 && reach.is_finite()) {
+            return None;
+        }
+        Self::aligned(pelvis, pelvis + up * (reach / norm))
+    }
+
+    /// The crop centred on `centre`, its up axis along `centre → top`, its side 2 × 1.25 times
+    /// that distance (MediaPipe's alignment-point region). `None` when the two coincide.
+    pub fn aligned(centre: Point2<f64>, top: Point2<f64>) -> Option<Crop> {
+        let pelvis = centre;
+        let up = top - pelvis;
         let reach = up.norm();
         if !(reach.is_finite() && reach > 1.0) {
             return None;
@@ -42,6 +59,15 @@ impl Crop {
             side_px: 2.0 * reach * MARGIN,
             angle_rad,
         })
+    }
+
+    /// Whether `other` frames the same region within a hundredth of the side (centre and
+    /// side) and a hundredth of a radian: the network would see the same picture.
+    pub fn same_as(&self, other: &Crop) -> bool {
+        let tol = 0.01 * self.side_px.max(other.side_px);
+        (self.centre - other.centre).norm() <= tol
+            && (self.side_px - other.side_px).abs() <= tol
+            && (self.angle_rad - other.angle_rad).abs() <= 0.01
     }
 
     /// The image point at crop pixel `(u, v)` (0–256, pixel centres at half-integers as the

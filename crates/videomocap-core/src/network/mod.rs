@@ -19,6 +19,7 @@ use crate::skeleton::{Joint, PerJoint};
 use image::RgbImage;
 use nalgebra::{Point2, Vector3};
 use std::path::{Path, PathBuf};
+use tract_linalg::multithread::{Executor, multithread_tract_scope};
 use tract_onnx::prelude::*;
 
 /// The bundled model (12.8 MB; sha256 in `assets/blazepose/SOURCE.md`).
@@ -51,7 +52,7 @@ pub enum NetworkError {
 }
 
 /// One joint as the network sees it.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct NetJoint {
     /// Position, image pixels.
     pub pos: Point2<f64>,
@@ -68,11 +69,24 @@ pub struct NetworkPose {
     pub presence: f64,
     /// Our 16 joints in the network's 3D body (metres, origin between the hips, y down).
     pub world: PerJoint<Vector3<f64>>,
+    /// The crop the network itself proposes for the next frame (its landmarks 33 and 34: the
+    /// hips' centre and a point beyond the head, MediaPipe's tracking region).
+    pub next_crop: Option<Crop>,
 }
 
 /// The loaded network (shareable between threads).
 pub struct PoseNetwork {
     plan: std::sync::Arc<TypedRunnableModel>,
+    /// Threads for the network's matrix products (`None`: the calling thread alone).
+    pool: Option<Executor>,
+}
+
+impl std::fmt::Debug for PoseNetwork {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PoseNetwork")
+            .field("threads", &self.pool.is_some())
+            .finish_non_exhaustive()
+    }
 }
 
 fn sigmoid(x: f64) -> f64 {
@@ -94,6 +108,22 @@ impl PoseNetwork {
         Self::from_reader(&mut std::io::Cursor::new(bytes), path)
     }
 
+    /// The same network running its matrix products on `threads` threads (1: the calling
+    /// thread alone). Falls back to one thread when the system gives no more.
+    pub fn with_threads(mut self, threads: usize) -> PoseNetwork {
+        self.pool = (threads > 1)
+            .then(|| {
+                rayon::ThreadPoolBuilder::new()
+                    .thread_name(|k| format!("pose-network-{k}"))
+                    .num_threads(threads)
+                    .build()
+                    .ok()
+            })
+            .flatten()
+            .map(|pool| Executor::MultiThread(std::sync::Arc::new(pool)));
+        self
+    }
+
     fn from_reader(
         reader: &mut dyn std::io::Read,
         path: &Path,
@@ -112,7 +142,7 @@ impl PoseNetwork {
             .map_err(|e| bad(&e))?
             .into_runnable()
             .map_err(|e| bad(&e))?;
-        let network = PoseNetwork { plan };
+        let network = PoseNetwork { plan, pool: None };
         // The outputs this code reads must be there, with their sizes.
         let probe = network
             .raw(vec![0.0; INPUT_PX * INPUT_PX * 3])
@@ -126,10 +156,12 @@ impl PoseNetwork {
         let run = |e: &dyn std::fmt::Display| NetworkError::Run(e.to_string());
         let tensor = tract_ndarray::Array4::from_shape_vec((1, INPUT_PX, INPUT_PX, 3), input)
             .map_err(|e| run(&e))?;
-        let outputs = self
-            .plan
-            .run(tvec!(Tensor::from(tensor).into()))
-            .map_err(|e| run(&e))?;
+        let input = tvec!(Tensor::from(tensor).into());
+        let outputs = match &self.pool {
+            Some(pool) => multithread_tract_scope(pool.clone(), || self.plan.run(input)),
+            None => self.plan.run(input),
+        }
+        .map_err(|e| run(&e))?;
         let mut landmarks = None;
         let mut flag = None;
         let mut world = None;
@@ -180,6 +212,7 @@ impl PoseNetwork {
             joints: ours(&lm),
             presence: sigmoid(f64::from(flag)),
             world: ours_3d(&w),
+            next_crop: Crop::aligned(lm(33).pos, lm(34).pos),
         })
     }
 }

@@ -30,7 +30,7 @@ mod search;
 mod similarity;
 pub(crate) mod smooth;
 
-pub use evidence::{EvidenceParams, NetworkFrames, run_network, weigh};
+pub use evidence::{EvidenceParams, NetFrame, NetworkFrames, run_network, weigh};
 pub use occlusion::{SpanKind, WeakSpan, weak_spans};
 pub use params::TrackerParams;
 pub use run::{KeyFrames, TrackError, TrackJob, TrackOutput, TrackProgress, track_video};

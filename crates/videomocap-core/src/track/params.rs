@@ -187,6 +187,9 @@ pub struct TrackerParams {
     /// 0.01, 116–119 from 0.015 to 0.04). So it is for 2D work: tracks to be read or exported
     /// as they are.
     pub smooth_s: f64,
+    /// Weigh the pose network's evidence beside VBA's own (when the caller has the network):
+    /// off tracks with VBA alone. Figures in `docs/method.md` ("The pose network as evidence").
+    pub network: bool,
 }
 
 // The derives above are `remote = "Self"`: they make inherent `TrackerParams::serialize` and
@@ -243,6 +246,7 @@ impl Default for TrackerParams {
             arm_foreground: 0.2,
             foreground_tau: 20.0,
             smooth_s: 0.0,
+            network: true,
         }
     }
 }
@@ -340,6 +344,7 @@ impl TrackerParams {
             arm_foreground,
             foreground_tau,
             smooth_s,
+            network: _,
         } = *self;
         weights.validate()?;
         let checks: [(&'static str, f64, Range); 27] = [

@@ -3,7 +3,8 @@
 //! One function shows the order ([`track_video`]): a forward pass from the first key frame (the
 //! marks) to the end, then a backward pass from the last key frame to the start, each re-started
 //! with the hand-placed joints at every key frame on the way (`pass`); the two made one
-//! per joint between its key frames (`fuse`); then short weak runs interpolated with key
+//! per joint between its key frames (`fuse`); the pose network's evidence weighed in
+//! (`evidence`, unless turned off); then short weak runs interpolated with key
 //! frames as anchors ([`super::occlusion`]), never runs that leave the frame, and the tracks
 //! smoothed when asked. A
 //! joint that ends up outside the image is off the frame (confidence 0, its position the
@@ -13,6 +14,7 @@
 
 use super::background::KnownBackground;
 use super::body::{JointResult, stature_px};
+use super::evidence::{EvidenceParams, NetworkFrames, run_network, weigh};
 use super::fuse::fuse;
 use super::occlusion::{WeakSpan, fill_weak_runs};
 use super::params::TrackerParams;
@@ -21,6 +23,7 @@ use super::smooth::smooth_tracks;
 use crate::camera::point_in_frame;
 pub use crate::formats::KeyFrames;
 use crate::formats::{FrameTracks, PointSource, SourceInfo, TrackedPoint, Tracks2d};
+use crate::network::PoseNetwork;
 use crate::skeleton::{Joint, PerJoint, Proportions};
 use crate::video::{Video, VideoError, VideoInfo};
 use nalgebra::Point2;
@@ -83,6 +86,12 @@ pub struct TrackJob {
     /// The background an earlier run of this video found ([`TrackOutput::background`]): used
     /// when it fits (same working size and threshold) instead of reading the clip again.
     pub background: Option<KnownBackground>,
+    /// The pose network whose evidence is weighed in (`None`, or the setting `network` off:
+    /// VBA alone).
+    pub network: Option<Arc<PoseNetwork>>,
+    /// What the network saw in the earlier result ([`TrackOutput::network`]): a re-track runs
+    /// it again only where a crop moved.
+    pub previous_network: Option<NetworkFrames>,
 }
 
 impl TrackJob {
@@ -99,7 +108,15 @@ impl TrackJob {
             from: None,
             previous: None,
             background: None,
+            network: None,
+            previous_network: None,
         }
+    }
+
+    /// This job with the pose network's evidence weighed in.
+    pub fn with_network(mut self, network: Option<Arc<PoseNetwork>>) -> TrackJob {
+        self.network = network;
+        self
     }
 }
 
@@ -129,6 +146,9 @@ pub struct TrackOutput {
     /// The background this run used (`None` when the settings use none): give it to the next
     /// job on this video ([`TrackJob::background`]).
     pub background: Option<KnownBackground>,
+    /// What the pose network saw on each frame (`None`: tracked with VBA alone): give it to
+    /// the next job on this video ([`TrackJob::previous_network`]).
+    pub network: Option<NetworkFrames>,
 }
 
 /// Frames of a re-track's backward pass (the corrected frame and the ten before it) tracked
@@ -148,12 +168,84 @@ pub fn track_video(
 ) -> Result<TrackOutput, TrackError> {
     job.params.validate()?;
     let info = video.info().clone();
-    let out = track_at_working_scale(video, &info, job, progress, cancel);
+    let network = job.network.as_deref().filter(|_| job.params.network);
+    // 1. VBA's passes, forwards and backwards, made one per joint.
+    let passes = track_at_working_scale(video, &info, job, network.is_some(), progress, cancel);
     if (video.info().width, video.info().height) != (info.width, info.height) {
         // Back to the size the caller had (full size unless it shrank the video itself).
         video.output_size(Some((info.width, info.height)));
     }
-    out
+    let Passes {
+        mut tracks,
+        low,
+        mut done,
+        total,
+        shrink,
+        damaged,
+        background,
+    } = passes?;
+    // 2. The network's evidence weighed in, the user's marks deciding whose body it is.
+    let net = match network {
+        Some(network) => {
+            let reuse = job.previous_network.as_ref().map(|p| (p, low));
+            let mut tick = || {
+                done += 1;
+                progress(&TrackProgress {
+                    done,
+                    total,
+                    frame: None,
+                });
+            };
+            let net = run_network(video, &tracks, network, &job.keys, reuse, &mut tick, cancel)?;
+            tracks = weigh(&tracks, &net, &job.keys, &EvidenceParams::default());
+            Some(net)
+        }
+        None => None,
+    };
+    // 3. Short weak runs interpolated, long ones reported.
+    let mut frames = tracks.frames;
+    let max_gap = (job.params.max_gap_s * info.fps).round().max(1.0) as usize;
+    let is_key = |i: usize, j: Joint| job.keys.is_key(i, j);
+    let spans = fill_weak_runs(&mut frames, job.params.weak_reliability, max_gap, &is_key);
+    // 4. Smoothed (when asked for): the filled runs with the rest. A re-track smooths what it
+    // tracked; the earlier result before it was smoothed already.
+    let first = job.from.map_or(0, |f| f + 1);
+    smooth_tracks(&mut frames, job.params.smooth_s * info.fps, first, &is_key);
+    // 5. The corrected frame's reliable joints stay as the user saw them. (The earlier result
+    // covers every frame and `from` lies in it: checked before tracking.)
+    if let (Some(from), Some(prev)) = (job.from, job.previous.as_ref()) {
+        for j in Joint::ALL {
+            let was = prev.frames[from].points[j];
+            if !job.keys.is_key(from, j) && was.confidence >= job.params.weak_reliability {
+                frames[from].points[j] = was;
+            }
+        }
+    }
+    Ok(TrackOutput {
+        damaged,
+        background,
+        tracks: Tracks2d {
+            source: tracks.source,
+            frames,
+        },
+        spans,
+        shrink,
+        network: net,
+    })
+}
+
+/// VBA's result before the network, the filling of weak runs and smoothing.
+struct Passes {
+    /// Every frame's joints in video pixels (key frames' joints as placed).
+    tracks: Tracks2d,
+    /// The earliest frame the job can change.
+    low: usize,
+    /// Progress so far, and in all (the network's frames included).
+    done: usize,
+    total: usize,
+    shrink: f64,
+    damaged: Vec<usize>,
+    background: Option<KnownBackground>,
 }
 
 /// The shrink factor that brings the marked person to the working stature (1 when they are no
@@ -175,14 +267,16 @@ fn working_scale(
     (shrink, (side(width), side(height)))
 }
 
-/// [`track_video`] with the video's full-size info.
+/// [`track_video`]'s passes, with the video's full-size info; `network`: the network's frames
+/// are counted in the progress's total.
 fn track_at_working_scale(
     video: &mut Video,
     info: &VideoInfo,
     job: &TrackJob,
+    network: bool,
     progress: &mut (dyn FnMut(&TrackProgress) + Send),
     cancel: &AtomicBool,
-) -> Result<TrackOutput, TrackError> {
+) -> Result<Passes, TrackError> {
     let n = info.frame_count;
     if n < 2 {
         return Err(TrackError::TooShort {
@@ -268,7 +362,7 @@ fn track_at_working_scale(
         threads: job.threads,
         damaged: Vec::new(),
         done: 0,
-        total: (n - start) + backward_frames.len(),
+        total: (n - start) + backward_frames.len() + if network { n - low } else { 0 },
         progress,
         cancel,
         background: None,
@@ -375,7 +469,7 @@ fn track_at_working_scale(
         raw[f] = r;
     }
 
-    let mut frames: Vec<FrameTracks> = raw
+    let frames: Vec<FrameTracks> = raw
         .into_iter()
         .enumerate()
         .map(|(index, r)| FrameTracks {
@@ -412,9 +506,6 @@ fn track_at_working_scale(
                 }),
         })
         .collect();
-    let max_gap = (job.params.max_gap_s * info.fps).round().max(1.0) as usize;
-    let is_key = |i: usize, j: Joint| job.keys.is_key(i, j);
-    let spans = fill_weak_runs(&mut frames, job.params.weak_reliability, max_gap, &is_key);
     let source = SourceInfo {
         path: info.path.clone(),
         width: info.width,
@@ -422,29 +513,17 @@ fn track_at_working_scale(
         fps: info.fps,
         frame_count: n,
     };
-    // Smoothed last (when asked for): the filled runs are smoothed with the rest. A re-track smooths what it tracked; the earlier result before it was smoothed
-    // already.
-    let first = job.from.map_or(0, |f| f + 1);
-    smooth_tracks(&mut frames, job.params.smooth_s * info.fps, first, &is_key);
-    // The corrected frame's reliable joints stay as the user saw them. (The
-    // earlier result covers every frame and `from` lies in it: checked before tracking.)
-    if let (Some(from), Some(prev)) = (job.from, job.previous.as_ref()) {
-        for j in Joint::ALL {
-            let was = prev.frames[from].points[j];
-            if !job.keys.is_key(from, j) && was.confidence >= job.params.weak_reliability {
-                frames[from].points[j] = was;
-            }
-        }
-    }
     let mut damaged = std::mem::take(&mut ctx.damaged);
     damaged.sort_unstable();
     damaged.dedup();
-    Ok(TrackOutput {
+    Ok(Passes {
+        tracks: Tracks2d { source, frames },
+        low,
+        done: ctx.done,
+        total: ctx.total,
+        shrink,
         damaged,
         background,
-        tracks: Tracks2d { source, frames },
-        spans,
-        shrink,
     })
 }
 
@@ -471,6 +550,8 @@ mod tests {
             from: None,
             previous: None,
             background: None,
+            network: None,
+            previous_network: None,
         }
     }
 

@@ -59,6 +59,8 @@ pub enum Command {
     Export(ExportArgs),
     /// Every step: track, lift and export into one directory.
     Run(RunArgs),
+    /// `run` for every row of a manifest (CSV), resumable, optionally one shard of it.
+    Batch(BatchArgs),
     /// Second pipeline: point volumes to kinematic motion.
     Volume(VolumeArgs),
     /// Carve voxel grids from calibrated cameras and silhouette masks, for `volume`.
@@ -87,6 +89,9 @@ pub struct TrackArgs {
     /// Tracker settings as JSON (see docs/formats.md; every field optional, defaults documented).
     #[arg(long)]
     pub tracker_settings: Option<PathBuf>,
+    /// Track with VBA alone, without the pose network's evidence.
+    #[arg(long)]
+    pub no_network: bool,
 }
 
 /// Camera and subject options shared by `lift` and `run`.
@@ -165,8 +170,40 @@ pub struct RunArgs {
     /// motion.trc.
     #[arg(long)]
     pub out_dir: PathBuf,
+    /// Track with VBA alone, without the pose network's evidence.
+    #[arg(long)]
+    pub no_network: bool,
     #[command(flatten)]
     pub options: LiftOptions,
+}
+
+/// `batch`.
+#[derive(Debug, Args)]
+pub struct BatchArgs {
+    /// The manifest: CSV with a header row; columns video (required), keys (a keys or marks
+    /// file), height_m, focal_px or fov_deg, lengths, tracker_settings, lift_settings, id
+    /// (default: the video's file stem). Paths are relative to the manifest (docs/batch.md).
+    pub manifest: PathBuf,
+    /// Each row's results go to DIR/<id>/ (as `run` writes them, plus status.json), and
+    /// DIR/summary.csv.
+    #[arg(long)]
+    pub out_dir: PathBuf,
+    /// Rows run at once (each gets its share of the cores).
+    #[arg(long, default_value_t = 1)]
+    pub jobs: usize,
+    /// K/N: run only the rows of shard K of N (by a stable hash of the id), e.g. one task of
+    /// a Slurm job array.
+    #[arg(long)]
+    pub shard: Option<String>,
+    /// Redo every row, also those complete and unchanged.
+    #[arg(long)]
+    pub force: bool,
+    /// Run nothing: gather the rows' status files (from every shard) into summary.csv.
+    #[arg(long)]
+    pub summary_only: bool,
+    /// Track with VBA alone, without the pose network's evidence.
+    #[arg(long)]
+    pub no_network: bool,
 }
 
 /// `volume`.

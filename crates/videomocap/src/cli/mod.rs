@@ -2,6 +2,7 @@
 //! stderr (indicatif) and, with `--json`, a summary on stdout.
 
 pub mod args;
+mod batch;
 mod carve;
 pub mod export;
 mod info;
@@ -53,6 +54,7 @@ pub fn run(command: Command, global: &GlobalArgs) -> Result<(), ExitError> {
         Command::Lift(a) => lift::run(&a, global),
         Command::Export(a) => export::run(&a, global),
         Command::Run(a) => run::run(&a, global),
+        Command::Batch(a) => batch::run(&a, global),
         Command::Volume(a) => volume::run(&a, global),
         Command::Carve(a) => carve::run(&a, global),
         Command::Gui { .. } => Err(ExitError::bad_input(anyhow::anyhow!(

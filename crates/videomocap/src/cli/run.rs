@@ -1,9 +1,12 @@
 //! `videomocap run`: track, lift and export into one directory.
 
-use super::args::{GlobalArgs, RunArgs};
+use super::args::{GlobalArgs, LiftOptions, RunArgs};
 use super::export::{Outputs3d, report_3d, write_3d, write_tracks_csv};
 use super::{ExitError, say};
 use anyhow::anyhow;
+use std::path::Path;
+use videomocap_core::skeleton::Joint;
+use videomocap_core::track::SpanKind;
 
 /// File names `run` writes in its output directory.
 pub const TRACKS_JSON: &str = "tracks2d.json";
@@ -15,37 +18,111 @@ pub const TRC: &str = "motion.trc";
 
 /// `run`.
 pub fn run(a: &RunArgs, global: &GlobalArgs) -> Result<(), ExitError> {
-    let (params, known) = super::lift::check_options(&a.options)?;
-    let (mut video, keys) =
-        super::track::open_checked(&a.video, a.marks.as_deref(), a.keys.as_deref())?;
-    std::fs::create_dir_all(&a.out_dir)
-        .map_err(|e| ExitError::failed(anyhow!("{}: cannot create: {e}", a.out_dir.display())))?;
+    run_into(
+        &RunInput {
+            video: &a.video,
+            marks: a.marks.as_deref(),
+            keys: a.keys.as_deref(),
+            tracker: videomocap_core::track::TrackerParams::default(),
+            no_network: a.no_network,
+            threads: None,
+            options: &a.options,
+        },
+        &a.out_dir,
+        global,
+    )?;
+    Ok(())
+}
+
+/// What one `run` works from.
+pub struct RunInput<'a> {
+    /// The video (or image folder).
+    pub video: &'a Path,
+    /// A marks file, or
+    pub marks: Option<&'a Path>,
+    /// a keys file.
+    pub keys: Option<&'a Path>,
+    /// Tracker settings.
+    pub tracker: videomocap_core::track::TrackerParams,
+    /// Track with VBA alone.
+    pub no_network: bool,
+    /// Worker threads (`None`: all cores).
+    pub threads: Option<usize>,
+    /// Camera, subject and lift settings.
+    pub options: &'a LiftOptions,
+}
+
+/// What one `run` found, for reports.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RunReport {
+    /// Frames of the clip.
+    pub frames: usize,
+    /// Joint-frames left weak, lost or off the frame (not interpolated), percent.
+    pub weak_pct: f64,
+    /// Frames the lift flagged (a bone too long for its image, no key pose), percent.
+    pub flagged_pct: f64,
+}
+
+/// Tracks, lifts and exports into `out_dir` (created if missing).
+pub fn run_into(
+    input: &RunInput,
+    out_dir: &Path,
+    global: &GlobalArgs,
+) -> Result<RunReport, ExitError> {
+    let (params, known) = super::lift::check_options(input.options)?;
+    let (mut video, keys) = super::track::open_checked(input.video, input.marks, input.keys)?;
+    std::fs::create_dir_all(out_dir)
+        .map_err(|e| ExitError::failed(anyhow!("{}: cannot create: {e}", out_dir.display())))?;
     let out = super::track::track_with_progress(
         &mut video,
         &keys,
-        None,
-        videomocap_core::track::TrackerParams::default(),
+        input.threads,
+        input.tracker,
+        input.no_network,
         global,
     )?;
-    let path = a.out_dir.join(TRACKS_JSON);
+    let path = out_dir.join(TRACKS_JSON);
     out.tracks.save(&path).map_err(ExitError::failed)?;
     super::track::report(&out, global);
     say(global, &format!("wrote {}", path.display()));
-    let csv = a.out_dir.join(TRACKS_CSV);
+    let csv = out_dir.join(TRACKS_CSV);
     write_tracks_csv(&out.tracks, &csv)?;
     say(global, &format!("wrote {}", csv.display()));
-    let lifted =
-        super::lift::lift_with_progress(&out.tracks, &a.video, &a.options, params, &known, global)?;
-    let path = a.out_dir.join(SKELETON_JSON);
+    let lifted = super::lift::lift_with_progress(
+        &out.tracks,
+        input.video,
+        input.options,
+        params,
+        &known,
+        global,
+    )?;
+    let path = out_dir.join(SKELETON_JSON);
     lifted.skeleton.save(&path).map_err(ExitError::failed)?;
     super::lift::report(&lifted, global);
     say(global, &format!("wrote {}", path.display()));
     let outputs = Outputs3d {
-        bvh: Some(a.out_dir.join(BVH)),
-        csv: Some(a.out_dir.join(JOINTS_CSV)),
-        trc: Some(a.out_dir.join(TRC)),
+        bvh: Some(out_dir.join(BVH)),
+        csv: Some(out_dir.join(JOINTS_CSV)),
+        trc: Some(out_dir.join(TRC)),
     };
     let written = write_3d(&lifted.skeleton, &path, None, &outputs)?;
     report_3d(&written, global);
-    Ok(())
+    let frames = out.tracks.frames.len();
+    let weak: usize = out
+        .spans
+        .iter()
+        .filter(|s| s.kind != SpanKind::Interpolated)
+        .map(|s| s.end + 1 - s.start)
+        .sum();
+    let flagged = lifted
+        .reports
+        .iter()
+        .filter(|r| !r.flags.is_empty())
+        .count();
+    let pct = |k: usize, n: usize| 100.0 * k as f64 / n.max(1) as f64;
+    Ok(RunReport {
+        frames,
+        weak_pct: pct(weak, frames * Joint::ALL.len()),
+        flagged_pct: pct(flagged, frames),
+    })
 }

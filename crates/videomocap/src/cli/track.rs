@@ -7,6 +7,7 @@ use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use videomocap_core::formats::{KeyFrames, Marks};
+use videomocap_core::network::PoseNetwork;
 use videomocap_core::project::Project;
 use videomocap_core::track::{
     SpanKind, TrackError, TrackJob, TrackOutput, TrackerParams, track_video,
@@ -45,12 +46,29 @@ fn check_keys(video: &Video, keys: &KeyFrames, path: &Path) -> Result<(), ExitEr
         .map_err(|e| ExitError::bad_input(anyhow!("{e} (video {})", info.path.display())))
 }
 
-/// Runs the tracker with a progress bar; shared by `track` and `run`.
+/// The bundled pose network on `threads` threads, unless `off`; when it cannot be loaded, says
+/// why and tracks with VBA alone (never a failure).
+pub fn load_network(off: bool, threads: usize) -> Option<Arc<PoseNetwork>> {
+    if off {
+        return None;
+    }
+    match PoseNetwork::bundled() {
+        Ok(n) => Some(Arc::new(n.with_threads(threads))),
+        Err(e) => {
+            eprintln!("warning: {e}; tracking with VBA alone");
+            None
+        }
+    }
+}
+
+/// Runs the tracker with a progress bar, with the pose network unless `no_network`; shared by
+/// `track` and `run`.
 pub fn track_with_progress(
     video: &mut Video,
     keys: &KeyFrames,
     threads: Option<usize>,
     params: TrackerParams,
+    no_network: bool,
     global: &GlobalArgs,
 ) -> Result<TrackOutput, ExitError> {
     let threads = threads.unwrap_or_else(|| {
@@ -63,6 +81,7 @@ pub fn track_with_progress(
             "--threads must be at least 1"
         )));
     }
+    let network = load_network(no_network || !params.network, threads);
     let job = TrackJob {
         keys: keys.clone(),
         params,
@@ -70,6 +89,8 @@ pub fn track_with_progress(
         from: None,
         previous: None,
         background: None,
+        network,
+        previous_network: None,
     };
     let bar = progress_bar(global, video.info().frame_count as u64, "tracking");
     let cancel = AtomicBool::new(false);
@@ -203,7 +224,7 @@ pub fn run(a: &TrackArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         (None, None) => TrackerParams::default(),
     };
     let t0 = std::time::Instant::now();
-    let out = track_with_progress(&mut video, &keys, a.threads, params, global)?;
+    let out = track_with_progress(&mut video, &keys, a.threads, params, a.no_network, global)?;
     let seconds = t0.elapsed().as_secs_f64();
     let mut written = Vec::new();
     if let Some(output) = &a.output {
