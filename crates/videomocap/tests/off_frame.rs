@@ -190,9 +190,10 @@ fn joints_leaving_the_frame_are_tracked_and_exported_consistently() {
     println!("{table}");
 
     let off_set = points_with(&tracks, PointSource::OffFrame);
+    // (With the pose network's evidence no run of this clip may be left lost; VBA alone left
+    // some. The exports must agree with the tracks either way.)
     let lost_set = points_with(&tracks, PointSource::Lost);
     assert!(!off_set.is_empty());
-    assert!(!lost_set.is_empty());
     for f in &tracks.frames {
         for j in Joint::ALL {
             let p = f.points[j];
@@ -209,8 +210,8 @@ fn joints_leaving_the_frame_are_tracked_and_exported_consistently() {
         }
     }
     // The report lists the off-frame runs and no interpolated run contains one; a run left
-    // weak holds lost points, or was kept as tracked (it moved like its joint) and holds only
-    // tracked points under the weak threshold.
+    // weak holds lost points, or was kept as tracked (it moved like its joint, or jumped) and
+    // holds only tracked points under the weak threshold and filled ones.
     let summary: serde_json::Value = serde_json::from_str(&summary).unwrap();
     let spans = summary["spans"].as_array().unwrap();
     for span in spans {
@@ -232,7 +233,10 @@ fn joints_leaving_the_frame_are_tracked_and_exported_consistently() {
                 .iter()
                 .filter(|f| (a..=b).contains(&f.index))
                 .all(|f| {
-                    f.points[j].source == PointSource::Tracked && f.points[j].confidence < weak
+                    let p = f.points[j];
+                    // (A joint shown weak where it jumped may border a run filled beside it.)
+                    (p.source == PointSource::Tracked && p.confidence < weak)
+                        || p.source == PointSource::Interpolated
                 });
             assert!(has(&lost_set) || kept, "{span}");
         }

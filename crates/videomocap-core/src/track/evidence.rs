@@ -6,7 +6,8 @@
 //! confidence, the continuity of the motion, and keys that always win.
 
 use super::run::TrackError;
-use crate::formats::{KeyFrames, PointSource, TrackedPoint, Tracks2d};
+use crate::camera::point_in_frame;
+use crate::formats::{FrameTracks, KeyFrames, PointSource, TrackedPoint, Tracks2d};
 use crate::network::{Crop, NetJoint, PoseNetwork};
 use crate::skeleton::{Joint, PerJoint};
 use crate::video::Video;
@@ -216,9 +217,9 @@ pub fn weigh(
                     confidence: p.confidence,
                     from_network: false,
                 }];
-                // (A joint VBA carried off the frame still gets the network's candidates: VBA's
-                // estimate out there is the least sure of all.)
-                if keyed.is_some() {
+                // A joint VBA carried off the frame stays off it: at the image's edge the network
+                // puts an arm that left inside the frame, and sure of it.
+                if keyed.is_some() || p.source == PointSource::OffFrame {
                     return c;
                 }
                 if let Some(pose) = net.get(t).and_then(|f| f.joints.as_ref()) {
@@ -241,15 +242,20 @@ pub fn weigh(
         let chosen = choose(&candidates, &torso, params);
         for (t, c) in chosen.into_iter().enumerate() {
             if c.from_network {
+                // A place the network gives outside the image is off the frame, as VBA's are.
+                let inside = point_in_frame(&c.pos, tracks.source.width, tracks.source.height);
                 out.frames[t].points[j] = TrackedPoint {
                     pos: c.pos,
-                    confidence: c.confidence,
-                    source: PointSource::Tracked,
+                    confidence: if inside { c.confidence } else { 0.0 },
+                    source: if inside {
+                        PointSource::Tracked
+                    } else {
+                        PointSource::OffFrame
+                    },
                 };
             }
         }
     }
-    flag_jumps(&mut out, keys);
     out
 }
 
@@ -263,22 +269,19 @@ const JUMP_TORSO: f64 = 0.1;
 /// The reliability a jump leaves (below the default weak threshold, 0.45).
 const JUMPED_RELIABILITY: f32 = 0.25;
 
-/// Lowers the reliability of every joint-frame that jumped (see [`JUMP_TORSO`]); keys keep
-/// theirs.
-fn flag_jumps(tracks: &mut Tracks2d, keys: &KeyFrames) {
-    let n = tracks.frames.len();
+/// Lowers the reliability of every joint-frame that jumped (see [`JUMP_TORSO`]), leaving its
+/// place as it is (shown weak for review, not filled); keys keep theirs.
+pub(crate) fn flag_jumps(frames: &mut [FrameTracks], keys: &KeyFrames) {
+    let n = frames.len();
     for t in 1..n.saturating_sub(1) {
-        let index = tracks.frames[t].index;
-        let torso = tracks.frames[t].torso_px().max(1.0);
+        let index = frames[t].index;
+        let torso = frames[t].torso_px().max(1.0);
         for j in Joint::ALL {
-            if keys.is_key(index, j) {
+            if keys.is_key(index, j) || frames[t].points[j].source != PointSource::Tracked {
                 continue;
             }
-            let (a, b) = (
-                tracks.frames[t - 1].points[j].pos,
-                tracks.frames[t + 1].points[j].pos,
-            );
-            let p = &mut tracks.frames[t].points[j];
+            let (a, b) = (frames[t - 1].points[j].pos, frames[t + 1].points[j].pos);
+            let p = &mut frames[t].points[j];
             if (p.pos - nalgebra::center(&a, &b)).norm() / torso > JUMP_TORSO {
                 p.confidence = p.confidence.min(JUMPED_RELIABILITY);
             }
@@ -433,7 +436,7 @@ mod tests {
     }
 
     #[test]
-    fn a_joint_that_jumps_for_one_frame_is_shown_weak_and_a_smooth_one_is_not() {
+    fn a_joint_that_jumps_for_one_frame_is_shown_weak_where_it_is_and_a_smooth_one_is_not() {
         let vba = tracks(
             12,
             |t| {
@@ -452,19 +455,21 @@ mod tests {
             };
             12
         ];
-        let out = weigh(
+        let mut out = weigh(
             &vba,
             &none,
             &keys_at(&[0], &vba),
             &EvidenceParams::default(),
         );
+        flag_jumps(&mut out.frames, &keys_at(&[0], &vba));
         let reliability = |t: usize, j: Joint| out.frames[t].points[j].confidence;
         // The spike (30 px on a 100 px torso) and its neighbours, whose middle it moves.
         assert!(reliability(6, Joint::LeftWrist) < 0.45);
         assert!(reliability(5, Joint::LeftWrist) < 0.45);
         assert!(reliability(9, Joint::LeftWrist) > 0.45);
         assert!(reliability(6, Joint::RightWrist) > 0.45);
-        // The key keeps its certainty.
+        // The key keeps its certainty, the spike its place.
         assert_eq!(reliability(0, Joint::LeftWrist), 0.9);
+        assert_eq!(out.frames[6].points[Joint::LeftWrist].pos.x, 102.0);
     }
 }

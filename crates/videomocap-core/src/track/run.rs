@@ -14,9 +14,9 @@
 
 use super::background::KnownBackground;
 use super::body::{JointResult, stature_px};
-use super::evidence::{EvidenceParams, NetworkFrames, run_network, weigh};
+use super::evidence::{EvidenceParams, NetworkFrames, flag_jumps, run_network, weigh};
 use super::fuse::fuse;
-use super::occlusion::{WeakSpan, fill_weak_runs};
+use super::occlusion::{WeakSpan, fill_weak_runs, weak_spans};
 use super::params::TrackerParams;
 use super::pass::{PassContext, Scale};
 use super::smooth::smooth_tracks;
@@ -211,7 +211,14 @@ pub fn track_video(
     // tracked; the earlier result before it was smoothed already.
     let first = job.from.map_or(0, |f| f + 1);
     smooth_tracks(&mut frames, job.params.smooth_s * info.fps, first, &is_key);
-    // 5. The corrected frame's reliable joints stay as the user saw them. (The earlier result
+    // 5. With the network: a joint that jumps is shown weak where it is (for review).
+    let spans = if net.is_some() {
+        flag_jumps(&mut frames, &job.keys);
+        weak_spans(&frames, job.params.weak_reliability, &is_key)
+    } else {
+        spans
+    };
+    // 6. The corrected frame's reliable joints stay as the user saw them. (The earlier result
     // covers every frame and `from` lies in it: checked before tracking.)
     if let (Some(from), Some(prev)) = (job.from, job.previous.as_ref()) {
         for j in Joint::ALL {

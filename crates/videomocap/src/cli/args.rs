@@ -184,7 +184,7 @@ pub struct BatchArgs {
     /// file), height_m, focal_px or fov_deg, lengths, tracker_settings, lift_settings, id
     /// (default: the video's file stem). Paths are relative to the manifest (docs/batch.md).
     pub manifest: PathBuf,
-    /// Each row's results go to DIR/<id>/ (as `run` writes them, plus status.json), and
+    /// Each row's results go to `DIR/<id>/` (as `run` writes them, plus status.json), and
     /// DIR/summary.csv.
     #[arg(long)]
     pub out_dir: PathBuf,
