@@ -260,10 +260,7 @@ pub fn weigh(
 }
 
 /// A joint further than this (torso lengths) from the middle of its places on the frames
-/// before and after has jumped: shown weak. (Of the joint-frames more than 0.2 torso off on
-/// the dev split, the chosen confidence below 0.45 or such a jump points at 45 %, and 41 % of
-/// those it points at are off; the confidence alone 24 % and 39 %, VBA's own reliability
-/// 35 % and 13 %: `docs/method.md`.)
+/// before and after has jumped: shown weak (dev figures in `docs/method.md`).
 const JUMP_TORSO: f64 = 0.1;
 
 /// The reliability a jump leaves (below the default weak threshold, 0.45).
