@@ -361,7 +361,7 @@ fn lift_writes_a_skeleton_and_refuses_a_bad_focal_length() {
     assert_eq!(code, 0, "{stderr}");
     let csv = std::fs::read_to_string(p("t.csv")).unwrap();
     assert!(csv.starts_with(
-        "frame,time_s,joint,x_px,y_px,confidence,interpolated,off_frame,lost,gait\n0,0.000000,head_top,"
+        "frame,time_s,joint,x_px,y_px,confidence,interpolated,off_frame,lost\n0,0.000000,head_top,"
     ));
     // What export cannot do is refused with the file named.
     assert_bad(&["export", outs], &["nothing to write"]);

@@ -22,8 +22,6 @@ pub enum PointState {
     OffFrame,
     /// In a weak run too long to fill: the tracker's guess.
     Lost,
-    /// A hidden far limb's joint completed from the other side's stride.
-    Gait,
 }
 
 impl PointState {
@@ -34,7 +32,6 @@ impl PointState {
             PointSource::Interpolated => PointState::Interpolated,
             PointSource::OffFrame => PointState::OffFrame,
             PointSource::Lost => PointState::Lost,
-            PointSource::Gait => PointState::Gait,
             PointSource::Tracked if p.confidence < weak => PointState::Weak,
             PointSource::Tracked => PointState::Tracked,
         }
@@ -49,7 +46,6 @@ impl PointState {
             PointState::Interpolated => "filled in between sound frames (blue)",
             PointState::OffFrame => "off the frame: an estimate (purple)",
             PointState::Lost => "lost: a guess (red)",
-            PointState::Gait => "completed from the gait (pink)",
         }
     }
 
@@ -62,7 +58,6 @@ impl PointState {
             PointState::Interpolated => Color32::from_rgb(80, 140, 255),
             PointState::OffFrame => Color32::from_rgb(170, 110, 230),
             PointState::Lost => Color32::from_rgb(220, 50, 50),
-            PointState::Gait => Color32::from_rgb(255, 140, 200),
         }
     }
 }

@@ -215,14 +215,13 @@ mod tests {
 
     #[test]
     fn strips_keep_each_state_and_say_which_at_a_frame() {
-        // Left wrist: tracked, weak, interpolated, off the frame, lost, from the gait.
+        // Left wrist: tracked, weak, interpolated, off the frame, lost.
         let states = [
             (0.9, PointSource::Tracked),
             (0.2, PointSource::Tracked),
             (0.2, PointSource::Interpolated),
             (0.0, PointSource::OffFrame),
             (0.1, PointSource::Lost),
-            (0.5, PointSource::Gait),
         ];
         let tracks = Tracks2d {
             source: SourceInfo {
@@ -266,11 +265,10 @@ mod tests {
                 PointState::Interpolated,
                 PointState::OffFrame,
                 PointState::Lost,
-                PointState::Gait,
             ]
         );
         assert_eq!(strips.state_at(Joint::LeftWrist, 4), Some(PointState::Lost));
         assert_eq!(strips.state_at(Joint::Neck, 4), Some(PointState::Tracked));
-        assert_eq!(strips.state_at(Joint::Neck, 6), None);
+        assert_eq!(strips.state_at(Joint::Neck, 5), None);
     }
 }

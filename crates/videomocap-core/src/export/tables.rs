@@ -11,11 +11,10 @@ use crate::formats::{PointSource, Tracks2d};
 use crate::skeleton::Joint;
 use std::fmt::Write as _;
 
-/// Tracks CSV: `frame,time_s,joint,x_px,y_px,confidence,interpolated,off_frame,lost,gait`
+/// Tracks CSV: `frame,time_s,joint,x_px,y_px,confidence,interpolated,off_frame,lost`
 /// (pixels, y down; time from the video's frame rate; `interpolated` is 1 for points filled in
 /// across an occlusion, `off_frame` 1 for the tracker's estimate of a joint outside the image,
-/// `lost` 1 for its guess in a weak run too long to fill, `gait` 1 for a far limb's joint
-/// completed from the gait).
+/// `lost` 1 for its guess in a weak run too long to fill).
 pub fn tracks_csv(tracks: &Tracks2d) -> String {
     let mut w = csv::Writer::from_writer(Vec::new());
     let header = [
@@ -28,7 +27,6 @@ pub fn tracks_csv(tracks: &Tracks2d) -> String {
         "interpolated",
         "off_frame",
         "lost",
-        "gait",
     ];
     let _ = w.write_record(header);
     for f in &tracks.frames {
@@ -46,7 +44,6 @@ pub fn tracks_csv(tracks: &Tracks2d) -> String {
                 flag(p.source == PointSource::Interpolated),
                 flag(p.source == PointSource::OffFrame),
                 flag(p.source == PointSource::Lost),
-                flag(p.source == PointSource::Gait),
             ]);
         }
     }

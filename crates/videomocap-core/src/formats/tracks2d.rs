@@ -1,6 +1,5 @@
 //! `tracks2d.json`: the tracker's output, every joint's image position per frame with its
-//! reliability and its state: tracked, interpolated, off the frame, lost or completed from the
-//! gait.
+//! reliability and its state: tracked, interpolated, off the frame or lost.
 
 use super::{
     FormatError, check_frame_order, check_header_up_to, joint_columns, joint_names, parse_json,
@@ -17,7 +16,8 @@ pub const TRACKS2D_FORMAT: &str = "videomocap.tracks2d";
 
 /// The tracks2d version this build writes (it reads 1 to 3). Version 2 added `off_frame` (a
 /// version 1 reader would refuse its points outside the frame) and `lost`; version 3 added
-/// `gait` (a version 2 reader would take those points for tracked ones).
+/// `gait` (a far limb completed from the gait by versions before 2026-11-28; read as
+/// interpolated, no longer written).
 pub const TRACKS2D_VERSION: u32 = 3;
 
 /// The video the tracks belong to.
@@ -48,10 +48,6 @@ pub enum PointSource {
     /// In a weak run too long to interpolate (or at an end of the video): the position is the
     /// tracker's guess, to be checked (a long occlusion, or a lost joint).
     Lost,
-    /// Completed from the gait: a far limb hidden in a side view, put where the other side's
-    /// limb was half a stride earlier and later (written by versions before 2026-11-28; read
-    /// and shown as it is).
-    Gait,
 }
 
 /// One joint in one frame.
@@ -61,7 +57,7 @@ pub struct TrackedPoint {
     pub pos: Point2<f64>,
     /// Reliability in `[0, 1]` (the block similarity mapped to this range).
     pub confidence: f32,
-    /// Tracked, interpolated, off the frame, lost or completed from the gait.
+    /// Tracked, interpolated, off the frame or lost.
     pub source: PointSource,
 }
 
@@ -102,8 +98,9 @@ struct FrameFile {
     /// Version 2; omitted when no joint of the frame is lost.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     lost: Option<Vec<bool>>,
-    /// Version 3; omitted when no joint of the frame was completed from the gait.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    /// Version 3, read only: a far limb completed from the gait by versions before
+    /// 2026-11-28, seen nowhere, migrated on load to an interpolated point.
+    #[serde(default, skip_serializing)]
     gait: Option<Vec<bool>>,
 }
 
@@ -234,9 +231,7 @@ impl Tracks2d {
                         PointSource::OffFrame
                     } else if lost[col] {
                         PointSource::Lost
-                    } else if gait[col] {
-                        PointSource::Gait
-                    } else if f.interpolated[col] {
+                    } else if gait[col] || f.interpolated[col] {
                         PointSource::Interpolated
                     } else {
                         PointSource::Tracked
@@ -291,7 +286,7 @@ impl Tracks2d {
                         .collect(),
                     off_frame: flags(f, PointSource::OffFrame),
                     lost: flags(f, PointSource::Lost),
-                    gait: flags(f, PointSource::Gait),
+                    gait: None,
                 })
                 .collect(),
         }
@@ -368,11 +363,10 @@ mod tests {
     }
 
     /// The sample with the left wrist off the frame (left of the image) in frame 1, the
-    /// right wrist lost in frame 0 and the right knee completed from the gait in frame 0.
+    /// right wrist lost in frame 0.
     fn with_off_frame() -> Tracks2d {
         let mut t = sample();
         t.frames[0].points[Joint::RightWrist].source = PointSource::Lost;
-        t.frames[0].points[Joint::RightKnee].source = PointSource::Gait;
         t.frames[1].points[Joint::LeftWrist] = TrackedPoint {
             pos: Point2::new(-40.0, 200.0),
             confidence: 0.0,
@@ -382,7 +376,7 @@ mod tests {
     }
 
     #[test]
-    fn off_frame_lost_and_gait_points_round_trip_as_version_3() {
+    fn off_frame_and_lost_points_round_trip_as_version_3() {
         let (_dir, path, v) = saved_json(&with_off_frame());
         assert_eq!(v["version"], 3);
         // Only the frame with an off-frame (lost) joint carries the array.
@@ -391,10 +385,29 @@ mod tests {
         assert_eq!(v["frames"][1]["off_frame"][5], false);
         assert!(v["frames"][1].get("lost").is_none());
         assert_eq!(v["frames"][0]["lost"][9], true);
-        assert!(v["frames"][1].get("gait").is_none());
-        assert_eq!(v["frames"][0]["gait"][14], true);
-        assert_eq!(v["frames"][0]["gait"][9], false);
+        assert!(v["frames"][0].get("gait").is_none());
         assert_eq!(Tracks2d::load(&path).unwrap(), with_off_frame());
+    }
+
+    /// Files from versions before 2026-11-28 may mark a point completed from the gait: it is
+    /// read as interpolated (seen nowhere, half weight in the lift) and not written back.
+    #[test]
+    fn gait_points_of_older_files_are_read_as_interpolated() {
+        let (_dir, path, mut v) = saved_json(&sample());
+        let mut gait = vec![false; 16];
+        gait[14] = true;
+        v["frames"][0]["gait"] = serde_json::json!(gait);
+        let t = Tracks2d::parse(&v.to_string(), &path).unwrap();
+        assert_eq!(
+            t.frames[0].points[Joint::RightKnee].source,
+            PointSource::Interpolated
+        );
+        assert_eq!(
+            t.frames[0].points[Joint::LeftKnee].source,
+            sample().frames[0].points[Joint::LeftKnee].source
+        );
+        let again = serde_json::to_value(t.to_json_value()).unwrap();
+        assert!(again["frames"][0].get("gait").is_none());
     }
 
     #[test]

@@ -165,10 +165,10 @@ pub struct Refined {
 }
 
 /// The weight of a track point in the reprojection term: its confidence (at least 0.05), halved
-/// when it was interpolated or completed from the gait (not seen there).
+/// when it was interpolated (not seen there).
 pub fn track_weight(p: &TrackedPoint) -> f64 {
     let c = f64::from(p.confidence).clamp(0.05, 1.0);
-    if matches!(p.source, PointSource::Interpolated | PointSource::Gait) {
+    if p.source == PointSource::Interpolated {
         0.5 * c
     } else {
         c

@@ -395,9 +395,7 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
                             .filter_map(|j| match f.points[j].source {
                                 PointSource::OffFrame => Some(FrameFlag::OffFrame(j)),
                                 PointSource::Lost => Some(FrameFlag::Lost(j)),
-                                PointSource::Tracked
-                                | PointSource::Interpolated
-                                | PointSource::Gait => None,
+                                PointSource::Tracked | PointSource::Interpolated => None,
                             }),
                     )
                     .collect(),

@@ -24,9 +24,6 @@ pub enum SpanKind {
     Weak,
     /// The joint is off the frame somewhere in the run: left as the tracker estimated it.
     OffFrame,
-    /// Completed from the gait somewhere in the run (tracks from versions before 2026-11-28),
-    /// nowhere lost or left weak.
-    Gait,
 }
 
 impl fmt::Display for SpanKind {
@@ -35,7 +32,6 @@ impl fmt::Display for SpanKind {
             SpanKind::Interpolated => "interpolated",
             SpanKind::Weak => "weak",
             SpanKind::OffFrame => "off frame",
-            SpanKind::Gait => "from the gait",
         })
     }
 }
@@ -185,8 +181,7 @@ pub fn fill_weak_runs(
 /// Lists every weak run of tracks as `fill_weak_runs` left them (or as read from a file):
 /// consecutive frames of a joint that are not key frames and not tracked with reliability at
 /// least `weak`. A run is off the frame when the joint leaves the image in it, weak when it
-/// holds a lost (or, in files without states, a weak tracked) point, from the gait when it
-/// holds a point completed from the gait, interpolated otherwise.
+/// holds a lost (or, in files without states, a weak tracked) point, interpolated otherwise.
 pub fn weak_spans(
     frames: &[FrameTracks],
     weak: f32,
@@ -205,8 +200,6 @@ pub fn weak_spans(
                 SpanKind::OffFrame
             } else if has(PointSource::Lost) || has(PointSource::Tracked) {
                 SpanKind::Weak
-            } else if has(PointSource::Gait) {
-                SpanKind::Gait
             } else {
                 SpanKind::Interpolated
             };
