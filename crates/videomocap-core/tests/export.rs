@@ -8,6 +8,7 @@ use videomocap_core::bvh::{Bvh, map_to_model};
 use videomocap_core::camera::PinholeCamera;
 use videomocap_core::export::rig::{RIG, rig_index_of};
 use videomocap_core::export::{WorldSkeleton, bvh, skeleton_csv, trc};
+use videomocap_core::formats::FrameIndex;
 use videomocap_core::formats::{Frame3d, Skeleton3d};
 use videomocap_core::skeleton::{Bone, Joint, PerJoint, SubjectModel};
 
@@ -33,7 +34,7 @@ fn to_camera(frames: &[PerJoint<Point3<f64>>], yaw: f64, pitch: f64) -> Skeleton
             .iter()
             .enumerate()
             .map(|(i, p)| Frame3d {
-                index: i,
+                index: FrameIndex(i),
                 points: p.map(|_, q| Point3::from(r * (q - centre))),
                 flags: vec![],
             })
@@ -325,7 +326,7 @@ fn gaps_and_missing_frame_rates_are_refused() {
         height: 1.7,
     };
     let mut skeleton = to_camera(&frames_of(&m, 4), 0.0, 0.0);
-    skeleton.frames[3].index = 7;
+    skeleton.frames[3].index = FrameIndex(7);
     let ws = WorldSkeleton::new(&skeleton, None).unwrap();
     let err = bvh(&ws).unwrap_err().to_string();
     assert!(err.contains("frame 7 follows frame 2"), "{err}");

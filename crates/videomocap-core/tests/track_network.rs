@@ -4,6 +4,7 @@
 
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
+use videomocap_core::formats::FrameIndex;
 use videomocap_core::formats::{KeyFrames, Marks};
 use videomocap_core::network::PoseNetwork;
 use videomocap_core::skeleton::Joint;
@@ -46,7 +47,7 @@ fn tracking_with_the_network_keeps_the_keys_and_a_retrack_reuses_what_it_saw() {
     let mut keys = KeyFrames::from_marks(&marks);
     let moved =
         first.tracks.frames[6].points[Joint::LeftWrist].pos + nalgebra::Vector2::new(3.0, 0.0);
-    keys.set(6, Joint::LeftWrist, moved);
+    keys.set(FrameIndex(6), Joint::LeftWrist, moved);
     let retrack = TrackJob {
         keys: keys.clone(),
         from: Some(6),

@@ -5,6 +5,7 @@ mod common;
 
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
+use videomocap_core::formats::FrameIndex;
 use videomocap_core::formats::{Marks, PointSource};
 use videomocap_core::skeleton::Joint;
 use videomocap_core::track::{TrackError, TrackJob, TrackerParams, track_video};
@@ -214,7 +215,7 @@ fn walk_with_a_correction(
     .unwrap();
     let mut j = job(&marks, 2);
     j.keys.set(
-        corrected,
+        FrameIndex(corrected),
         Joint::LeftAnkle,
         gt.frames[corrected].points2d()[Joint::LeftAnkle],
     );
@@ -297,7 +298,7 @@ fn a_correction_redraws_both_sides_of_it_first() {
     let fresh = track_video(
         &mut video,
         &j,
-        &mut |p| arrived.extend(p.frame.as_ref().map(|f| f.index)),
+        &mut |p| arrived.extend(p.frame.as_ref().map(|f| f.index.get())),
         &AtomicBool::new(false),
     )
     .unwrap();

@@ -12,7 +12,7 @@ use super::{FrameProblem, FrameResult};
 use nalgebra::{Point3, Vector3};
 use std::collections::BTreeMap;
 use videomocap_core::camera::PinholeCamera;
-use videomocap_core::formats::{Frame3d, Skeleton3d};
+use videomocap_core::formats::{Frame3d, FrameIndex, Skeleton3d};
 use videomocap_core::skeleton::{Bone, Joint, PerJoint, SubjectModel};
 
 /// How left and right were decided.
@@ -286,7 +286,7 @@ pub fn assemble(
             if let Some(p) = &poses[i] {
                 before = i;
                 frames.push(Frame3d {
-                    index: i,
+                    index: FrameIndex(i),
                     points: *p,
                     flags: Vec::new(),
                 });
@@ -299,7 +299,7 @@ pub fn assemble(
             };
             let t = (i - before) as f64 / (after - before) as f64;
             frames.push(Frame3d {
-                index: i,
+                index: FrameIndex(i),
                 points: PerJoint::from_fn(|j| a[j] + (b[j] - a[j]) * t),
                 flags: vec!["interpolated".to_owned()],
             });

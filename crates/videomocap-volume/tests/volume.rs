@@ -4,6 +4,7 @@
 use nalgebra::{Point3, Vector3};
 use rand::SeedableRng;
 use std::sync::atomic::AtomicBool;
+use videomocap_core::formats::FrameIndex;
 use videomocap_core::skeleton::{Joint, SubjectModel};
 use videomocap_testkit::eval::volume::{CarveCase, VolumeScore, carve_and_score, score_volume};
 use videomocap_testkit::synth::{
@@ -178,14 +179,19 @@ fn bad_frames_are_warned_about_and_interpolated_never_a_panic() {
             && w.contains("placed between frames 2 and 6"),
         "{w}"
     );
-    let placed = p.assembled.skeleton.frames.iter().find(|f| f.index == 5);
+    let placed = p
+        .assembled
+        .skeleton
+        .frames
+        .iter()
+        .find(|f| f.index == FrameIndex(5));
     let wrist = placed.map(|f| f.points[Joint::LeftWrist]).unwrap();
     let off = (wrist - motion.frames[5][Joint::LeftWrist]).norm();
     assert!(off < 0.2, "left wrist placed {off:.3} m from the truth");
     let frames = &p.assembled.skeleton.frames;
     assert_eq!(frames.len(), 8);
     for f in frames {
-        let bad = p.results[f.index].is_err();
+        let bad = p.results[f.index.get()].is_err();
         assert_eq!(
             f.flags.contains(&"interpolated".to_owned()),
             bad,

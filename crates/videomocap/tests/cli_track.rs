@@ -1,6 +1,7 @@
 //! `videomocap track` end to end: marks, keys with a correction, and a project re-tracked.
 
 use assert_cmd::Command;
+use videomocap_core::formats::FrameIndex;
 use videomocap_core::formats::{Marks, Tracks2d};
 use videomocap_core::skeleton::Joint;
 use videomocap_testkit::synth::{ProceduralMotion, View, render_small_clip};
@@ -39,7 +40,7 @@ fn the_track_command_writes_tracks_that_load() {
     let marks = Marks::load(&dir.path().join("marks.json")).unwrap();
     let mut keys = videomocap_core::formats::KeyFrames::from_marks(&marks);
     let wrist = t.frames[5].points[Joint::LeftWrist].pos + nalgebra::Vector2::new(4.0, 0.0);
-    keys.set(5, Joint::LeftWrist, wrist);
+    keys.set(FrameIndex(5), Joint::LeftWrist, wrist);
     keys.save(&dir.path().join("keys.json")).unwrap();
     let cli = |args: &[&std::ffi::OsStr]| {
         let o = Command::cargo_bin("videomocap")

@@ -16,6 +16,7 @@ use crate::{ExitError, say};
 use std::collections::BTreeSet;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
+use videomocap_core::formats::FrameIndex;
 use videomocap_core::formats::{Marks, Tracks2d};
 use videomocap_core::track::{KeyFrames, TrackJob, TrackProgress, TrackerParams, track_video};
 use videomocap_core::video::{OpenOptions, Video};
@@ -76,7 +77,7 @@ fn correct_clip(
     let background = first.background;
     let mut seen = first.network;
     let mut keys = KeyFrames::from_marks(&marks);
-    let mut done = BTreeSet::from([marks.frame]);
+    let mut done = BTreeSet::from([marks.frame.get()]);
     let score = |tracks: &Tracks2d| -> Result<Accuracy, ExitError> {
         score_tracks(&gt, tracks)
             .map(|s| s.overall)
@@ -100,7 +101,7 @@ fn correct_clip(
             break;
         };
         for (joint, pos) in &c.drags {
-            keys.set(c.frame, *joint, *pos);
+            keys.set(FrameIndex(c.frame), *joint, *pos);
         }
         done.insert(c.frame);
         let n = tracks.frames.len();
@@ -115,8 +116,9 @@ fn correct_clip(
             previous_network: seen.take(),
         };
         // The re-track changes nothing before this (those frames stay drawn as they were).
-        let low = keys.earliest_changed_by(c.frame);
-        let mut waiting: BTreeSet<usize> = next_to(c.frame, n).filter(|&f| f >= low).collect();
+        let low = keys.earliest_changed_by(FrameIndex(c.frame));
+        let mut waiting: BTreeSet<usize> =
+            next_to(c.frame, n).filter(|&f| f >= low.get()).collect();
         // Timed as the app re-tracks: the job opens the video, reuses the background of the
         // first run, and draws frames as they arrive.
         let started = Instant::now();
@@ -125,7 +127,7 @@ fn correct_clip(
         let mut arrived_s = None;
         let mut on_progress = |p: &TrackProgress| {
             if let Some(f) = &p.frame {
-                waiting.remove(&f.index);
+                waiting.remove(&f.index.get());
                 if waiting.is_empty() && arrived_s.is_none() {
                     arrived_s = Some(started.elapsed().as_secs_f64());
                 }

@@ -18,11 +18,14 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 use videomocap_core::camera::default_focal;
 use videomocap_core::formats::{Marks, Tracks2d};
-use videomocap_core::lift::subject_from_height;
-use videomocap_core::lift::{LiftJob, LiftParams, lift, lift_per_frame};
+
+use videomocap_core::lift::{
+    CameraChoice, LiftJob, LiftParams, SubjectChoice, lift_per_frame, reconstruct,
+};
 use videomocap_core::skeleton::{Bone, DEFAULT_HEIGHT_M};
 use videomocap_core::track::TrackerParams;
 use videomocap_core::video::{OpenOptions, Video};
+use videomocap_testkit::eval::doubt::{DoubtTally, UNSURE_SWEEP, tally_doubt};
 use videomocap_testkit::eval::pose3d::{
     Pose3dScore, cutout, score_skeleton, subject_from_truth, tracks_from_truth,
 };
@@ -39,8 +42,8 @@ const FOCALS: [&str; 2] = ["true focal", "default 60°"];
 /// The lift's score and the cut-out's on the same input and camera.
 type Pair = (Pose3dScore, Pose3dScore);
 /// Every case of one clip: `[input][lengths][focal]`, and per input the bone lengths the lift
-/// ended with from the stated height and the true focal length.
-type Cases = ([[[Pair; 2]; 2]; 3], [LengthErrors; 3]);
+/// ended with from the stated height and the true focal length, and its doubts there.
+type Cases = ([[[Pair; 2]; 2]; 3], [(LengthErrors, DoubtTally); 3]);
 
 /// How far the bone lengths a lift ended with are from the reference's: |read ÷ true − 1| per
 /// bone and clip.
@@ -60,6 +63,26 @@ impl LengthErrors {
         v.sort_by(f64::total_cmp);
         v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
     }
+}
+
+/// The doubt table's columns: frames flagged, wrong rates flagged / not, and per margin the
+/// unsure share with the wrong rates unsure / sure (percent).
+fn doubt_cell(d: &DoubtTally) -> String {
+    let (wf, wu) = d.flagged_rates();
+    let mut s = format!(
+        "{:>7.1}% {:>6.1}/{:<6.1}",
+        100.0 * d.frames_flagged_share(),
+        100.0 * wf,
+        100.0 * wu
+    );
+    for k in 0..UNSURE_SWEEP.len() {
+        let (u, wu, ws) = d.unsure_rates(k);
+        s += &format!(
+            " {:>17}",
+            format!("{:.1} {:.0}/{:.0}", 100.0 * u, 100.0 * wu, 100.0 * ws)
+        );
+    }
+    s
 }
 
 /// The side table's column: the lengths' median error and the share of frames mirrored.
@@ -136,31 +159,41 @@ fn run_clip(
         let flat =
             score_skeleton(&gt, &cutout(&gt, tracks, true_camera)).map_err(ExitError::failed)?;
         for (f, camera) in [true_camera, default_camera].into_iter().enumerate() {
-            let t0 = Instant::now();
-            let read = subject_from_height(stated, tracks, camera, params, &Default::default())
-                .map_err(ExitError::failed)?
-                .0;
-            if (*i, f) == (0, 0) {
-                whole_s += t0.elapsed().as_secs_f64();
-            }
-            let subjects = [subject_from_truth(&gt), read];
-            for (l, subject) in subjects.into_iter().enumerate() {
-                let job = LiftJob {
-                    tracks,
-                    camera,
-                    subject,
-                    params: *params,
-                    overrides: Default::default(),
-                };
+            // The user's case reads the lengths through the camera; the true lengths are a
+            // subject given whole.
+            let subjects = [
+                SubjectChoice::Model(Box::new(subject_from_truth(&gt))),
+                SubjectChoice::Height {
+                    height_m: stated,
+                    known: Default::default(),
+                },
+            ];
+            for (l, subject) in subjects.iter().enumerate() {
                 if (*i, l, f) == (0, 0, 0) {
+                    let job = LiftJob {
+                        tracks,
+                        camera,
+                        subject: subject_from_truth(&gt),
+                        params: *params,
+                        overrides: Default::default(),
+                    };
                     let t0 = Instant::now();
                     lift_per_frame(&job).map_err(ExitError::failed)?;
                     solve_s += t0.elapsed().as_secs_f64();
                     solve_frames += tracks.frames.len();
                 }
                 let t0 = Instant::now();
-                let out =
-                    lift(&job, &mut |_| {}, &AtomicBool::new(false)).map_err(ExitError::failed)?;
+                let out = reconstruct(
+                    tracks,
+                    CameraChoice::Given(camera),
+                    subject,
+                    params,
+                    Default::default(),
+                    &mut |_| {},
+                    &AtomicBool::new(false),
+                )
+                .map_err(ExitError::failed)?
+                .output;
                 if (*i, l, f) == (0, 1, 0) {
                     whole_s += t0.elapsed().as_secs_f64();
                 }
@@ -168,7 +201,11 @@ fn run_clip(
                 if (l, f) == (1, 0) {
                     cases.1[*i]
                         .0
+                        .0
                         .extend(length_errors(&gt, &out.skeleton.bone_lengths_m));
+                    let doubt =
+                        tally_doubt(&gt, &out.skeleton, &out.bones).map_err(ExitError::failed)?;
+                    cases.1[*i].1.merge(&doubt);
                 }
                 let case = &mut cases.0[*i][l][f];
                 case.0.merge(&score);
@@ -266,7 +303,30 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     for (i, input) in INPUTS.iter().enumerate() {
         out.push((*input).to_owned());
         out.extend(Tally::<Cases>::heading(SIDE_WIDTH, SIDE_COLUMNS));
-        out.extend(tally.lines(SIDE_WIDTH, |c: &Cases| side_cell(&c.1[i], &c.0[i][1][0].0)));
+        out.extend(tally.lines(SIDE_WIDTH, |c: &Cases| {
+            side_cell(&c.1[i].0, &c.0[i][1][0].0)
+        }));
+    }
+    out.push(String::new());
+    out.push(
+        "stated height, true focal: the depth choices that matter (roots apart, no coin flip): frames with a bone flagged too long; how often a flagged bone's choice is wrong against an unflagged one's; per margin, the share shown unsure and how often an unsure / a sure choice is wrong"
+            .to_owned(),
+    );
+    let doubt_columns = format!(
+        "{:>8} {:>13} {}",
+        "flagged",
+        "wrong f/unf",
+        UNSURE_SWEEP
+            .iter()
+            .map(|m| format!("{:>17}", format!("<{m}: u% wu/ws")))
+            .collect::<Vec<_>>()
+            .join(" ")
+    );
+    let doubt_width = doubt_columns.chars().count();
+    for (i, input) in INPUTS.iter().enumerate() {
+        out.push((*input).to_owned());
+        out.extend(Tally::<Cases>::heading(doubt_width, &doubt_columns));
+        out.extend(tally.lines(doubt_width, |c: &Cases| doubt_cell(&c.1[i].1)));
     }
     out.push(String::new());
     out.extend(per_clip);
@@ -292,7 +352,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
                                 "mpjpe_mm": p.0.mpjpe_mm(), "pa_mpjpe_mm": p.0.pa_mpjpe_mm(),
                                 "cutout_mm": p.1.mpjpe_mm(), "wrong_roots": p.0.wrong_share(),
                                 "facing_mirrored": p.0.facing_mirrored_share(),
-                                "length_median_error": ((l, f) == (1, 0)).then(|| c.1[i].median()),
+                                "length_median_error": ((l, f) == (1, 0)).then(|| c.1[i].0.median()),
                             })
                         }),
                     );

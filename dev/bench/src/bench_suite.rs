@@ -86,6 +86,12 @@ impl Merge for videomocap_testkit::eval::pose3d::Pose3dScore {
     }
 }
 
+impl Merge for videomocap_testkit::eval::doubt::DoubtTally {
+    fn merge_from(&mut self, other: &Self) {
+        self.merge(other);
+    }
+}
+
 impl Merge for videomocap_testkit::eval::volume::VolumeScore {
     fn merge_from(&mut self, other: &Self) {
         self.merge(other);

@@ -22,6 +22,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
+use videomocap_core::formats::FrameIndex;
 use videomocap_core::formats::Marks;
 use videomocap_core::skeleton::{Joint, PerJoint};
 use videomocap_core::track::FloatFrame;
@@ -502,7 +503,7 @@ fn speed_both_ways(dir: &Path, params: TrackerParams) -> Result<f64, ExitError> 
         .ok_or_else(|| ExitError::failed(anyhow!("{}: no reference frames", dir.display())))?
         .points2d();
     for j in Joint::ALL {
-        timer.job.keys.set(n - 1, j, last[j]);
+        timer.job.keys.set(FrameIndex(n - 1), j, last[j]);
     }
     let mut best = f64::INFINITY;
     for _ in 0..SPEED_RUNS {

@@ -11,6 +11,7 @@ use anyhow::anyhow;
 use nalgebra::Point2;
 use std::io::Write;
 use videomocap::cli::export::{Outputs3d, write_3d};
+use videomocap_core::formats::FrameIndex;
 use videomocap_core::project::Project;
 use videomocap_core::skeleton::{Joint, PerJoint};
 
@@ -37,14 +38,14 @@ pub fn run(a: &StressWriteArgs) -> Result<(), ExitError> {
         round += 1;
         let mut correction = PerJoint::from_fn(|_| None);
         correction[Joint::LeftWrist] = Some(Point2::new(round as f64, 0.5));
-        project.keys.frames.retain(|&f, _| f == 0);
+        project.keys.frames.retain(|&f, _| f == FrameIndex(0));
         let corrected = if round.is_multiple_of(2) {
             1..frames
         } else {
             ROUND_FRAME..ROUND_FRAME + 1
         };
         for f in corrected {
-            project.keys.frames.insert(f, correction);
+            project.keys.frames.insert(FrameIndex(f), correction);
         }
         // Each step is announced on stdout first, so the test can aim its kill at it.
         announce(&format!("save {round}"))?;

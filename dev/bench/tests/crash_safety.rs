@@ -11,6 +11,7 @@ use std::process::{Command, Stdio};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use videomocap_core::bvh::Bvh;
+use videomocap_core::formats::FrameIndex;
 use videomocap_core::formats::{Skeleton3d, Tracks2d};
 use videomocap_core::project::Project;
 use videomocap_core::skeleton::Joint;
@@ -34,7 +35,7 @@ fn big_project(n: usize) -> Project {
     tracks.frames = (0..n)
         .map(|i| {
             let mut f = tracks.frames[i % 3].clone();
-            f.index = i;
+            f.index = FrameIndex(i);
             f
         })
         .collect();
@@ -42,7 +43,7 @@ fn big_project(n: usize) -> Project {
     skeleton.frames = (0..n)
         .map(|i| {
             let mut f = skeleton.frames[i % 3].clone();
-            f.index = i;
+            f.index = FrameIndex(i);
             f
         })
         .collect();
@@ -143,7 +144,7 @@ fn killing_the_writer_never_leaves_a_torn_project_or_export() {
             .keys
             .frames
             .iter()
-            .filter(|(f, _)| **f != 0)
+            .filter(|(f, _)| **f != FrameIndex(0))
             .map(|(_, k)| k[Joint::LeftWrist].expect("the writer's correction").x)
             .collect();
         let round = rounds[0];

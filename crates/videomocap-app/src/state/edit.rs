@@ -4,6 +4,7 @@
 
 use super::State;
 use nalgebra::Point2;
+use videomocap_core::formats::FrameIndex;
 use videomocap_core::project::{History, Project, Settings};
 use videomocap_core::skeleton::{Bone, Joint};
 
@@ -106,12 +107,12 @@ impl State {
         };
         self.edit(what, |p| {
             let old = shown[joint].map(|(q, _)| q);
-            p.keys.set(frame, joint, onto_image(pos));
+            p.keys.set(FrameIndex(frame), joint, onto_image(pos));
             if move_limb && let Some(old) = old {
                 let delta = pos - old;
                 for j in descendants(joint) {
                     if let Some((q, _)) = shown[j] {
-                        p.keys.set(frame, j, onto_image(q + delta));
+                        p.keys.set(FrameIndex(frame), j, onto_image(q + delta));
                     }
                 }
             }
@@ -157,7 +158,11 @@ impl State {
             .project
             .as_ref()
             .and_then(|p| p.tracks.as_ref())
-            .and_then(|t| t.frames.binary_search_by_key(&frame, |f| f.index).ok())
+            .and_then(|t| {
+                t.frames
+                    .binary_search_by_key(&FrameIndex(frame), |f| f.index)
+                    .ok()
+            })
         else {
             self.status = format!("Frame {frame} is not tracked: nothing to flip");
             return;
@@ -174,7 +179,11 @@ impl State {
                 .to_owned();
             return;
         };
-        if choices.single_root.get(k).is_some_and(|s| s[bone.index()]) {
+        if choices
+            .bones
+            .get(k)
+            .is_some_and(|s| s[bone.index()].single_root)
+        {
             self.status = format!(
                 "{} cannot flip on frame {frame}: its 2D image is longer than the bone, so both \
                  depths are one point. Correct its joints on the frame, or the subject height",
@@ -182,11 +191,12 @@ impl State {
             );
             return;
         }
-        let Some(current) = choices.roots.get(k).map(|c| c[bone.index()]) else {
+        let Some(current) = choices.bones.get(k).map(|c| c[bone.index()].root) else {
             return;
         };
         self.edit(&format!("flip {} on frame {frame}", bone.key()), |p| {
-            p.overrides.insert((frame, bone), current.flipped());
+            p.overrides
+                .insert((FrameIndex(frame), bone), current.flipped());
         });
         self.status = format!("{} flipped on frame {frame}: lifting again", bone.key());
         self.start_lift();
@@ -242,7 +252,7 @@ mod tests {
     use videomocap_core::formats::{
         FrameTracks, PointSource, Skeleton3d, SourceInfo, TrackedPoint,
     };
-    use videomocap_core::lift::Root;
+    use videomocap_core::lift::{BoneDepth, Root};
     use videomocap_core::skeleton::{BONE_COUNT, PerJoint};
 
     /// A state without a window, dialogs or autosave, on a project of `frames` tracked frames.
@@ -264,7 +274,7 @@ mod tests {
             },
             frames: (0..frames)
                 .map(|index| FrameTracks {
-                    index,
+                    index: FrameIndex(index),
                     points: PerJoint::from_fn(|_| TrackedPoint {
                         pos: Point2::new(10.0, 10.0),
                         confidence: 0.9,
@@ -285,12 +295,16 @@ mod tests {
             bone_lengths_m: Default::default(),
             frames: Vec::new(),
         });
-        let mut single_root = vec![[false; BONE_COUNT]; frames];
-        single_root[0][4] = true;
+        let near = BoneDepth {
+            root: Root::Near,
+            single_root: false,
+            margin: 1.0,
+        };
+        let mut bones = vec![[near; BONE_COUNT]; frames];
+        bones[0][4].single_root = true;
         s.choices.push(LiftChoices {
             skeleton: skeleton.clone(),
-            roots: vec![[Root::Near; BONE_COUNT]; frames],
-            single_root,
+            bones,
         });
         if let Some(p) = &mut s.project {
             p.skeleton = Some(skeleton);
@@ -314,6 +328,68 @@ mod tests {
         assert_eq!(s.project().unwrap().overrides.len(), 1);
         let name = format!("flip {} on frame 0", Bone::ALL[5].key());
         assert_eq!(s.undo_name(), Some(name.as_str()));
+    }
+
+    /// The lift's unsure depth choices are offered on their own frame only, and only for the
+    /// skeleton they came from.
+    #[test]
+    fn the_bones_the_lift_was_unsure_of_are_named_on_their_frame() {
+        let mut s = state_with_tracks(2);
+        // A person 3 m in front of the camera (camera space, Y down).
+        let body = PerJoint::from_fn(|j| {
+            let x = if j.name().starts_with("left") {
+                0.2
+            } else if j.name().starts_with("right") {
+                -0.2
+            } else {
+                0.0
+            };
+            let y = match j {
+                Joint::HeadTop => -0.8,
+                Joint::Neck => -0.6,
+                Joint::Chest | Joint::LeftShoulder | Joint::RightShoulder => -0.45,
+                Joint::LeftElbow | Joint::RightElbow => -0.2,
+                Joint::LeftWrist | Joint::RightWrist => 0.05,
+                Joint::LeftKnee | Joint::RightKnee => 0.45,
+                Joint::LeftAnkle | Joint::RightAnkle => 0.9,
+                _ => 0.0,
+            };
+            nalgebra::Point3::new(x, y, 3.0)
+        });
+        let skeleton = Arc::new(Skeleton3d {
+            camera: PinholeCamera::centred(60.0, 64, 48),
+            fps: Some(30.0),
+            bone_lengths_m: Default::default(),
+            frames: (0..2)
+                .map(|i| videomocap_core::formats::Frame3d {
+                    index: FrameIndex(i),
+                    points: body,
+                    flags: Vec::new(),
+                })
+                .collect(),
+        });
+        let sure = BoneDepth {
+            root: Root::Near,
+            single_root: false,
+            margin: 1.0,
+        };
+        let mut bones = vec![[sure; BONE_COUNT]; 2];
+        let forearm = Bone::new(Joint::LeftElbow, Joint::LeftWrist);
+        bones[1][forearm.index()].margin = 0.0;
+        // A single root has nothing to choose, however small its margin.
+        bones[1][Bone::ALL[4].index()] = BoneDepth {
+            single_root: true,
+            margin: 0.0,
+            ..sure
+        };
+        s.choices.push(LiftChoices {
+            skeleton: skeleton.clone(),
+            bones,
+        });
+        s.edit("lift", |p| p.skeleton = Some(skeleton));
+        assert!(s.unsure_bones(0).is_empty());
+        assert_eq!(s.unsure_bones(1), [forearm]);
+        assert_eq!(forearm.plain_name(), "left forearm");
     }
 
     #[test]

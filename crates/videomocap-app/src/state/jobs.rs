@@ -8,8 +8,8 @@ use std::sync::mpsc::{Receiver, channel};
 use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 use videomocap_core::formats::{FrameTracks, Tracks2d};
-use videomocap_core::lift::{DepthOverrides, LiftJob, LiftOutput, LiftParams, lift};
-use videomocap_core::lift::{SubjectFit, subject_from_height};
+use videomocap_core::lift::{CameraChoice, SubjectChoice, reconstruct};
+use videomocap_core::lift::{DepthOverrides, LiftOutput, LiftParams, SubjectFit};
 use videomocap_core::network::PoseNetwork;
 use videomocap_core::track::{TrackJob, TrackOutput, track_video};
 use videomocap_core::video::{OpenOptions, Video};
@@ -42,7 +42,7 @@ pub enum JobEvent {
     /// Tracking finished.
     Tracked(Result<TrackOutput, String>),
     /// Lifting finished.
-    Lifted(Result<(LiftOutput, SubjectFit), String>),
+    Lifted(Result<(LiftOutput, Option<SubjectFit>), String>),
     /// A point-volume sequence was processed.
     Volume(Result<Processed, String>),
 }
@@ -109,36 +109,29 @@ impl Job {
         let cancel = Arc::new(AtomicBool::new(false));
         let flag = cancel.clone();
         std::thread::spawn(move || {
-            let camera = videomocap_core::camera::PinholeCamera::centred(
-                focal_px,
-                tracks.source.width,
-                tracks.source.height,
-            );
-            let result = subject_from_height(height_m, &tracks, camera, &params, &known)
-                .map_err(|e| e.to_string())
-                .and_then(|(subject, fit)| {
-                    let job = LiftJob {
-                        tracks: &tracks,
-                        camera,
-                        subject,
-                        params,
-                        overrides,
-                    };
-                    let progress_tx = tx.clone();
-                    let repaint = ctx.clone();
-                    let mut progress = move |p: &videomocap_core::lift::LiftProgress| {
-                        let _ = progress_tx.send(JobEvent::Progress {
-                            done: p.done,
-                            total: p.total,
-                            stage: p.stage.to_owned(),
-                            frame: None,
-                        });
-                        repaint.request_repaint();
-                    };
-                    lift(&job, &mut progress, &flag)
-                        .map(|out| (out, fit))
-                        .map_err(|e| e.to_string())
+            let progress_tx = tx.clone();
+            let repaint = ctx.clone();
+            let mut progress = move |p: &videomocap_core::lift::LiftProgress| {
+                let _ = progress_tx.send(JobEvent::Progress {
+                    done: p.done,
+                    total: p.total,
+                    stage: p.stage.to_string(),
+                    frame: None,
                 });
+                repaint.request_repaint();
+            };
+            let subject = SubjectChoice::Height { height_m, known };
+            let result = reconstruct(
+                &tracks,
+                CameraChoice::FocalPx(focal_px),
+                &subject,
+                &params,
+                overrides,
+                &mut progress,
+                &flag,
+            )
+            .map(|done| (done.output, done.fit))
+            .map_err(|e| e.to_string());
             let _ = tx.send(JobEvent::Lifted(result));
             ctx.request_repaint();
         });

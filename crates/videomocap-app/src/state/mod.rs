@@ -33,11 +33,11 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 use videomocap_core::export::WorldSkeleton;
-use videomocap_core::formats::{FrameTracks, Skeleton3d};
-use videomocap_core::lift::Root;
+use videomocap_core::formats::{FrameIndex, FrameTracks, Skeleton3d};
+use videomocap_core::lift::BoneDepth;
 use videomocap_core::lift::SubjectFit;
 use videomocap_core::project::{History, Project};
-use videomocap_core::skeleton::{BONE_COUNT, JOINT_COUNT, Joint, PerJoint};
+use videomocap_core::skeleton::{BONE_COUNT, Bone, JOINT_COUNT, Joint, PerJoint};
 use videomocap_core::track::{KeyFrames, WeakSpan, weak_spans};
 use videomocap_core::video::VideoInfo;
 use volume::VolumeSequence;
@@ -73,8 +73,7 @@ struct Running {
 /// redo, which bring back an earlier skeleton, find its choices).
 struct LiftChoices {
     skeleton: Arc<Skeleton3d>,
-    roots: Vec<[Root; BONE_COUNT]>,
-    single_root: Vec<[bool; BONE_COUNT]>,
+    bones: Vec<[BoneDepth; BONE_COUNT]>,
 }
 
 /// How much of the clip's tracks is weak, lost or filled in (the side panel's headline).
@@ -381,7 +380,7 @@ impl State {
     pub fn weak_share(&self) -> Option<WeakShare> {
         let tracks = self.project.as_ref()?.tracks.as_ref()?;
         Some(WeakShare {
-            joint_frames: self.spans.iter().map(|s| s.end + 1 - s.start).sum(),
+            joint_frames: self.spans.iter().map(|s| s.frames()).sum(),
             total: tracks.frames.len() * JOINT_COUNT,
         })
     }
@@ -398,6 +397,32 @@ impl State {
             None if self.busy() => self.last_world.as_ref().map(|(w, s)| (w, s.as_ref())),
             None => None,
         }
+    }
+
+    /// The bones whose depth choice the lift of the shown skeleton was unsure of on `frame`
+    /// ([`BoneDepth::unsure`]: the other root explained the clip almost as well), worth a look
+    /// and perhaps a flip. Empty when the lift's choices are not known (a loaded result).
+    pub fn unsure_bones(&self, frame: usize) -> Vec<Bone> {
+        let Some((_, skeleton)) = self.shown_world() else {
+            return Vec::new();
+        };
+        let Some(k) = skeleton
+            .frames
+            .binary_search_by_key(&FrameIndex(frame), |f| f.index)
+            .ok()
+        else {
+            return Vec::new();
+        };
+        self.choices
+            .iter()
+            .find(|c| std::ptr::eq(c.skeleton.as_ref(), skeleton))
+            .and_then(|c| c.bones.get(k))
+            .map_or_else(Vec::new, |bones| {
+                Bone::ALL
+                    .into_iter()
+                    .filter(|b| bones[b.index()].unsure())
+                    .collect()
+            })
     }
 
     /// Whether the 3D skeleton shown is the last one, kept while a job makes the next.
@@ -445,12 +470,12 @@ impl State {
         let tracked = self.partial.get(&frame).or_else(|| {
             p.tracks.as_ref().and_then(|t| {
                 t.frames
-                    .binary_search_by_key(&frame, |f| f.index)
+                    .binary_search_by_key(&FrameIndex(frame), |f| f.index)
                     .ok()
                     .map(|k| &t.frames[k])
             })
         });
-        let keys = p.keys.frames.get(&frame);
+        let keys = p.keys.frames.get(&FrameIndex(frame));
         PerJoint::from_fn(|j| {
             if let Some(k) = keys.and_then(|k| k[j]) {
                 return Some((k, PointState::Key));
@@ -513,7 +538,7 @@ impl State {
         self.strips = p.tracks.as_ref().map(|t| Strips::new(t, &p.keys, weak));
         // From the tracks, so a reopened project or an undone re-track shows its own spans.
         self.spans = p.tracks.as_ref().map_or_else(Vec::new, |t| {
-            weak_spans(&t.frames, weak, &|i, j| p.keys.is_key(t.frames[i].index, j))
+            weak_spans(&t.frames, weak, &|f, j| p.keys.is_key(f, j))
         });
         self.world = p
             .skeleton

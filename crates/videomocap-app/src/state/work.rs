@@ -105,7 +105,7 @@ impl State {
         for event in events {
             match event {
                 JobEvent::Progress { frame: Some(f), .. } => {
-                    self.partial.insert(f.index, f);
+                    self.partial.insert(f.index.get(), f);
                 }
                 JobEvent::Progress { .. } => {}
                 JobEvent::Tracked(result) => self.tracked(result),
@@ -202,7 +202,7 @@ impl State {
                     .is_ok()
             });
         if let Some(m) = beside {
-            self.current = m.frame.min(info.frame_count.saturating_sub(1));
+            self.current = m.frame.get().min(info.frame_count.saturating_sub(1));
             if let Some(p) = &mut self.project {
                 p.keys = KeyFrames::from_marks(&m);
             }
@@ -252,7 +252,7 @@ impl State {
         }
     }
 
-    fn lifted(&mut self, result: Result<(LiftOutput, SubjectFit), String>) {
+    fn lifted(&mut self, result: Result<(LiftOutput, Option<SubjectFit>), String>) {
         let Some(r) = self.running.take() else { return };
         match result {
             Ok((out, fit)) => {
@@ -264,7 +264,7 @@ impl State {
                     self.status = "Lift finished for an older edit; result dropped".to_owned();
                     return;
                 }
-                self.subject_fit = Some(fit);
+                self.subject_fit = fit;
                 let skeleton = Arc::new(out.skeleton);
                 let flagged = skeleton
                     .frames
@@ -273,8 +273,7 @@ impl State {
                     .count();
                 self.choices.push(LiftChoices {
                     skeleton: skeleton.clone(),
-                    roots: out.choices,
-                    single_root: out.single_root,
+                    bones: out.bones,
                 });
                 if self.choices.len() > CHOICES_KEPT {
                     self.choices.remove(0);

@@ -3,6 +3,7 @@ use crate::state::ExportKind;
 use crate::state::frame_loader::FrameLoader;
 use crate::state::frame_loader::ProxyStatus;
 use egui_kittest::kittest::Queryable;
+use videomocap_core::formats::FrameIndex;
 use videomocap_core::formats::Marks;
 use videomocap_core::project::Project;
 use videomocap_core::skeleton::{Bone, Joint};
@@ -170,14 +171,16 @@ fn mark_drag_undo_track_scrub_orbit_export_and_recover() {
     let wrist = truth.points[Joint::LeftWrist];
     let from = screen(&h, wrist);
     drag(&mut h, from, from + egui::vec2(30.0, 0.0));
-    let moved = h.state().state().project().unwrap().keys.frames[&0][Joint::LeftWrist].unwrap();
+    let moved =
+        h.state().state().project().unwrap().keys.frames[&FrameIndex(0)][Joint::LeftWrist].unwrap();
     assert!(
         moved.x - wrist.x > 5.0,
         "dragged to {moved:?} from {wrist:?}"
     );
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
     h.step();
-    let back = h.state().state().project().unwrap().keys.frames[&0][Joint::LeftWrist].unwrap();
+    let back =
+        h.state().state().project().unwrap().keys.frames[&FrameIndex(0)][Joint::LeftWrist].unwrap();
     assert!(
         (back - marks.points[Joint::LeftWrist]).norm() < 1e-9,
         "undo puts it back"
@@ -244,7 +247,7 @@ fn mark_drag_undo_track_scrub_orbit_export_and_recover() {
         !a.busy() && a.project().is_some_and(|p| p.skeleton.is_some())
     });
     let p = h.state().state().project().unwrap();
-    let key = p.keys.frames[&3][Joint::LeftWrist].unwrap();
+    let key = p.keys.frames[&FrameIndex(3)][Joint::LeftWrist].unwrap();
     assert!((key - moved_to).norm() < 1.5, "key {key} vs {moved_to}");
     let tracked = &p.tracks.as_ref().unwrap().frames[3].points[Joint::LeftWrist];
     assert!((tracked.pos - key).norm() < 1e-9, "the track keeps the key");

@@ -8,6 +8,7 @@ use crate::state::State;
 use crate::state::volume::VolumeSequence;
 use egui::{Color32, Stroke};
 use nalgebra::{Point3, Vector3};
+use videomocap_core::formats::FrameIndex;
 use videomocap_core::skeleton::{Bone, Joint};
 use videomocap_volume::Part;
 use videomocap_volume::bodies::Cylinder;
@@ -27,7 +28,7 @@ pub fn scene(state: &State) -> Scene {
     };
     let joints = world
         .indices
-        .binary_search(&current)
+        .binary_search(&FrameIndex(current))
         .ok()
         .map(|k| world.frames[k]);
     let cam = &skeleton.camera;
@@ -66,7 +67,7 @@ pub fn scene(state: &State) -> Scene {
     }
     let flags = skeleton
         .frames
-        .binary_search_by_key(&current, |f| f.index)
+        .binary_search_by_key(&FrameIndex(current), |f| f.index)
         .ok()
         .map(|k| &skeleton.frames[k].flags);
     let mut too_long = Vec::new();
@@ -87,6 +88,19 @@ pub fn scene(state: &State) -> Scene {
             format!("flagged: {what} longer in the image than it can be"),
         );
         scene.flagged = too_long;
+    }
+    let unsure: Vec<Bone> = state
+        .unsure_bones(current)
+        .into_iter()
+        .filter(|b| scene.flippable.contains(b))
+        .collect();
+    if !unsure.is_empty() {
+        let names: Vec<String> = unsure.iter().map(|b| b.plain_name()).collect();
+        scene.notes.push(format!(
+            "depth unsure (amber): {}: if one points the wrong way, click it to flip",
+            names.join(", ")
+        ));
+        scene.unsure = unsure;
     }
     scene
 }
@@ -113,7 +127,7 @@ pub fn volume_scene(v: &VolumeSequence, index: usize) -> Scene {
     let to_world = |q: &Point3<f64>| world.world.to_world(q);
     scene.joints = world
         .indices
-        .binary_search(&index)
+        .binary_search(&FrameIndex(index))
         .ok()
         .map(|k| world.frames[k]);
     let Some(Ok(frame)) = p.results.get(index) else {

@@ -142,7 +142,7 @@ fn weak(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
                     s.joint, s.start, s.end, s.kind, s.min_reliability
                 );
                 if ui.link(text).clicked() {
-                    out.push(Intent::GoTo(s.start));
+                    out.push(Intent::GoTo(s.start.get()));
                 }
             }
         });

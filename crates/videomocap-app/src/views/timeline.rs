@@ -7,7 +7,7 @@ use super::frame_view::PointState;
 use crate::intent::Intent;
 use crate::state::State;
 use egui::{Color32, Rect, Sense, Stroke, Vec2};
-use videomocap_core::formats::Tracks2d;
+use videomocap_core::formats::{FrameIndex, Tracks2d};
 use videomocap_core::skeleton::{JOINT_COUNT, Joint};
 use videomocap_core::track::KeyFrames;
 
@@ -90,7 +90,7 @@ pub fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
             s.frames
                 .iter()
                 .filter(|f| !f.flags.is_empty())
-                .map(|f| f.index)
+                .map(|f| f.index.get())
                 .collect()
         })
         .unwrap_or_default();
@@ -163,7 +163,7 @@ pub fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
         );
     };
     for &f in keys.frames.keys() {
-        tick(f, 0.0, Color32::WHITE);
+        tick(f.get(), 0.0, Color32::WHITE);
     }
     for &f in &flagged {
         tick(f, 1.0, Color32::from_rgb(230, 60, 60));
@@ -186,7 +186,7 @@ pub fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
         let row = ((pos.y - strips_top) / STRIP_H).floor();
         let text = if pos.y < strips_top {
             let mut t = format!("frame {f}");
-            if keys.frames.contains_key(&f) {
+            if keys.frames.contains_key(&FrameIndex(f)) {
                 t += " · key frame (white)";
             }
             if flagged.contains(&f) {
@@ -235,7 +235,7 @@ mod tests {
                 .iter()
                 .enumerate()
                 .map(|(i, &(confidence, source))| FrameTracks {
-                    index: i,
+                    index: FrameIndex(i),
                     points: PerJoint::from_fn(|j| TrackedPoint {
                         pos: Point2::new(10.0, 10.0),
                         confidence: if j == Joint::LeftWrist {

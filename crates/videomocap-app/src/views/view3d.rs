@@ -24,12 +24,17 @@ pub struct Scene {
     pub segments: Vec<(Point3<f64>, Point3<f64>, Stroke)>,
     /// Bones the lift flagged on this frame (drawn red).
     pub flagged: Vec<Bone>,
+    /// Bones whose depth the lift was unsure of on this frame (drawn amber).
+    pub unsure: Vec<Bone>,
     /// Lines written over the view's top-left corner (what the lift flagged, a stale view).
     pub notes: Vec<String>,
 }
 
 /// Colour of a bone the lift flagged.
 const FLAGGED: Color32 = Color32::from_rgb(230, 60, 60);
+
+/// Colour of a bone whose depth the lift was unsure of.
+const UNSURE: Color32 = Color32::from_rgb(255, 190, 40);
 
 /// An orbiting view around a target point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -173,6 +178,8 @@ impl Orbit {
                 let width = if hovered == Some(b) { 5.0 } else { 2.5 };
                 let colour = if scene.flagged.contains(&b) {
                     FLAGGED
+                } else if scene.unsure.contains(&b) {
+                    UNSURE
                 } else {
                     side_colour(b.child)
                 };

@@ -17,7 +17,9 @@ pub use euler::zxy_degrees;
 pub use tables::{skeleton_csv, tracks_csv, trc};
 pub use world::{UpSource, WorldFrame};
 
-use crate::formats::{FormatError, LOST_FLAG, OFF_FRAME_FLAG, Skeleton3d, write_atomically};
+use crate::formats::{
+    FormatError, FrameIndex, LOST_FLAG, OFF_FRAME_FLAG, Skeleton3d, write_atomically,
+};
 use crate::skeleton::{Joint, PerJoint};
 use nalgebra::Point3;
 use std::path::{Path, PathBuf};
@@ -38,7 +40,10 @@ pub enum ExportError {
     #[error(
         "frames are not consecutive (frame {next} follows frame {previous}); BVH needs one pose per frame"
     )]
-    Gap { previous: usize, next: usize },
+    Gap {
+        previous: FrameIndex,
+        next: FrameIndex,
+    },
     #[error(transparent)]
     Write(#[from] FormatError),
 }
@@ -52,7 +57,7 @@ pub struct WorldSkeleton {
     /// Frames per second of the source.
     pub fps: f64,
     /// Frame indices in the video.
-    pub indices: Vec<usize>,
+    pub indices: Vec<FrameIndex>,
     /// Joints per frame, world metres.
     pub frames: Vec<PerJoint<Point3<f64>>>,
     /// Per frame, the joints whose 2D track was off the frame (from the `off_frame:` flags):
@@ -97,7 +102,7 @@ impl WorldSkeleton {
 
     /// Time of the `k`-th frame, seconds from the video's start.
     pub fn time_s(&self, k: usize) -> f64 {
-        self.indices[k] as f64 / self.fps
+        self.indices[k].seconds(self.fps)
     }
 }
 

@@ -30,7 +30,7 @@ pub fn tracks_csv(tracks: &Tracks2d) -> String {
     ];
     let _ = w.write_record(header);
     for f in &tracks.frames {
-        let time = f.index as f64 / tracks.source.fps;
+        let time = f.index.seconds(tracks.source.fps);
         for j in Joint::ALL {
             let p = f.points[j];
             let flag = |b: bool| if b { "1" } else { "0" }.to_owned();
@@ -102,7 +102,7 @@ pub fn trc(skeleton: &WorldSkeleton, file_name: &str) -> String {
         out,
         "DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\tOrigDataStartFrame\tOrigNumFrames"
     );
-    let first = skeleton.indices.first().map_or(1, |i| i + 1);
+    let first = skeleton.indices.first().map_or(1, |i| i.get() + 1);
     let _ = writeln!(
         out,
         "{rate:.4}\t{rate:.4}\t{n}\t{}\tm\t{rate:.4}\t{first}\t{n}",

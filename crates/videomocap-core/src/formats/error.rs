@@ -1,5 +1,6 @@
 //! The one error type of the file formats: every variant names the file.
 
+use super::FrameIndex;
 use crate::skeleton::Joint;
 use std::path::PathBuf;
 
@@ -43,13 +44,13 @@ pub enum FormatError {
     MissingJoint {
         path: PathBuf,
         joint: Joint,
-        frame: Option<usize>,
+        frame: Option<FrameIndex>,
     },
     #[error("{path}: joint {joint} has a non-finite coordinate{}", frame_suffix(*.frame))]
     NonFinite {
         path: PathBuf,
         joint: Joint,
-        frame: Option<usize>,
+        frame: Option<FrameIndex>,
     },
     #[error(
         "{path}: joint {joint} at ({x:.1}, {y:.1}) is outside the {width}×{height} frame{}",
@@ -62,12 +63,12 @@ pub enum FormatError {
         y: f64,
         width: u32,
         height: u32,
-        frame: Option<usize>,
+        frame: Option<FrameIndex>,
     },
     #[error("{path}: frame {frame}: \"{field}\" has {found} entries, expected {expected}")]
     WrongLength {
         path: PathBuf,
-        frame: usize,
+        frame: FrameIndex,
         field: &'static str,
         found: usize,
         expected: usize,
@@ -76,6 +77,6 @@ pub enum FormatError {
     Invalid { path: PathBuf, problem: String },
 }
 
-fn frame_suffix(frame: Option<usize>) -> String {
+fn frame_suffix(frame: Option<FrameIndex>) -> String {
     frame.map_or_else(String::new, |f| format!(" in frame {f}"))
 }

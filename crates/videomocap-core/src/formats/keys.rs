@@ -6,7 +6,8 @@
 //! shape (its `keys` field).
 
 use super::{
-    FORMAT_VERSION, FormatError, Marks, check_header, check_on_image, parse_json, read_text,
+    FORMAT_VERSION, FormatError, FrameIndex, Marks, check_header, check_on_image, parse_json,
+    read_text,
 };
 use crate::skeleton::{JOINT_COUNT, Joint, PerJoint};
 use nalgebra::Point2;
@@ -21,14 +22,14 @@ pub const KEYS_FORMAT: &str = "videomocap.keys";
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct KeyFrames {
     /// Per frame index, the joints placed by hand there.
-    pub frames: BTreeMap<usize, PerJoint<Option<Point2<f64>>>>,
+    pub frames: BTreeMap<FrameIndex, PerJoint<Option<Point2<f64>>>>,
 }
 
 /// One key as files write it: a frame and the joints placed on it, by name.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct KeyEntry {
-    pub(crate) frame: usize,
+    pub(crate) frame: FrameIndex,
     pub(crate) joints: BTreeMap<String, [f64; 2]>,
 }
 
@@ -56,7 +57,7 @@ impl KeyFrames {
     }
 
     /// Places one joint by hand on a frame (that frame becomes a key frame for the joint).
-    pub fn set(&mut self, frame: usize, joint: Joint, pos: Point2<f64>) {
+    pub fn set(&mut self, frame: FrameIndex, joint: Joint, pos: Point2<f64>) {
         self.frames
             .entry(frame)
             .or_insert_with(|| PerJoint([None; JOINT_COUNT]))[joint] = Some(pos);
@@ -65,7 +66,7 @@ impl KeyFrames {
     /// The earliest frame a re-track from a correction on frame `from` can change: the latest
     /// key before `from` that every joint has had (each joint's last key before it, the
     /// earliest of those; 0 when a joint has none).
-    pub fn earliest_changed_by(&self, from: usize) -> usize {
+    pub fn earliest_changed_by(&self, from: FrameIndex) -> FrameIndex {
         Joint::ALL
             .iter()
             .map(|&j| {
@@ -73,21 +74,21 @@ impl KeyFrames {
                     .range(..from)
                     .rev()
                     .find(|(_, k)| k[j].is_some())
-                    .map_or(0, |(&f, _)| f)
+                    .map_or(FrameIndex(0), |(&f, _)| f)
             })
             .min()
-            .unwrap_or(0)
+            .unwrap_or(FrameIndex(0))
     }
 
     /// Whether a joint was placed by hand on a frame.
-    pub fn is_key(&self, frame: usize, joint: Joint) -> bool {
+    pub fn is_key(&self, frame: FrameIndex, joint: Joint) -> bool {
         self.frames
             .get(&frame)
             .is_some_and(|joints| joints[joint].is_some())
     }
 
     /// The first frame holding all 16 joints, and its pose: where tracking starts.
-    pub fn first_full(&self) -> Option<(usize, PerJoint<Point2<f64>>)> {
+    pub fn first_full(&self) -> Option<(FrameIndex, PerJoint<Point2<f64>>)> {
         self.frames.iter().find_map(|(f, joints)| {
             let all: Option<Vec<Point2<f64>>> = joints.0.iter().copied().collect();
             all.map(|v| (*f, PerJoint::from_fn(|j| v[j.index()])))
@@ -169,7 +170,7 @@ impl KeyFrames {
         frames: usize,
     ) -> Result<(), FormatError> {
         for (&frame, joints) in &self.frames {
-            if frame >= frames {
+            if frame.get() >= frames {
                 return Err(FormatError::Invalid {
                     path: path.to_owned(),
                     problem: format!(
@@ -243,8 +244,11 @@ mod tests {
         ]);
         let keys = KeyFrames::parse(&text, p).expect("valid keys");
         assert_eq!(keys.frames.len(), 2);
-        assert_eq!(keys.first_full().map(|k| k.0), Some(3));
-        assert!(keys.is_key(42, Joint::LeftWrist) && !keys.is_key(42, Joint::Neck));
+        assert_eq!(keys.first_full().map(|k| k.0), Some(FrameIndex(3)));
+        assert!(
+            keys.is_key(FrameIndex(42), Joint::LeftWrist)
+                && !keys.is_key(FrameIndex(42), Joint::Neck)
+        );
         let again = KeyFrames::parse(&keys.to_json(), p).expect("written keys read back");
         assert_eq!(again, keys);
         keys.check_in_video(p, 100, 100, 50).expect("keys fit");

@@ -3,7 +3,7 @@
 //! `{"format":"videomocap.marks","version":1,"frame":0,"joints":{"head_top":[x,y],…}}`
 
 use super::{
-    FORMAT_VERSION, FormatError, check_header, check_on_image, parse_json, read_text,
+    FORMAT_VERSION, FormatError, FrameIndex, check_header, check_on_image, parse_json, read_text,
     write_atomically,
 };
 use crate::skeleton::{JOINT_COUNT, Joint, PerJoint};
@@ -20,7 +20,7 @@ pub const MARKS_FORMAT: &str = "videomocap.marks";
 #[derive(Debug, Clone, PartialEq)]
 pub struct Marks {
     /// The frame the marks were placed on (0-based).
-    pub frame: usize,
+    pub frame: FrameIndex,
     /// Each joint's position in image pixels.
     pub points: PerJoint<Point2<f64>>,
 }
@@ -30,7 +30,7 @@ struct MarksIn {
     format: Option<String>,
     version: Option<u32>,
     #[serde(default)]
-    frame: usize,
+    frame: FrameIndex,
     joints: BTreeMap<String, [f64; 2]>,
 }
 
@@ -38,7 +38,7 @@ struct MarksIn {
 struct MarksOut<'a> {
     format: &'static str,
     version: u32,
-    frame: usize,
+    frame: FrameIndex,
     joints: JointsInOrder<'a>,
 }
 
@@ -132,7 +132,7 @@ mod tests {
 
     fn sample() -> Marks {
         Marks {
-            frame: 3,
+            frame: FrameIndex(3),
             points: PerJoint::from_fn(|j| Point2::new(10.0 + j.index() as f64, 20.5)),
         }
     }
@@ -156,7 +156,7 @@ mod tests {
         }
         let text = serde_json::json!({ "joints": joints }).to_string();
         let m = Marks::parse(&text, Path::new("m.json")).unwrap();
-        assert_eq!(m.frame, 0);
+        assert_eq!(m.frame, FrameIndex(0));
     }
 
     #[test]

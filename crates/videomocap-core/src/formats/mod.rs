@@ -3,6 +3,7 @@
 
 mod atomic;
 mod error;
+mod frame_index;
 mod keys;
 mod lengths;
 mod marks;
@@ -11,6 +12,7 @@ mod tracks2d;
 
 pub use atomic::write_atomically;
 pub use error::FormatError;
+pub use frame_index::FrameIndex;
 pub(crate) use keys::KeyEntry;
 pub use keys::{KEYS_FORMAT, KeyFrames};
 pub use lengths::{KnownLengths, LENGTH_RANGE_M, LENGTHS_FORMAT, SHOULDER_WIDTH_KEY, TapeLengths};
@@ -81,7 +83,7 @@ pub(crate) fn check_on_image(
     joint: Joint,
     p: &nalgebra::Point2<f64>,
     (width, height): (u32, u32),
-    frame: usize,
+    frame: FrameIndex,
 ) -> Result<(), FormatError> {
     if crate::camera::point_in_frame(p, width, height) {
         return Ok(());
@@ -168,8 +170,8 @@ fn joint_columns(path: &Path, names: &[String]) -> Result<[usize; JOINT_COUNT], 
 /// Checks that frame indexes strictly increase; `previous` carries the last index seen.
 fn check_frame_order(
     path: &Path,
-    previous: &mut Option<usize>,
-    index: usize,
+    previous: &mut Option<FrameIndex>,
+    index: FrameIndex,
 ) -> Result<(), FormatError> {
     if previous.is_some_and(|p| index <= p) {
         return Err(FormatError::Invalid {

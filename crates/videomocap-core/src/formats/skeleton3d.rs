@@ -2,8 +2,8 @@
 //! (metres, X right, Y down, Z forward), with the camera and the bone lengths used.
 
 use super::{
-    FORMAT_VERSION, FormatError, check_frame_order, check_header, joint_columns, joint_names,
-    parse_json, read_text, save_json,
+    FORMAT_VERSION, FormatError, FrameIndex, check_frame_order, check_header, joint_columns,
+    joint_names, parse_json, read_text, save_json,
 };
 use crate::camera::PinholeCamera;
 use crate::skeleton::{Bone, Joint, PerJoint};
@@ -26,8 +26,8 @@ pub const LOST_FLAG: &str = "lost:";
 /// The 16 joints of one frame in camera space.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Frame3d {
-    /// Frame index in the video (0-based).
-    pub index: usize,
+    /// Frame number in the video (0-based).
+    pub index: FrameIndex,
     /// Joint positions in camera space, metres.
     pub points: PerJoint<Point3<f64>>,
     /// What the reconstruction noticed on this frame (e.g. `too_long:left_elbow-left_wrist`,
@@ -64,7 +64,7 @@ impl Frame3d {
 
 #[derive(Serialize, Deserialize)]
 struct FrameFile {
-    index: usize,
+    index: FrameIndex,
     points: Vec<[f64; 3]>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     flags: Vec<String>,
@@ -132,7 +132,7 @@ impl Skeleton3d {
             }
         }
         let mut frames = Vec::with_capacity(raw.frames.len());
-        let mut previous: Option<usize> = None;
+        let mut previous: Option<FrameIndex> = None;
         for f in raw.frames {
             if f.points.len() != raw.joints.len() {
                 return Err(FormatError::WrongLength {
@@ -220,7 +220,7 @@ mod tests {
             fps: Some(30.0),
             bone_lengths_m: [("left_knee-left_ankle".to_owned(), 0.42)].into(),
             frames: vec![Frame3d {
-                index: 0,
+                index: FrameIndex(0),
                 points: PerJoint::from_fn(|j| Point3::new(j.index() as f64 * 0.1, -0.5, 3.0)),
                 flags: vec!["too_long:left_elbow-left_wrist".to_owned()],
             }],

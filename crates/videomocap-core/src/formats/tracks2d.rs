@@ -2,8 +2,8 @@
 //! reliability and its state: tracked, interpolated, off the frame or lost.
 
 use super::{
-    FormatError, check_frame_order, check_header_up_to, joint_columns, joint_names, parse_json,
-    read_text, save_json,
+    FormatError, FrameIndex, check_frame_order, check_header_up_to, joint_columns, joint_names,
+    parse_json, read_text, save_json,
 };
 use crate::camera::point_in_frame;
 use crate::skeleton::{Joint, PerJoint};
@@ -64,8 +64,8 @@ pub struct TrackedPoint {
 /// All 16 joints in one frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameTracks {
-    /// Frame index in the video (0-based).
-    pub index: usize,
+    /// Frame number in the video (0-based).
+    pub index: FrameIndex,
     /// The joints.
     pub points: PerJoint<TrackedPoint>,
 }
@@ -88,7 +88,7 @@ pub struct Tracks2d {
 
 #[derive(Serialize, Deserialize)]
 struct FrameFile {
-    index: usize,
+    index: FrameIndex,
     points: Vec<[f64; 2]>,
     confidence: Vec<f32>,
     interpolated: Vec<bool>,
@@ -143,7 +143,7 @@ impl Tracks2d {
             });
         }
         let mut frames = Vec::with_capacity(raw.frames.len());
-        let mut previous: Option<usize> = None;
+        let mut previous: Option<FrameIndex> = None;
         for f in raw.frames {
             let n = raw.joints.len();
             let off_frame = f.off_frame.unwrap_or_else(|| vec![false; n]);
@@ -315,7 +315,7 @@ mod tests {
             },
             frames: (0..2)
                 .map(|i| FrameTracks {
-                    index: i,
+                    index: FrameIndex(i),
                     points: PerJoint::from_fn(|j| TrackedPoint {
                         pos: Point2::new(100.0 + j.index() as f64, 50.0 + i as f64),
                         confidence: 0.75,

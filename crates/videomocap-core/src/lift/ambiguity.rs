@@ -19,9 +19,11 @@
 //! are solved centre outwards, each on the trajectory chosen for its root. A user's choice for a
 //! bone on a frame ([`DepthOverrides`]) is a hard constraint.
 mod gait;
+mod margins;
 
 use super::backproject::{Root, bone_roots};
 use super::error::{LiftError, check_setting};
+use crate::formats::FrameIndex;
 use crate::skeleton::{
     BONE_COUNT, BodyPart, Bone, Joint, PerJoint, SubjectModel, segment_distance,
 };
@@ -307,7 +309,7 @@ const TRUNK_DEPTH: f64 = 0.35;
 const THIGH_DEPTH: f64 = 0.45;
 
 /// Forced root choices: `(frame index, bone) → root`, set by a user flipping a limb.
-pub type DepthOverrides = BTreeMap<(usize, Bone), Root>;
+pub type DepthOverrides = BTreeMap<(FrameIndex, Bone), Root>;
 
 /// Which prior scores a group.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -392,6 +394,10 @@ pub struct Resolved {
     pub choices: Vec<[Root; BONE_COUNT]>,
     /// Whether each bone was too long for its 2D image (flagged, placed off its ray).
     pub too_long: Vec<[bool; BONE_COUNT]>,
+    /// How much the clip-wide cost of the bone's group would rise, at best, were the bone to
+    /// take its other root on that frame (`margins`): small where the choice was close,
+    /// infinite where the user forced it.
+    pub margins: Vec<[f64; BONE_COUNT]>,
     /// The minimised total of each group of bones, priors (but the arms' swing and gait
     /// symmetry and the spine's look ahead, which only steer their roots) plus squared
     /// accelerations (squared metres), in the order they are solved: head and neck, spine, hips,
@@ -662,7 +668,7 @@ struct Candidate {
 pub fn resolve(
     key: &[[Point3<f64>; 3]],
     rays: &[PerJoint<Vector3<f64>>],
-    frame_index: &[usize],
+    frame_index: &[FrameIndex],
     subject: &SubjectModel,
     weights: &AmbiguityWeights,
     overrides: &DepthOverrides,
@@ -691,6 +697,7 @@ pub fn resolve(
         points,
         choices: vec![[Root::Near; BONE_COUNT]; n],
         too_long: vec![[false; BONE_COUNT]; n],
+        margins: vec![[0.0; BONE_COUNT]; n],
         group_costs: [0.0; GROUP_COUNT],
     };
     for g in 0..GROUP_COUNT {
@@ -722,7 +729,7 @@ pub fn resolve(
 /// subject, the weights, the user's overrides and the key triangle's frames.
 struct Inputs<'a> {
     rays: &'a [PerJoint<Vector3<f64>>],
-    frame_index: &'a [usize],
+    frame_index: &'a [FrameIndex],
     subject: &'a SubjectModel,
     weights: &'a AmbiguityWeights,
     overrides: &'a DepthOverrides,
@@ -807,6 +814,7 @@ fn solve_group(
         .map(|(t, &c)| candidates[t][c].steer)
         .sum();
     resolved.group_costs[g] = cost - steer;
+    let marginals = margins::min_marginals(&candidates);
     for (t, &combo) in path.iter().enumerate() {
         let c = &candidates[t][combo];
         for (k, bone) in group.bones.iter().enumerate() {
@@ -814,6 +822,12 @@ fn solve_group(
             let b = bone.index();
             resolved.choices[t][b] = root_of(combo, k);
             resolved.too_long[t][b] = c.too_long[k];
+            // The best the clip can do with this bone's other root here.
+            let other = (0..combos)
+                .filter(|&o| root_of(o, k) != root_of(combo, k))
+                .map(|o| marginals[t][o])
+                .fold(f64::INFINITY, f64::min);
+            resolved.margins[t][b] = (other - cost).max(0.0);
         }
     }
 }
@@ -1228,7 +1242,7 @@ mod tests {
     type Seen = (
         Vec<[Point3<f64>; 3]>,
         Vec<PerJoint<Vector3<f64>>>,
-        Vec<usize>,
+        Vec<FrameIndex>,
     );
 
     /// What [`resolve`] is given for a sequence of known bodies: their key joints, every
@@ -1242,7 +1256,7 @@ mod tests {
             .iter()
             .map(|p| p.map(|_, q| q.coords.normalize()))
             .collect();
-        (key, rays, (0..frames.len()).collect())
+        (key, rays, (0..frames.len()).map(FrameIndex).collect())
     }
 
     /// `n` frames of a standing body moved by `offset`, whose limbs on side `s` (1 left, −1
@@ -1303,7 +1317,7 @@ mod tests {
         let forced: DepthOverrides = arms
             .flat_map(|g| g.bones.iter())
             .flat_map(|&bone| (0..frames.len()).map(move |t| (t, bone)))
-            .map(|(t, bone)| ((t, bone), with.choices[t][bone.index()]))
+            .map(|(t, bone)| ((FrameIndex(t), bone), with.choices[t][bone.index()]))
             .collect();
         let without = solve(0.0, &forced);
         assert_eq!(with.choices, without.choices);

@@ -1,5 +1,6 @@
 //! Why a lift could not run.
 
+use crate::formats::FrameIndex;
 use crate::setting_range::Range;
 use crate::skeleton::{Joint, ProportionsError};
 
@@ -10,7 +11,7 @@ pub enum LiftError {
     #[error("the tracks have no frames")]
     NoFrames,
     #[error("frame {frame}: joint {joint} has a position that is not a finite number")]
-    NonFinite { frame: usize, joint: Joint },
+    NonFinite { frame: FrameIndex, joint: Joint },
     #[error("focal length must be a positive finite number of pixels, got {0}")]
     BadFocal(f64),
     #[error(
@@ -31,7 +32,7 @@ pub enum LiftError {
         want: &'static str,
     },
     #[error("camera calibration on the key triangle did not converge on frame {frame}")]
-    CalibrationFailed { frame: usize },
+    CalibrationFailed { frame: FrameIndex },
     #[error(transparent)]
     Subject(#[from] ProportionsError),
     #[error(

@@ -14,6 +14,8 @@
 //! some lengths) are known, and marks read lengths as uncertain: the lift solves those bones
 //! shorter, leaning towards lying square to their rays, and gives their lengths back after.
 //! Its input is [`crate::formats::Tracks2d`], its output [`crate::formats::Skeleton3d`].
+//! Every front end runs it through [`reconstruct`] (`pipeline`): the camera, the subject's
+//! lengths, then the skeleton, reporting each [`LiftStage`] as it starts.
 
 mod ambiguity;
 mod backproject;
@@ -23,8 +25,10 @@ mod focal;
 mod key_path;
 mod least_squares;
 mod newton;
+mod pipeline;
 mod propagate;
 mod refine;
+mod report;
 mod smoothing;
 mod solve;
 mod subject_fit;
@@ -34,10 +38,11 @@ pub use backproject::Root;
 pub use backproject::bone_roots;
 pub use calibrate::{KEY_JOINTS, KeyTriangle};
 pub use error::LiftError;
-pub use focal::{DEFAULT_FOV_LONG_SIDE_DEG, default_focal, estimate_focal};
-pub use refine::RefineParams;
-pub use solve::{
-    FrameFlag, FrameReport, LiftJob, LiftOutput, LiftParams, LiftProgress, PerFrame, lift,
-    lift_per_frame,
+pub use focal::{DEFAULT_FOV_LONG_SIDE_DEG, default_focal};
+pub use pipeline::{
+    CameraChoice, FocalSource, LiftStage, Reconstruction, SubjectChoice, reconstruct,
 };
-pub use subject_fit::{SubjectFit, fit_in_perspective, subject_from_height};
+pub use refine::RefineParams;
+pub use report::{BoneDepth, FrameFlag, FrameReport, UNSURE_MARGIN};
+pub use solve::{LiftJob, LiftOutput, LiftParams, LiftProgress, PerFrame, lift, lift_per_frame};
+pub use subject_fit::{SubjectFit, subject_from_height};

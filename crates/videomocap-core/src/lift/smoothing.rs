@@ -113,6 +113,7 @@ pub fn median_noise_px(tracks: &Tracks2d, joints: &[Joint]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::formats::FrameIndex;
     use rand::SeedableRng;
     use rand_distr::{Distribution, Normal};
 
@@ -181,7 +182,7 @@ mod tests {
                 .iter()
                 .enumerate()
                 .map(|(index, p)| FrameTracks {
-                    index,
+                    index: FrameIndex(index),
                     points: PerJoint::from_fn(|_| TrackedPoint {
                         pos: p + Vector2::new(normal.sample(&mut rng), normal.sample(&mut rng)),
                         confidence: 1.0,

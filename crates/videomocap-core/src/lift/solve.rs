@@ -2,22 +2,23 @@
 //! others, root choices, the optional global refinement, and the per-frame report.
 
 use super::ambiguity::{AmbiguityWeights, DepthOverrides, Resolved, resolve};
-use super::backproject::Root;
+
 use super::calibrate::{
     KEY_JOINTS, KeyTriangle, Residuals, calibrate_all, calibrate_from, longest_side, shape,
     starting_poses,
 };
 use super::error::{LiftError, check_setting};
 use super::key_path::{centroid, chain_pitch_prior, smooth_key_path, tilt_m};
+use super::pipeline::LiftStage;
 use super::propagate::key_depths;
 use super::refine::{RefineParams, RefineSummary, refine, track_weight};
+use super::report::{BoneDepth, FrameFlag, FrameReport, flag_too_long};
 use super::smoothing::{adaptive_sigmas, median_noise_px, smoothed_images};
 use crate::camera::PinholeCamera;
-use crate::formats::{Frame3d, PointSource, Skeleton3d, Tracks2d};
+use crate::formats::{Frame3d, FrameIndex, PointSource, Skeleton3d, Tracks2d};
 use crate::skeleton::{BONE_COUNT, Bone, Joint, PerJoint, SubjectModel};
 use nalgebra::{Point2, Point3};
 use serde::{Deserialize, Serialize};
-use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Settings of the lift; every field has a documented default and can be given as JSON.
@@ -93,41 +94,6 @@ pub struct LiftJob<'a> {
     pub overrides: DepthOverrides,
 }
 
-/// Something worth knowing about one frame of the result.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FrameFlag {
-    /// No pose of the key triangle fits the frame's three points; the closest fit is kept.
-    KeyTriangleNotConverged,
-    /// The bone's 2D image is longer than its 3D length allows: the joint is off its ray.
-    TooLong(Bone),
-    /// The joint's 2D track was off the frame: its 3D position rests on the tracker's estimate.
-    OffFrame(Joint),
-    /// The joint's 2D track was lost (a weak run too long to fill): it rests on a guess.
-    Lost(Joint),
-}
-
-impl fmt::Display for FrameFlag {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            FrameFlag::KeyTriangleNotConverged => f.write_str("key_triangle_not_converged"),
-            FrameFlag::TooLong(b) => write!(f, "too_long:{}", b.key()),
-            FrameFlag::OffFrame(j) => write!(f, "{}{}", crate::formats::OFF_FRAME_FLAG, j.name()),
-            FrameFlag::Lost(j) => write!(f, "{}{}", crate::formats::LOST_FLAG, j.name()),
-        }
-    }
-}
-
-/// The per-frame report.
-#[derive(Debug, Clone, PartialEq)]
-pub struct FrameReport {
-    /// Video frame index.
-    pub index: usize,
-    /// RMS residual of eq. 11 for the key triangle, metres.
-    pub key_rms_m: f64,
-    /// Flags.
-    pub flags: Vec<FrameFlag>,
-}
-
 /// The per-frame solve before refinement.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PerFrame {
@@ -145,7 +111,7 @@ pub struct PerFrame {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LiftProgress {
     /// What is being done.
-    pub stage: &'static str,
+    pub stage: LiftStage,
     /// Steps done.
     pub done: usize,
     /// Steps in this stage.
@@ -159,12 +125,10 @@ pub struct LiftOutput {
     pub skeleton: Skeleton3d,
     /// The per-frame skeleton (eqs. 6–11 and the root choices), before refinement.
     pub per_frame: Skeleton3d,
-    /// The root taken by each bone (indexed like [`Bone::ALL`]) per frame, for flipping.
-    pub choices: Vec<[Root; BONE_COUNT]>,
-    /// Per frame and bone (indexed like [`Bone::ALL`]), whether the bone's two roots were one
-    /// point (its 2D image too long for its length): flipping it there changes nothing.
-    pub single_root: Vec<[bool; BONE_COUNT]>,
-    /// One report per frame.
+    /// Per frame, each bone's depth choice (indexed like [`Bone::ALL`]), for flipping and for
+    /// pointing at the unsure ones.
+    pub bones: Vec<[BoneDepth; BONE_COUNT]>,
+    /// One report per frame (its flags those of the final skeleton).
     pub reports: Vec<FrameReport>,
     /// The frame the camera was calibrated on.
     pub calibration_frame: usize,
@@ -248,6 +212,17 @@ pub(crate) fn miss_m(
 
 /// Eqs. 6–11 and the root choices for every frame.
 pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
+    per_frame_solve(job, &job.subject.length_doubt, false)
+}
+
+/// [`lift_per_frame`], flagging a bone too long only beyond its length's `doubt` (per bone, a
+/// share of the length); `shortened` when the job's subject is already solved that much shorter
+/// than read ([`SubjectModel::leaning`]).
+fn per_frame_solve(
+    job: &LiftJob<'_>,
+    doubt: &[f64; BONE_COUNT],
+    shortened: bool,
+) -> Result<PerFrame, LiftError> {
     check(job)?;
     let cam = &job.camera;
     let tracks = job.tracks;
@@ -268,7 +243,7 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
     };
     let images = smoothed_images(tracks, &sigma);
     let rays: Vec<_> = images.iter().map(|im| im.map(|_, p| cam.ray(p))).collect();
-    let frame_index: Vec<usize> = tracks.frames.iter().map(|f| f.index).collect();
+    let frame_index: Vec<FrameIndex> = tracks.frames.iter().map(|f| f.index).collect();
 
     // The calibration frame: the best-shaped key triangle, weighted by the trust in its points
     // and by its size in the image (a pixel of noise turns a small triangle further: with one
@@ -403,23 +378,9 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
             .collect();
         let (resolved, score) = build(&key);
         if best.as_ref().is_none_or(|b| score < b.0) {
-            let all_noise_px = median_noise_px(tracks, &Joint::ALL);
-            for (t, report) in reports.iter_mut().enumerate() {
-                for (b, bone) in Bone::ALL.iter().enumerate() {
-                    if resolved.too_long[t][b]
-                        && too_long_beyond_noise(
-                            cam,
-                            &resolved.points[t],
-                            &images[t],
-                            *bone,
-                            job.subject.bone_length(*bone),
-                            all_noise_px,
-                        )
-                    {
-                        report.flags.push(FrameFlag::TooLong(*bone));
-                    }
-                }
-            }
+            let lengths = &job.subject.bone_length_m;
+            let solved = (&resolved.points[..], &images[..], lengths);
+            flag_too_long(job, &mut reports, solved, doubt, shortened);
             best = Some((score, reports, resolved));
         }
     }
@@ -434,39 +395,6 @@ pub fn lift_per_frame(job: &LiftJob<'_>) -> Result<PerFrame, LiftError> {
         calibration_frame,
         images,
     })
-}
-
-/// How many times the tracks' own white noise a bone's child must miss its image point before
-/// the bone is flagged too long ([`too_long_beyond_noise`]).
-pub const TOO_LONG_NOISE_TIMES: f64 = 3.0;
-
-/// The share of a bone's own image length its child may miss its image point by before the bone
-/// is flagged too long: the lengths read from the clip are uncertain by a few per cent (the
-/// median bone within 2–5 % on the benchmark), so a bone a little short of its image says
-/// nothing about the tracks.
-pub const TOO_LONG_LENGTH_SHARE: f64 = 0.05;
-
-/// Whether a bone whose image is longer than its length allows misses by more than the 2D
-/// noise and the length's own uncertainty explain: its child's image point lies farther from
-/// where the placed child projects than [`TOO_LONG_NOISE_TIMES`] the tracks' noise (`noise_px`)
-/// plus [`TOO_LONG_LENGTH_SHARE`] of the bone's image length, and half a pixel. Only such a
-/// bone is flagged, so the flag points at a tracking slip or a wrong length, not at the frames
-/// where a bone lies square to the camera.
-pub(crate) fn too_long_beyond_noise(
-    cam: &PinholeCamera,
-    points: &PerJoint<Point3<f64>>,
-    image: &PerJoint<Point2<f64>>,
-    bone: Bone,
-    length_m: f64,
-    noise_px: f64,
-) -> bool {
-    let Some(placed) = cam.project(&points[bone.child]) else {
-        return true;
-    };
-    let miss_px = (placed - image[bone.child]).norm();
-    let depth = points[bone.parent].z.max(1e-6);
-    let length_px = cam.focal_px * length_m / depth;
-    miss_px > TOO_LONG_NOISE_TIMES * noise_px + TOO_LONG_LENGTH_SHARE * length_px + 0.5
 }
 
 /// The least a part's cost counts as in [`fit_score`] (in the part's own unit: metres for the
@@ -815,7 +743,7 @@ pub fn lift(
         subject: job.subject.leaning(),
         ..job.clone()
     };
-    let mut out = lift_leaning(&leaning, progress, cancel)?;
+    let mut out = lift_leaning(&leaning, &job.subject.length_doubt, progress, cancel)?;
     if job.subject.length_doubt.iter().any(|&d| d > 0.0) {
         // The refined lengths, each over its doubt's share.
         let full = |s: &Skeleton3d| -> [f64; BONE_COUNT] {
@@ -841,18 +769,19 @@ pub fn lift(
     Ok(out)
 }
 
-/// [`lift`] on the subject as given.
+/// [`lift`] on the subject as given, solved `doubt` shorter than read.
 fn lift_leaning(
     job: &LiftJob<'_>,
+    doubt: &[f64; BONE_COUNT],
     progress: &mut dyn FnMut(&LiftProgress),
     cancel: &AtomicBool,
 ) -> Result<LiftOutput, LiftError> {
     progress(&LiftProgress {
-        stage: "per-frame solve",
+        stage: LiftStage::PerFrame,
         done: 0,
         total: 1,
     });
-    let per = lift_per_frame(job)?;
+    let per = per_frame_solve(job, doubt, true)?;
     if cancel.load(Ordering::Relaxed) {
         return Err(LiftError::Cancelled);
     }
@@ -862,7 +791,7 @@ fn lift_leaning(
         &job.subject.bone_length_m,
         &per.reports,
     );
-    let (final_skeleton, refinement) = if job.params.refine {
+    let (final_skeleton, refinement, reports) = if job.params.refine {
         let weights: Vec<PerJoint<f64>> = job
             .tracks
             .frames
@@ -882,26 +811,43 @@ fn lift_leaning(
             &job.params.refinement,
             &mut |done, total| {
                 progress(&LiftProgress {
-                    stage: "global refinement",
+                    stage: LiftStage::Refine,
                     done,
                     total,
                 })
             },
             cancel,
         )?;
+        // The flags of what the refined skeleton still cannot explain.
+        let mut reports = per.reports.clone();
+        let solved = (&refined.points[..], &per.images[..], &refined.bone_lengths);
+        flag_too_long(job, &mut reports, solved, doubt, true);
         (
-            skeleton(job, &refined.points, &refined.bone_lengths, &per.reports),
+            skeleton(job, &refined.points, &refined.bone_lengths, &reports),
             Some(refined.summary),
+            reports,
         )
     } else {
-        (per_frame.clone(), None)
+        (per_frame.clone(), None, per.reports)
     };
     Ok(LiftOutput {
         skeleton: final_skeleton,
         per_frame,
-        choices: per.resolved.choices,
-        single_root: per.resolved.too_long,
-        reports: per.reports,
+        bones: per
+            .resolved
+            .choices
+            .iter()
+            .zip(&per.resolved.too_long)
+            .zip(&per.resolved.margins)
+            .map(|((roots, single), margins)| {
+                std::array::from_fn(|b| BoneDepth {
+                    root: roots[b],
+                    single_root: single[b],
+                    margin: margins[b],
+                })
+            })
+            .collect(),
+        reports,
         calibration_frame: per.calibration_frame,
         refinement,
     })

@@ -683,7 +683,7 @@ fn fit_at_depth(
 }
 
 /// What a user who knows only the subject's height gets: the proportions table scaled to the
-/// height and fitted to the tracks seen through `camera` ([`fit_in_perspective`], its first lift
+/// height and fitted to the tracks seen through `camera` (`fit_in_perspective`, its first lift
 /// with `params`).
 pub fn subject_from_height(
     height_m: f64,
@@ -700,7 +700,7 @@ pub fn subject_from_height(
 mod tests {
     use super::*;
     use crate::camera::PinholeCamera;
-    use crate::formats::{FrameTracks, SourceInfo, TrackedPoint};
+    use crate::formats::{FrameIndex, FrameTracks, SourceInfo, TrackedPoint};
     use crate::skeleton::standing_pose;
     use nalgebra::{Point3, Rotation3, Vector3};
 
@@ -746,7 +746,7 @@ mod tests {
                 let r = Rotation3::from_axis_angle(&Vector3::y_axis(), yaw)
                     * Rotation3::from_axis_angle(&Vector3::x_axis(), 0.1);
                 FrameTracks {
-                    index: t,
+                    index: FrameIndex(t),
                     points: PerJoint::from_fn(|j| {
                         let q = r * body[j].coords;
                         let c = Point3::new(q.x, -q.y + 0.2, q.z + 4.0);

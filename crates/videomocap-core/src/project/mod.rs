@@ -8,8 +8,8 @@ mod history;
 pub use history::History;
 
 use crate::formats::{
-    FORMAT_VERSION, FormatError, KeyEntry, KeyFrames, LENGTH_RANGE_M, Skeleton3d, TapeLengths,
-    Tracks2d, parse_json, read_text, write_atomically,
+    FORMAT_VERSION, FormatError, FrameIndex, KeyEntry, KeyFrames, LENGTH_RANGE_M, Skeleton3d,
+    TapeLengths, Tracks2d, parse_json, read_text, write_atomically,
 };
 use crate::lift::{DepthOverrides, LiftParams, Root};
 use crate::skeleton::Bone;
@@ -240,7 +240,7 @@ struct ProjectFile {
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct OverrideFile {
-    frame: usize,
+    frame: FrameIndex,
     bone: String,
     root: String,
 }
@@ -254,10 +254,12 @@ mod tests {
     #[test]
     fn a_project_round_trips_through_its_file() {
         let mut p = Project::new(PathBuf::from("clip.mp4"));
-        p.keys.set(0, Joint::Neck, Point2::new(10.5, 20.25));
-        p.keys.set(7, Joint::LeftWrist, Point2::new(1.0, 2.0));
+        p.keys
+            .set(FrameIndex(0), Joint::Neck, Point2::new(10.5, 20.25));
+        p.keys
+            .set(FrameIndex(7), Joint::LeftWrist, Point2::new(1.0, 2.0));
         p.overrides.insert(
-            (3, Bone::new(Joint::LeftElbow, Joint::LeftWrist)),
+            (FrameIndex(3), Bone::new(Joint::LeftElbow, Joint::LeftWrist)),
             Root::Far,
         );
         p.settings.height_m = 1.82;

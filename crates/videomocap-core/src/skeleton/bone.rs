@@ -55,6 +55,30 @@ impl Bone {
         Bone::ALL.into_iter().find(|b| b.key() == key)
     }
 
+    /// The bone in a user's words: "left forearm", "right shin", "neck".
+    pub fn plain_name(self) -> String {
+        let side = |j: Joint| {
+            if j.name().starts_with("left") {
+                "left "
+            } else {
+                "right "
+            }
+        };
+        let (side, part) = match self.child {
+            Joint::Chest => ("", "spine"),
+            Joint::Neck => ("", "neck"),
+            Joint::HeadTop => ("", "head"),
+            Joint::LeftShoulder | Joint::RightShoulder => (side(self.child), "collarbone"),
+            Joint::LeftElbow | Joint::RightElbow => (side(self.child), "upper arm"),
+            Joint::LeftWrist | Joint::RightWrist => (side(self.child), "forearm"),
+            Joint::LeftHip | Joint::RightHip => (side(self.child), "hip"),
+            Joint::LeftKnee | Joint::RightKnee => (side(self.child), "thigh"),
+            Joint::LeftAnkle | Joint::RightAnkle => (side(self.child), "shin"),
+            Joint::Pelvis => ("", "pelvis"),
+        };
+        format!("{side}{part}")
+    }
+
     /// Position of the bone in [`Bone::ALL`].
     pub fn index(self) -> usize {
         Bone::ALL.iter().position(|b| *b == self).unwrap_or(0)

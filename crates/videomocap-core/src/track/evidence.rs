@@ -7,7 +7,7 @@
 
 use super::run::TrackError;
 use crate::camera::point_in_frame;
-use crate::formats::{FrameTracks, KeyFrames, PointSource, TrackedPoint, Tracks2d};
+use crate::formats::{FrameIndex, FrameTracks, KeyFrames, PointSource, TrackedPoint, Tracks2d};
 use crate::network::{Crop, NetJoint, PoseNetwork};
 use crate::skeleton::{Joint, PerJoint};
 use crate::video::Video;
@@ -87,7 +87,7 @@ pub fn run_network(
     let mut out: NetworkFrames = previous.map_or_else(Vec::new, |p| p[..from].to_vec());
     out.reserve(n - from);
     let mut next: Option<Crop> = out.last().and_then(|f| f.next);
-    for f in &tracks.frames[from..] {
+    for (t, f) in tracks.frames.iter().enumerate().skip(from) {
         if cancel.load(Ordering::Relaxed) {
             return Err(TrackError::Cancelled);
         }
@@ -101,12 +101,12 @@ pub fn run_network(
             Some(c) if !placed => Some(c),
             _ => Crop::around(&f.points.map(|_, p| p.pos)),
         };
-        let before = previous.and_then(|p| p.get(f.index));
+        let before = previous.and_then(|p| p.get(t));
         let frame = match (before, crop) {
             (Some(b), Some(c)) if b.crop.is_some_and(|bc| bc.same_as(&c)) => b.clone(),
             (_, Some(c)) => {
                 let pose = video
-                    .frame(f.index)
+                    .frame(f.index.get())
                     .ok()
                     .and_then(|image| network.run(&image.image, &c).ok())
                     .filter(|p| p.presence >= MIN_PRESENCE);
@@ -166,17 +166,17 @@ pub fn weigh(
     params: &EvidenceParams,
 ) -> Tracks2d {
     let n = tracks.frames.len();
-    let key_index: Vec<Option<usize>> = tracks
+    // Frames to the nearest key, for the key's fading certainty.
+    let key_frames: Vec<FrameIndex> = tracks
         .frames
         .iter()
-        .map(|f| keys.frames.contains_key(&f.index).then_some(f.index))
+        .filter(|f| keys.frames.contains_key(&f.index))
+        .map(|f| f.index)
         .collect();
-    // Frames to the nearest key, for the key's fading certainty.
-    let key_frames: Vec<usize> = key_index.iter().flatten().copied().collect();
-    let to_key = |index: usize| {
+    let to_key = |index: FrameIndex| {
         key_frames
             .iter()
-            .map(|&k| k.abs_diff(index))
+            .map(|&k| k.get().abs_diff(index.get()))
             .min()
             .map_or(f64::INFINITY, |d| d as f64)
     };
@@ -339,7 +339,7 @@ mod tests {
     fn tracks(n: usize, wrist: impl Fn(usize) -> Point2<f64>, confidence: f32) -> Tracks2d {
         let frames = (0..n)
             .map(|t| FrameTracks {
-                index: t,
+                index: FrameIndex(t),
                 points: PerJoint::from_fn(|j| TrackedPoint {
                     pos: match j {
                         Joint::Neck => Point2::new(100.0, 100.0),
@@ -384,7 +384,7 @@ mod tests {
         KeyFrames {
             frames: frames
                 .iter()
-                .map(|&k| (k, t.frames[k].points.map(|_, p| Some(p.pos))))
+                .map(|&k| (FrameIndex(k), t.frames[k].points.map(|_, p| Some(p.pos))))
                 .collect(),
         }
     }

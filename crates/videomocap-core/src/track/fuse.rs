@@ -49,7 +49,7 @@ pub(crate) fn fuse(
             .frames
             .iter()
             .filter(|(_, k)| k[j].is_some())
-            .map(|(&f, _)| f)
+            .map(|(&f, _)| f.get())
             .collect();
         for f in range.clone() {
             // Before the joint's first key only the backward pass is anchored; after its last,
@@ -149,6 +149,7 @@ fn fuse_stretch(pairs: &[(JointResult, JointResult)], torso: f64, weak: f32) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::formats::FrameIndex;
     use nalgebra::Point2;
 
     fn at(x: f64, reliability: f32) -> PerJoint<JointResult> {
@@ -162,7 +163,7 @@ mod tests {
         let mut keys = KeyFrames::default();
         for &f in frames {
             for j in Joint::ALL {
-                keys.set(f, j, Point2::new(0.0, 0.0));
+                keys.set(FrameIndex(f), j, Point2::new(0.0, 0.0));
             }
         }
         keys

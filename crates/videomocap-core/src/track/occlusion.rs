@@ -8,7 +8,7 @@
 //! an undone edit) give the same spans again ([`weak_spans`]).
 //! Key frames (hand-placed joints) always count as reliable anchors.
 
-use crate::formats::{FrameTracks, PointSource};
+use crate::formats::{FrameIndex, FrameTracks, PointSource};
 use crate::skeleton::Joint;
 use serde::Serialize;
 use std::fmt;
@@ -42,13 +42,20 @@ pub struct WeakSpan {
     /// The joint's name.
     pub joint: &'static str,
     /// First frame of the run.
-    pub start: usize,
+    pub start: FrameIndex,
     /// Last frame of the run (inclusive).
-    pub end: usize,
+    pub end: FrameIndex,
     /// Interpolated or left weak.
     pub kind: SpanKind,
     /// Lowest reliability in the run.
     pub min_reliability: f32,
+}
+
+impl WeakSpan {
+    /// The number of frames in the run.
+    pub fn frames(&self) -> usize {
+        self.end.get() + 1 - self.start.get()
+    }
 }
 
 /// The runs `(first, last)` (positions in `frames`) of consecutive frames that are not
@@ -132,19 +139,19 @@ fn moves_with_its_anchors(
 
 /// Fills short weak runs by interpolation (keeping those that move like the joint around
 /// them), marks the rest lost, and lists every weak run.
-/// `frames` must hold consecutive frame indices; `is_key(frame position, joint)` marks
+/// `frames` must hold consecutive frame indices; `is_key(frame, joint)` marks
 /// hand-placed joints.
 pub fn fill_weak_runs(
     frames: &mut [FrameTracks],
     weak: f32,
     max_gap: usize,
-    is_key: &dyn Fn(usize, Joint) -> bool,
+    is_key: &dyn Fn(FrameIndex, Joint) -> bool,
 ) -> Vec<WeakSpan> {
     let n = frames.len();
     let floor = KEEP_FLOOR_TORSO * median_torso(frames);
     for joint in Joint::ALL {
         let reliable: Vec<bool> = (0..n)
-            .map(|i| is_key(i, joint) || frames[i].points[joint].confidence >= weak)
+            .map(|i| is_key(frames[i].index, joint) || frames[i].points[joint].confidence >= weak)
             .collect();
         let weak_runs = runs(n, |i| reliable[i]);
         for (start, end) in weak_runs {
@@ -185,13 +192,14 @@ pub fn fill_weak_runs(
 pub fn weak_spans(
     frames: &[FrameTracks],
     weak: f32,
-    is_key: &dyn Fn(usize, Joint) -> bool,
+    is_key: &dyn Fn(FrameIndex, Joint) -> bool,
 ) -> Vec<WeakSpan> {
     let mut spans = Vec::new();
     for joint in Joint::ALL {
         let weak_runs = runs(frames.len(), |i| {
             let p = frames[i].points[joint];
-            is_key(i, joint) || (p.source == PointSource::Tracked && p.confidence >= weak)
+            is_key(frames[i].index, joint)
+                || (p.source == PointSource::Tracked && p.confidence >= weak)
         });
         for (start, end) in weak_runs {
             let run = &frames[start..=end];
@@ -230,7 +238,7 @@ mod tests {
         conf.iter()
             .enumerate()
             .map(|(i, &c)| FrameTracks {
-                index: i,
+                index: FrameIndex(i),
                 points: PerJoint::from_fn(|_| TrackedPoint {
                     pos: Point2::new(i as f64 * 10.0 + if c < 0.5 { 100.0 } else { 0.0 }, 0.0),
                     confidence: c,
@@ -248,11 +256,11 @@ mod tests {
         assert_eq!(head.len(), 2);
         assert_eq!(
             (head[0].start, head[0].end, head[0].kind),
-            (2, 3, SpanKind::Interpolated)
+            (FrameIndex(2), FrameIndex(3), SpanKind::Interpolated)
         );
         assert_eq!(
             (head[1].start, head[1].end, head[1].kind),
-            (5, 8, SpanKind::Weak)
+            (FrameIndex(5), FrameIndex(8), SpanKind::Weak)
         );
         // Interpolated on the line between frames 1 and 4 (x = 10 … 40).
         assert!((f[2].points[Joint::HeadTop].pos.x - 20.0).abs() < 1e-9);
@@ -289,7 +297,7 @@ mod tests {
         let wrist: Vec<_> = spans.iter().filter(|s| s.joint == "left_wrist").collect();
         assert_eq!(
             (wrist[0].start, wrist[0].end, wrist[0].kind),
-            (3, 5, SpanKind::Weak)
+            (FrameIndex(3), FrameIndex(5), SpanKind::Weak)
         );
         assert_eq!(weak_spans(&f, 0.5, &|_, _| false), spans);
         // The same run jumping 60 px away and back (a lock on something else) is filled.
@@ -321,7 +329,7 @@ mod tests {
         assert_eq!(wrist.len(), 1);
         assert_eq!(
             (wrist[0].start, wrist[0].end, wrist[0].kind),
-            (1, 3, SpanKind::OffFrame)
+            (FrameIndex(1), FrameIndex(3), SpanKind::OffFrame)
         );
         let after: Vec<_> = f.iter().map(|f| f.points[Joint::LeftWrist]).collect();
         assert_eq!(before, after);
@@ -338,11 +346,11 @@ mod tests {
         let spans = fill_weak_runs(&mut f, 0.5, 10, &|_, _| false);
         assert!(spans.iter().all(|s| s.kind == SpanKind::Weak));
         let mut f = frames(&[0.9, 0.1, 0.1]);
-        let spans = fill_weak_runs(&mut f, 0.5, 10, &|i, _| i == 2);
+        let spans = fill_weak_runs(&mut f, 0.5, 10, &|i, _| i == FrameIndex(2));
         assert!(
             spans
                 .iter()
-                .all(|s| s.kind == SpanKind::Interpolated && s.end == 1)
+                .all(|s| s.kind == SpanKind::Interpolated && s.end == FrameIndex(1))
         );
     }
 }

@@ -7,7 +7,7 @@ use super::background::{self, Background};
 use super::body::{BodyTracker, JointResult};
 use super::params::TrackerParams;
 use super::run::TrackProgress;
-use crate::formats::{FrameTracks, KeyFrames, PointSource, TrackedPoint};
+use crate::formats::{FrameIndex, FrameTracks, KeyFrames, PointSource, TrackedPoint};
 use crate::skeleton::{Joint, PerJoint, Proportions};
 use crate::video::{Video, VideoError};
 use image::RgbImage;
@@ -195,10 +195,11 @@ impl PassContext<'_, '_> {
                 }
                 Some(t) => {
                     let mut r = t.step(&image);
-                    if keys.frames.contains_key(&index) {
+                    if keys.frames.contains_key(&FrameIndex(index)) {
                         arrivals.insert(index, to_video(r));
                         let tracked = r.map(|_, j| j.pos);
-                        let work_keys = keys.frames[&index].map(|_, k| k.map(|p| scale.to_work(p)));
+                        let work_keys =
+                            keys.frames[&FrameIndex(index)].map(|_, k| k.map(|p| scale.to_work(p)));
                         let fixed = tracked.map(|j, p| work_keys[j].unwrap_or(*p));
                         *t = BodyTracker::new(
                             &image,
@@ -230,7 +231,7 @@ impl PassContext<'_, '_> {
                 done,
                 total,
                 frame: Some(FrameTracks {
-                    index,
+                    index: FrameIndex(index),
                     points: r.map(|_, j| TrackedPoint {
                         pos: j.pos,
                         confidence: j.reliability,

@@ -22,7 +22,7 @@ use super::pass::{PassContext, Scale};
 use super::smooth::smooth_tracks;
 use crate::camera::point_in_frame;
 pub use crate::formats::KeyFrames;
-use crate::formats::{FrameTracks, PointSource, SourceInfo, TrackedPoint, Tracks2d};
+use crate::formats::{FrameIndex, FrameTracks, PointSource, SourceInfo, TrackedPoint, Tracks2d};
 use crate::network::PoseNetwork;
 use crate::skeleton::{Joint, PerJoint, Proportions};
 use crate::video::{Video, VideoError, VideoInfo};
@@ -205,7 +205,7 @@ pub fn track_video(
     // 3. Short weak runs interpolated, long ones reported.
     let mut frames = tracks.frames;
     let max_gap = (job.params.max_gap_s * info.fps).round().max(1.0) as usize;
-    let is_key = |i: usize, j: Joint| job.keys.is_key(i, j);
+    let is_key = |f: FrameIndex, j: Joint| job.keys.is_key(f, j);
     let spans = fill_weak_runs(&mut frames, job.params.weak_reliability, max_gap, &is_key);
     // 4. Smoothed (when asked for): the filled runs with the rest. A re-track smooths what it
     // tracked; the earlier result before it was smoothed already.
@@ -223,7 +223,9 @@ pub fn track_video(
     if let (Some(from), Some(prev)) = (job.from, job.previous.as_ref()) {
         for j in Joint::ALL {
             let was = prev.frames[from].points[j];
-            if !job.keys.is_key(from, j) && was.confidence >= job.params.weak_reliability {
+            if !job.keys.is_key(FrameIndex(from), j)
+                && was.confidence >= job.params.weak_reliability
+            {
                 frames[from].points[j] = was;
             }
         }
@@ -291,14 +293,16 @@ fn track_at_working_scale(
             frames: n,
         });
     }
-    if let Some((&frame, _)) = job.keys.frames.range(n..).next() {
+    if let Some((&frame, _)) = job.keys.frames.range(FrameIndex(n)..).next() {
         return Err(TrackError::KeyFrameOutOfRange {
             path: info.path.clone(),
-            frame,
+            frame: frame.get(),
             frames: n,
         });
     }
     let (first_key, first_pose) = job.keys.first_full().ok_or(TrackError::NoFullKeyFrame)?;
+    // The tracker works in video positions, which are frame numbers.
+    let first_key = first_key.get();
     let (shrink, (ww, wh)) = working_scale(job, &first_pose, info.width, info.height);
     let scale = Scale {
         sx: f64::from(info.width) / f64::from(ww),
@@ -331,7 +335,7 @@ fn track_at_working_scale(
                 .filter(|p| p.frames.len() == n && from < n)
                 .ok_or(TrackError::NoEarlierResult { frame: from })?;
             for f in &prev.frames {
-                forward[f.index] = Some(f.points.map(|_, p| JointResult {
+                forward[f.index.get()] = Some(f.points.map(|_, p| JointResult {
                     pos: p.pos,
                     reliability: p.confidence,
                 }));
@@ -348,11 +352,10 @@ fn track_at_working_scale(
         .frames
         .keys()
         .next_back()
-        .copied()
-        .unwrap_or(first_key);
-    let low = job
-        .from
-        .map_or(0, |from| job.keys.earliest_changed_by(from));
+        .map_or(first_key, |k| k.get());
+    let low = job.from.map_or(0, |from| {
+        job.keys.earliest_changed_by(FrameIndex(from)).get()
+    });
     let backward_frames: Vec<usize> = if last_key > low {
         (low..=last_key).rev().collect()
     } else {
@@ -423,7 +426,7 @@ fn track_at_working_scale(
                 arrived.extend(out.arrivals);
                 if let Some(now) = into[order[0]].as_mut().filter(|_| fresh) {
                     for j in Joint::ALL {
-                        if !job.keys.is_key(order[0], j) {
+                        if !job.keys.is_key(FrameIndex(order[0]), j) {
                             now[j].reliability = before[j].reliability;
                         }
                     }
@@ -480,7 +483,7 @@ fn track_at_working_scale(
         .into_iter()
         .enumerate()
         .map(|(index, r)| FrameTracks {
-            index,
+            index: FrameIndex(index),
             points: r
                 .unwrap_or_else(|| {
                     first_pose.map(|_, p| JointResult {
@@ -489,7 +492,7 @@ fn track_at_working_scale(
                     })
                 })
                 .map(|j, r| {
-                    let key = job.keys.frames.get(&index).and_then(|k| k[j]);
+                    let key = job.keys.frames.get(&FrameIndex(index)).and_then(|k| k[j]);
                     let pos = key.unwrap_or(r.pos);
                     if key.is_some() {
                         TrackedPoint {
@@ -536,7 +539,7 @@ fn track_at_working_scale(
 
 /// A pose with the joints placed by hand on frame `f` put in.
 fn keyed(base: &PerJoint<Point2<f64>>, keys: &KeyFrames, f: usize) -> PerJoint<Point2<f64>> {
-    match keys.frames.get(&f) {
+    match keys.frames.get(&FrameIndex(f)) {
         Some(k) => base.map(|j, p| k[j].unwrap_or(*p)),
         None => *base,
     }

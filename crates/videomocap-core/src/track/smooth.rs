@@ -18,7 +18,7 @@
 //! all, gave 1288 / 1292 at 0.02 s. Smoothing the tracks as tracked, before the weak runs are
 //! filled and the gait completed, gave 1303 (the real sample 0.801).
 
-use crate::formats::{FrameTracks, PointSource};
+use crate::formats::{FrameIndex, FrameTracks, PointSource};
 use crate::skeleton::Joint;
 use nalgebra::Vector2;
 
@@ -57,14 +57,14 @@ pub fn gaussian_mean(
 /// Smooths every joint's track from position `first` of `frames` on (the frames before it
 /// are neighbours only) with a Gaussian window of standard deviation `sigma_frames` (frames),
 /// each neighbour weighted by its reliability (at least [`MIN_WEIGHT`]). Joints for which
-/// `is_key(position in frames, joint)` holds and joints off the frame are left where they are;
+/// `is_key(frame, joint)` holds and joints off the frame are left where they are;
 /// off-frame joints are not used as neighbours. Does nothing when `sigma_frames` is not above
 /// 0.
 pub fn smooth_tracks(
     frames: &mut [FrameTracks],
     sigma_frames: f64,
     first: usize,
-    is_key: &dyn Fn(usize, Joint) -> bool,
+    is_key: &dyn Fn(FrameIndex, Joint) -> bool,
 ) {
     // A NaN window counts as none (the settings' check refuses it before this).
     if sigma_frames.is_nan() || sigma_frames <= 0.0 || frames.len() < 2 {
@@ -74,14 +74,15 @@ pub fn smooth_tracks(
         let smoothed: Vec<Option<Vector2<f64>>> = (0..frames.len())
             .map(|t| {
                 let p = frames[t].points[joint];
-                if t < first || is_key(t, joint) || p.source == PointSource::OffFrame {
+                if t < first || is_key(frames[t].index, joint) || p.source == PointSource::OffFrame
+                {
                     return None;
                 }
                 // The weights are not all 0: the frame itself is on the frame and weighs at
                 // least MIN_WEIGHT.
                 Some(gaussian_mean(t, frames.len(), sigma_frames, |u| {
                     let q = frames[u].points[joint];
-                    let reliability = if is_key(u, joint) {
+                    let reliability = if is_key(frames[u].index, joint) {
                         1.0
                     } else {
                         f64::from(q.confidence).max(MIN_WEIGHT)
@@ -109,7 +110,7 @@ mod tests {
         xs.iter()
             .enumerate()
             .map(|(index, &(x, confidence, source))| FrameTracks {
-                index,
+                index: FrameIndex(index),
                 points: PerJoint::from_fn(|_| TrackedPoint {
                     pos: Point2::new(x, 10.0),
                     confidence,
@@ -164,7 +165,7 @@ mod tests {
             (-500.0, 0.0, off),
             (5.0, 0.9, T),
         ]);
-        smooth_tracks(&mut frames, 2.0, 0, &|t, _| t == 0);
+        smooth_tracks(&mut frames, 2.0, 0, &|t, _| t == FrameIndex(0));
         let x = |t: usize| frames[t].points[Joint::HeadTop].pos.x;
         assert_eq!(x(0), 0.0);
         assert_eq!(x(2), -500.0);

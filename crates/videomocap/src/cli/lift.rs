@@ -5,12 +5,11 @@ use super::{ExitError, progress_bar, say};
 use anyhow::anyhow;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
-use videomocap_core::camera::PinholeCamera;
 use videomocap_core::formats::{KnownLengths, Tracks2d};
-use videomocap_core::lift::fit_in_perspective;
-use videomocap_core::lift::{DEFAULT_FOV_LONG_SIDE_DEG, default_focal, estimate_focal};
-use videomocap_core::lift::{FrameFlag, LiftError, LiftJob, LiftOutput, LiftParams, lift};
-use videomocap_core::skeleton::{DEFAULT_HEIGHT_M, Proportions, SubjectModel};
+use videomocap_core::lift::{
+    CameraChoice, FrameFlag, LiftError, LiftOutput, LiftParams, SubjectChoice, reconstruct,
+};
+use videomocap_core::skeleton::DEFAULT_HEIGHT_M;
 
 /// Checks the camera and subject options before any work, and reads the lift settings (the
 /// defaults without `--lift-settings`) and the known lengths (none without `--lengths`) they
@@ -70,8 +69,8 @@ fn lift_error(source: &Path, e: LiftError) -> ExitError {
 }
 
 /// Lifts tracks with the options' camera and subject and the lift settings `params` (from
-/// [`check_options`]), with progress; shared by `lift` and `run`. `source` names the tracks (or
-/// the video they came from) in errors.
+/// [`check_options`]) through [`reconstruct`], with progress; shared by `lift` and `run`.
+/// `source` names the tracks (or the video they came from) in errors.
 pub fn lift_with_progress(
     tracks: &Tracks2d,
     source: &Path,
@@ -80,63 +79,26 @@ pub fn lift_with_progress(
     known: &KnownLengths,
     global: &GlobalArgs,
 ) -> Result<LiftOutput, ExitError> {
-    let table = SubjectModel::from_height(
-        o.height_m.unwrap_or(DEFAULT_HEIGHT_M),
-        Proportions::default(),
-    )
-    .map_err(ExitError::bad_input)?;
-    let (w, h) = (tracks.source.width, tracks.source.height);
-    let mut camera = PinholeCamera::centred(1.0, w, h);
-    if let Some(f) = o.focal_px {
-        camera.focal_px = f;
-    } else if let Some(fov) = o.fov_deg {
-        camera.focal_px = PinholeCamera::focal_from_horizontal_fov(fov, w);
-    } else if o.estimate_focal {
-        say(global, "estimating the focal length …");
-        // On the table's lengths: see `estimate_focal`.
-        let table_job = LiftJob {
-            tracks,
-            camera,
-            subject: table.clone(),
-            params,
-            overrides: Default::default(),
-        };
-        let est = estimate_focal(&table_job).map_err(|e| lift_error(source, e))?;
-        camera.focal_px = est.focal_px;
-        let fov = 2.0 * (f64::from(w) / 2.0 / est.focal_px).atan().to_degrees();
-        say(
-            global,
-            &format!(
-                "estimated focal length {:.0} px (horizontal field of view {fov:.0}°)",
-                est.focal_px
-            ),
-        );
-    } else {
-        camera.focal_px = default_focal(w, h);
-        say(
-            global,
-            &format!(
-                "focal length {:.0} px: the default {DEFAULT_FOV_LONG_SIDE_DEG:.0}° across the longer image side (give --focal-px or --fov-deg if you know the camera)",
-                camera.focal_px
-            ),
-        );
-    }
-    let (subject, fit) = fit_in_perspective(&table, tracks, camera, &params, known)
-        .map_err(|e| lift_error(source, e))?;
-    say(global, &fit.to_string());
-    let job = LiftJob {
-        tracks,
-        camera,
-        subject,
-        params,
-        overrides: Default::default(),
+    let camera = match (o.focal_px, o.fov_deg) {
+        (Some(f), _) => CameraChoice::FocalPx(f),
+        (None, Some(fov)) => CameraChoice::FovDeg(fov),
+        (None, None) if o.estimate_focal => CameraChoice::Estimate,
+        (None, None) => CameraChoice::Default,
+    };
+    let subject = SubjectChoice::Height {
+        height_m: o.height_m.unwrap_or(DEFAULT_HEIGHT_M),
+        known: known.clone(),
     };
     let bar = progress_bar(global, 1, "lifting");
     let cancel = AtomicBool::new(false);
-    let out = lift(
-        &job,
+    let done = reconstruct(
+        tracks,
+        camera,
+        &subject,
+        &params,
+        Default::default(),
         &mut |p| {
-            bar.set_message(p.stage);
+            bar.set_message(p.stage.to_string());
             bar.set_length(p.total as u64);
             bar.set_position(p.done as u64);
         },
@@ -144,7 +106,11 @@ pub fn lift_with_progress(
     )
     .map_err(|e| lift_error(source, e))?;
     bar.finish_and_clear();
-    Ok(out)
+    say(global, &done.camera_line());
+    if let Some(fit) = &done.fit {
+        say(global, &fit.to_string());
+    }
+    Ok(done.output)
 }
 
 /// Prints what the lift found.

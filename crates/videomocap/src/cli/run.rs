@@ -112,7 +112,7 @@ pub fn run_into(
         .spans
         .iter()
         .filter(|s| s.kind != SpanKind::Interpolated)
-        .map(|s| s.end + 1 - s.start)
+        .map(|s| s.frames())
         .sum();
     let flagged = lifted
         .reports

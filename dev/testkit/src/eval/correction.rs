@@ -40,10 +40,10 @@ pub fn next_correction(
 ) -> Option<Correction> {
     let derived = gt.derived();
     for f in &tracks.frames {
-        if done.contains(&f.index) {
+        if done.contains(&f.index.get()) {
             continue;
         }
-        let Some(truth) = gt.frames.get(f.index).map(|g| g.points2d()) else {
+        let Some(truth) = gt.frames.get(f.index.get()).map(|g| g.points2d()) else {
             continue;
         };
         let torso = (truth[Joint::Neck] - truth[Joint::Pelvis]).norm().max(1.0);
@@ -57,7 +57,7 @@ pub fn next_correction(
             .map(|j| (j, truth[j]))
             .collect();
         return Some(Correction {
-            frame: f.index,
+            frame: f.index.get(),
             drags,
         });
     }

@@ -5,6 +5,7 @@
 //! measures live in [`pose3d`].
 
 pub mod correction;
+pub mod doubt;
 pub mod pose3d;
 pub mod suite;
 pub mod volume;
@@ -168,6 +169,6 @@ pub fn score_tracks(gt: &GroundTruth, tracks: &Tracks2d) -> Result<ClipScore, Ev
         tracks
             .frames
             .iter()
-            .map(|f| (f.index, f.points.map(|_, p| p.pos))),
+            .map(|f| (f.index.get(), f.points.map(|_, p| p.pos))),
     )
 }

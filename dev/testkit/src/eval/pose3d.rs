@@ -11,7 +11,7 @@ use rand_distr::{Distribution, Normal};
 use std::collections::BTreeMap;
 use videomocap_core::camera::PinholeCamera;
 use videomocap_core::formats::{
-    Frame3d, FrameTracks, PointSource, Skeleton3d, SourceInfo, TrackedPoint, Tracks2d,
+    Frame3d, FrameIndex, FrameTracks, PointSource, Skeleton3d, SourceInfo, TrackedPoint, Tracks2d,
 };
 use videomocap_core::lift::{AmbiguityWeights, lift_order, resolve};
 use videomocap_core::skeleton::{Bone, Joint, PerJoint, SubjectModel};
@@ -215,10 +215,10 @@ pub fn score_skeleton(gt: &GroundTruth, skeleton: &Skeleton3d) -> Result<Pose3dS
     for frame in &skeleton.frames {
         let truth = gt
             .frames
-            .get(frame.index)
+            .get(frame.index.get())
             .ok_or(EvalError {
                 gt: gt.frames.len(),
-                frame: frame.index,
+                frame: frame.index.get(),
             })?
             .points3d();
         let p = &frame.points;
@@ -319,7 +319,7 @@ pub fn tracks_from_truth(gt: &GroundTruth, noise_px: f64, seed: u64) -> Tracks2d
             .map(|f| {
                 let p = f.points2d();
                 FrameTracks {
-                    index: f.index,
+                    index: FrameIndex(f.index),
                     points: PerJoint::from_fn(|j| TrackedPoint {
                         pos: Point2::new(p[j].x + jitter(), p[j].y + jitter()),
                         confidence: 1.0,
@@ -380,7 +380,7 @@ pub fn lift_on_reference_key(
         .iter()
         .map(|f| f.points2d().map(|_, p| camera.ray(p)))
         .collect();
-    let index: Vec<usize> = gt.frames.iter().map(|f| f.index).collect();
+    let index: Vec<FrameIndex> = gt.frames.iter().map(|f| FrameIndex(f.index)).collect();
     let resolved = resolve(&key, &rays, &index, subject, weights, &Default::default());
     Skeleton3d {
         camera,
@@ -406,7 +406,7 @@ pub fn cutout(gt: &GroundTruth, tracks: &Tracks2d, camera: PinholeCamera) -> Ske
         .frames
         .iter()
         .filter_map(|f| {
-            let depth = gt.frames.get(f.index)?.points3d()[Joint::Pelvis].z;
+            let depth = gt.frames.get(f.index.get())?.points3d()[Joint::Pelvis].z;
             Some(Frame3d {
                 index: f.index,
                 points: f.points.map(|_, p| {
@@ -493,7 +493,7 @@ mod tests {
                 .iter()
                 .enumerate()
                 .map(|(index, p)| Frame3d {
-                    index,
+                    index: FrameIndex(index),
                     points: *p,
                     flags: vec![],
                 })

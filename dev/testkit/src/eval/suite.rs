@@ -374,6 +374,7 @@ pub fn clicked_marks(marks: &Marks, sigma_px: f64, clip_name: &str) -> Marks {
 mod tests {
     use super::*;
     use std::collections::{BTreeMap, BTreeSet};
+    use videomocap_core::formats::FrameIndex;
 
     fn suite() -> Suite {
         Suite::load(&crate::repo_root()).unwrap()
@@ -459,7 +460,7 @@ mod tests {
     #[test]
     fn clicked_marks_move_by_about_the_click_noise_and_repeat() {
         let marks = Marks {
-            frame: 0,
+            frame: FrameIndex(0),
             points: PerJoint::from_fn(|j| Point2::new(100.0 + j.index() as f64, 50.0)),
         };
         let a = clicked_marks(&marks, CLICK_NOISE_PX, "clip");

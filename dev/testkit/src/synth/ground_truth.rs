@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
 use videomocap_core::camera::PinholeCamera;
-use videomocap_core::formats::{FormatError, write_atomically};
+use videomocap_core::formats::{FormatError, FrameIndex, write_atomically};
 use videomocap_core::skeleton::{Joint, PerJoint};
 
 /// One frame of ground truth.
@@ -95,7 +95,7 @@ impl GroundTruth {
                 if n != Joint::ALL.len() {
                     return Err(FormatError::WrongLength {
                         path: path.to_owned(),
-                        frame: f.index,
+                        frame: FrameIndex(f.index),
                         field,
                         found: n,
                         expected: Joint::ALL.len(),

@@ -31,7 +31,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use videomocap_core::bvh::BvhError;
 use videomocap_core::camera::PinholeCamera;
-use videomocap_core::formats::{FormatError, Marks};
+use videomocap_core::formats::{FormatError, FrameIndex, Marks};
 use videomocap_core::skeleton::{Bone, Joint, PerJoint, SubjectModel};
 use videomocap_core::video::VideoError;
 
@@ -550,7 +550,7 @@ pub fn render_clip(
     let marks_path = out_dir.join("marks.json");
     if let Some(points) = first_points2d {
         Marks {
-            frame: 0,
+            frame: FrameIndex(0),
             points: points.map(|_, p| nalgebra::Point2::new(round4(p.x), round4(p.y))),
         }
         .save(&marks_path)?;

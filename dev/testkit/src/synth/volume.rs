@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::Path;
 use videomocap_core::camera::PinholeCamera;
-use videomocap_core::formats::{Frame3d, Skeleton3d};
+use videomocap_core::formats::{Frame3d, FrameIndex, Skeleton3d};
 use videomocap_core::skeleton::{Bone, PerJoint};
 use videomocap_volume::VolumeError;
 use videomocap_volume::carve::{CalibratedCamera, CamerasFile};
@@ -268,7 +268,7 @@ pub fn truth(motion: &Motion) -> Skeleton3d {
             .iter()
             .enumerate()
             .map(|(index, points)| Frame3d {
-                index,
+                index: FrameIndex(index),
                 points: *points,
                 flags: Vec::new(),
             })
