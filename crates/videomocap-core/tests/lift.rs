@@ -251,6 +251,19 @@ fn with_the_true_roots_exact_tracks_give_back_every_joint() {
     }
 }
 
+/// The (frame, bone) pairs flagged too long in `reports`.
+fn too_long_flags(reports: &[videomocap_core::lift::FrameReport]) -> Vec<(FrameIndex, Bone)> {
+    reports
+        .iter()
+        .flat_map(|r| {
+            r.flags.iter().filter_map(move |f| match f {
+                videomocap_core::lift::FrameFlag::TooLong(b) => Some((r.index, *b)),
+                _ => None,
+            })
+        })
+        .collect()
+}
+
 #[test]
 fn a_bone_is_flagged_too_long_only_where_its_image_is_beyond_noise_and_length_doubt() {
     // Limbs 3 % short of the truth: every frame where one lies square to the camera has its
@@ -265,16 +278,7 @@ fn a_bone_is_flagged_too_long_only_where_its_image_is_beyond_noise_and_length_do
     let mut tracks = tracks_from_truth(&gt, 0.0, 3);
     let too_long = |tracks: &Tracks2d| {
         let job = job_for(tracks, &short, LiftParams::default());
-        let per = lift_per_frame(&job).unwrap();
-        per.reports
-            .iter()
-            .flat_map(|r| {
-                r.flags.iter().filter_map(move |f| match f {
-                    videomocap_core::lift::FrameFlag::TooLong(b) => Some((r.index, *b)),
-                    _ => None,
-                })
-            })
-            .collect::<Vec<_>>()
+        too_long_flags(&lift_per_frame(&job).unwrap().reports)
     };
     let quiet = too_long(&tracks);
     assert!(quiet.is_empty(), "{quiet:?}");
@@ -296,16 +300,11 @@ fn a_bone_is_flagged_too_long_only_where_its_image_is_beyond_noise_and_length_do
     }
     let flags_of = |tracks: &Tracks2d| {
         let job = job_for(tracks, &doubtful, LiftParams::default());
-        let out = lift(&job, &mut |_| {}, &AtomicBool::new(false)).unwrap();
-        out.reports
-            .iter()
-            .flat_map(|r| {
-                r.flags.iter().filter_map(move |f| match f {
-                    videomocap_core::lift::FrameFlag::TooLong(b) => Some((r.index, *b)),
-                    _ => None,
-                })
-            })
-            .collect::<Vec<_>>()
+        too_long_flags(
+            &lift(&job, &mut |_| {}, &AtomicBool::new(false))
+                .unwrap()
+                .reports,
+        )
     };
     let exact = tracks_from_truth(&gt, 0.0, 3);
     let quiet = flags_of(&exact);

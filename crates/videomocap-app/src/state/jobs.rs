@@ -53,7 +53,9 @@ pub struct Job {
     pub what: &'static str,
     events: Receiver<JobEvent>,
     cancel: Arc<AtomicBool>,
-    started: Instant,
+    /// When the current stage started and the steps done then (the stage's own steps give the
+    /// rate: stages differ in speed).
+    started: (Instant, usize),
     /// Progress so far.
     pub done: usize,
     /// Steps in all.
@@ -168,7 +170,7 @@ impl Job {
             what,
             events,
             cancel,
-            started: Instant::now(),
+            started: (Instant::now(), 0),
             done: 0,
             total: 0,
             stage: String::new(),
@@ -188,6 +190,12 @@ impl Job {
                 done, total, stage, ..
             } = &e
             {
+                if *stage != self.stage || *done < self.done {
+                    self.started = (
+                        Instant::now(),
+                        if *done < self.done { 0 } else { self.done },
+                    );
+                }
                 self.done = *done;
                 self.total = *total;
                 self.stage.clone_from(stage);
@@ -197,16 +205,83 @@ impl Job {
         out
     }
 
-    /// Share done, steps per second and seconds left.
+    /// The progress bar's text: what, the stage, the share done, and once the stage has run
+    /// a second and done a step, the time left in it. A share and not a step count: a track's
+    /// steps are its passes over the frames (and the network's), not the clip's frames.
+    pub fn progress_text(&self) -> String {
+        let (share, _, left) = self.rate();
+        let mut text = self.what.to_owned();
+        if !self.stage.is_empty() {
+            text += &format!(" ({})", self.stage);
+        }
+        if self.total > 0 {
+            text += &format!(" {:.0} %", 100.0 * share);
+        }
+        if let Some(s) = left.filter(|_| self.started.0.elapsed().as_secs_f64() >= 1.0) {
+            text += &format!(" · {s:.0} s left");
+        }
+        text
+    }
+
+    /// Share done, steps per second and seconds left, in the current stage.
     pub fn rate(&self) -> (f32, f64, Option<f64>) {
         let share = if self.total == 0 {
             0.0
         } else {
             self.done as f32 / self.total as f32
         };
-        let secs = self.started.elapsed().as_secs_f64().max(1e-3);
-        let per_s = self.done as f64 / secs;
+        let (since, from) = self.started;
+        let secs = since.elapsed().as_secs_f64().max(1e-3);
+        let per_s = self.done.saturating_sub(from) as f64 / secs;
         let left = (per_s > 0.0).then(|| (self.total.saturating_sub(self.done)) as f64 / per_s);
         (share, per_s, left)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn job() -> (Job, std::sync::mpsc::Sender<JobEvent>) {
+        let (tx, rx) = channel();
+        (
+            Job::new("Lifting", rx, Arc::new(AtomicBool::new(false))),
+            tx,
+        )
+    }
+
+    fn progress(done: usize, total: usize, stage: &str) -> JobEvent {
+        JobEvent::Progress {
+            done,
+            total,
+            stage: stage.to_owned(),
+            frame: None,
+        }
+    }
+
+    /// The bar shows a share, not the steps (a track's steps are its passes, not the clip's
+    /// frames: "72/101" on a 100-frame clip), and the time left is the current stage's.
+    #[test]
+    fn progress_reads_as_a_share_and_the_rate_restarts_with_each_stage() {
+        let (mut j, tx) = job();
+        tx.send(progress(72, 101, "")).unwrap();
+        j.poll();
+        let text = j.progress_text();
+        assert!(text.contains("71 %") && !text.contains("72/101"), "{text}");
+        // A new stage (its own steps) restarts the clock and the count the rate is taken from.
+        j.started = (Instant::now() - std::time::Duration::from_secs(10), 0);
+        tx.send(progress(1, 20, "global refinement")).unwrap();
+        j.poll();
+        assert_eq!(j.started.1, 0);
+        assert!(j.started.0.elapsed().as_secs_f64() < 5.0);
+        assert!(j.progress_text().contains("(global refinement) 5 %"));
+        // Within one stage the clock runs on.
+        j.started.0 -= std::time::Duration::from_secs(4);
+        tx.send(progress(11, 20, "global refinement")).unwrap();
+        j.poll();
+        let (_, per_s, left) = j.rate();
+        assert!((2.0..3.0).contains(&per_s), "{per_s}");
+        let left = left.unwrap();
+        assert!((3.0..4.5).contains(&left), "{left}");
     }
 }

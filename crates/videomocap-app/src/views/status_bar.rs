@@ -29,17 +29,8 @@ fn progress(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
     if ui.button("Cancel").clicked() {
         out.push(Intent::Cancel);
     }
-    let (share, per_s, left) = job.rate();
-    let mut text = job.what.to_owned();
-    if !job.stage.is_empty() {
-        text += &format!(" ({})", job.stage);
-    }
-    if job.total > 0 {
-        text += &format!(" {}/{}", job.done, job.total);
-    }
-    if let Some(s) = left {
-        text += &format!(" · {per_s:.1}/s · {s:.0} s left");
-    }
+    let (share, _, _) = job.rate();
+    let text = job.progress_text();
     ui.add(
         egui::ProgressBar::new(share)
             .desired_width(360.0)
