@@ -330,6 +330,38 @@ mod tests {
         assert_eq!(s.undo_name(), Some(name.as_str()));
     }
 
+    /// With unsaved work, opening something that cannot open is refused before "save
+    /// changes?" is asked: nothing is asked, nothing closed, the work still unsaved.
+    #[test]
+    fn a_failed_open_leaves_unsaved_work_as_it_was() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut s = state_with_tracks(3);
+        s.edit("place", |p| {
+            p.keys
+                .set(FrameIndex(1), Joint::Neck, Point2::new(12.0, 9.0))
+        });
+        assert!(s.dirty());
+        let broken = dir.path().join("broken.videomocap.json");
+        std::fs::write(&broken, "{ not a project").unwrap();
+        let empty = dir.path().join("empty");
+        std::fs::create_dir(&empty).unwrap();
+        for (path, says) in [
+            (broken, "not a project"),
+            (empty.clone(), "neither video frames"),
+            (dir.path().join("missing.mp4"), "no such file"),
+        ] {
+            s.apply(Intent::Open(path.clone()));
+            assert!(s.leaving().is_none(), "{}", path.display());
+            assert!(
+                s.status().contains(&path.display().to_string()) && s.status().contains(says),
+                "{}",
+                s.status()
+            );
+            assert!(s.dirty());
+            assert!(s.project().unwrap().keys.is_key(FrameIndex(1), Joint::Neck));
+        }
+    }
+
     /// The lift's unsure depth choices are offered on their own frame only, and only for the
     /// skeleton they came from.
     #[test]

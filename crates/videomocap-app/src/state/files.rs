@@ -89,8 +89,17 @@ pub(super) const NO_DIALOG: &str = "No file dialog could be shown on this deskto
      kdialog): type the path in the window instead";
 
 impl State {
-    /// Opens `path`, or asks "save changes?" first; quits, likewise.
+    /// Opens `path`, or asks "save changes?" first; quits, likewise. A path that cannot open
+    /// (missing, a broken project, a folder with nothing to open) is refused first, with the
+    /// session left as it was: nothing is asked and nothing is lost.
     pub(super) fn leave(&mut self, to: Leave) {
+        if let Leave::Open(path) = &to
+            && let Err(problem) = openable(path)
+        {
+            self.status = format!("Cannot open {}: {problem}", path.display());
+            self.forget(&path.clone());
+            return;
+        }
         if self.dirty() {
             self.leaving = Some(to);
         } else {
@@ -294,6 +303,10 @@ impl State {
         match p.save(path) {
             Ok(()) => {
                 self.project_path = Some(path.to_owned());
+                // Recent brings back the project, not its bare video.
+                let video = p.video.clone();
+                self.forget(&video);
+                self.remember(path);
                 self.dirty = false;
                 if let Some(a) = &mut self.autosaver {
                     a.clear();
@@ -327,26 +340,55 @@ impl State {
 
     /// Opens a video, image folder, project file or a folder of point volumes now.
     pub(super) fn open_now(&mut self, path: &Path) {
-        self.dirty = false;
         if is_volume_dir(path) {
+            self.dirty = false;
             self.open_volume(path);
+            self.remember(path);
         } else if path.is_file() && path.extension().is_some_and(|e| e == "json") {
             match Project::load(path) {
                 Ok(p) => {
+                    self.dirty = false;
                     self.open_video(&p.video.clone());
                     self.set_project(p);
                     self.project_path = Some(path.to_owned());
                     self.status = format!("Opened project {}", path.display());
+                    self.remember(path);
                 }
-                Err(e) => self.status = format!("Cannot open project: {e}"),
+                Err(e) => {
+                    self.status = format!("Cannot open project: {e}");
+                    self.forget(path);
+                }
             }
         } else {
+            // Remembered once it opens (`remember_opened`).
+            self.dirty = false;
             self.open_video(path);
         }
+    }
+
+    /// Puts `path` first in File ▸ Recent.
+    pub(super) fn remember(&mut self, path: &Path) {
         self.recent.retain(|p| p != path);
         self.recent.insert(0, path.to_owned());
         self.recent.truncate(8);
         self.save_recent();
+    }
+
+    /// Takes `path` out of File ▸ Recent (it did not open).
+    pub(super) fn forget(&mut self, path: &Path) {
+        let before = self.recent.len();
+        self.recent.retain(|p| p != path);
+        if self.recent.len() != before {
+            self.save_recent();
+        }
+    }
+
+    /// A video that opened: remembered in Recent unless a project holds it (the project is
+    /// what the user opened, and what Recent should bring back).
+    pub(super) fn remember_opened(&mut self, video: &Path) {
+        if self.project_path.is_none() {
+            self.remember(video);
+        }
     }
 
     fn recent_path(&self) -> Option<PathBuf> {
@@ -427,13 +469,37 @@ impl State {
 }
 
 /// Whether `path` is a folder of point clouds (and no images): volume mode.
+/// Why `path` cannot be opened, in the user's words, checked before anything is closed (a
+/// video's own format is checked as it opens).
+fn openable(path: &Path) -> Result<(), String> {
+    if !path.exists() {
+        return Err("there is no such file or folder".to_owned());
+    }
+    if path.is_file() && path.extension().is_some_and(|e| e == "json") {
+        return Project::load(path)
+            .map(|_| ())
+            .map_err(|e| format!("it is not a project this app can read ({e})"));
+    }
+    if path.is_dir() && !is_volume_dir(path) && !has_images(path) {
+        return Err(
+            "the folder holds neither video frames (PNG or JPEG images) nor point volumes \
+             (PLY files); choose a video file, an image folder or a project"
+                .to_owned(),
+        );
+    }
+    Ok(())
+}
+
 fn is_volume_dir(path: &Path) -> bool {
-    path.is_dir()
-        && videomocap_volume::list_frames(path).is_ok()
-        && !std::fs::read_dir(path).is_ok_and(|entries| {
-            entries.filter_map(Result::ok).any(|e| {
-                let name = e.file_name().to_string_lossy().to_ascii_lowercase();
-                name.ends_with(".png") || name.ends_with(".jpg") || name.ends_with(".jpeg")
-            })
+    path.is_dir() && videomocap_volume::list_frames(path).is_ok() && !has_images(path)
+}
+
+/// Whether a folder holds PNG or JPEG images (video frames).
+fn has_images(path: &Path) -> bool {
+    std::fs::read_dir(path).is_ok_and(|entries| {
+        entries.filter_map(Result::ok).any(|e| {
+            let name = e.file_name().to_string_lossy().to_ascii_lowercase();
+            name.ends_with(".png") || name.ends_with(".jpg") || name.ends_with(".jpeg")
         })
+    })
 }

@@ -144,12 +144,16 @@ impl State {
                     info.frame_count
                 );
                 self.after_open(&info);
+                self.remember_opened(&info.path);
                 if let Some(l) = &self.loader {
                     l.request(self.current);
                 }
             }
             LoaderEvent::Opened(Err(e)) => {
                 self.status = format!("Cannot open: {e}");
+                if let Some(video) = self.project.as_ref().map(|p| p.video.clone()) {
+                    self.forget(&video);
+                }
                 self.loader = None;
                 self.project = None;
             }

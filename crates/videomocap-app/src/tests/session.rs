@@ -362,4 +362,18 @@ fn mark_drag_undo_track_scrub_orbit_export_and_recover() {
     );
     assert_eq!(Project::load(&saved).unwrap().keys, expected.keys);
     wait(&mut h, "the other folder", |a| a.frame_count() == 1);
+    // Recent lists what opened, and the saved project in place of its bare video.
+    assert_eq!(
+        h.state().state().recent()[..2],
+        [other.clone(), saved.clone()]
+    );
+    assert!(!h.state().state().recent().contains(&video));
+    // A project that does not open is not listed (the clip stays open).
+    let broken = dir.path().join("broken.videomocap.json");
+    std::fs::write(&broken, "{ not a project").unwrap();
+    h.state_mut()
+        .state_mut()
+        .apply(Intent::Open(broken.clone()));
+    h.run_steps(2);
+    assert!(!h.state().state().recent().contains(&broken));
 }
