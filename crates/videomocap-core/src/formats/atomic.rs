@@ -15,11 +15,22 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), FormatError> {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
+    if !dir.is_dir() {
+        return Err(FormatError::Invalid {
+            path: path.to_owned(),
+            problem: format!(
+                "cannot write: the folder {} does not exist (create it or choose another)",
+                dir.display()
+            ),
+        });
+    }
+    // The temporary file's name means nothing to the user: the error keeps only its kind
+    // ("permission denied"), named by the file being saved.
     let mut tmp = tempfile::Builder::new()
         .prefix(TEMP_PREFIX)
         .suffix(TEMP_SUFFIX)
         .tempfile_in(dir)
-        .map_err(err)?;
+        .map_err(|e| err(std::io::Error::from(e.kind())))?;
     tmp.write_all(bytes).map_err(err)?;
     // The temporary file is private (0600); give the result the old file's permissions, or the
     // usual 0644 for a new file, so that saving never changes who can read the user's work.
@@ -128,8 +139,17 @@ mod tests {
     }
 
     #[test]
-    fn a_missing_directory_is_an_error_naming_the_file() {
+    fn a_missing_directory_is_an_error_naming_the_file_and_the_folder_not_the_temporary() {
         let err = write_atomically(Path::new("/nonexistent-dir/x.json"), b"x").unwrap_err();
-        assert!(err.to_string().contains("/nonexistent-dir/x.json"));
+        let text = err.to_string();
+        assert!(text.contains("/nonexistent-dir/x.json"), "{text}");
+        assert!(
+            text.contains("the folder /nonexistent-dir does not exist"),
+            "{text}"
+        );
+        assert!(
+            !text.contains(".tmp") && !text.contains("os error"),
+            "{text}"
+        );
     }
 }
