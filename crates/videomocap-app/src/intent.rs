@@ -27,6 +27,8 @@ pub enum Intent {
     AnswerSave(SaveAnswer),
     /// The answer to "recover unsaved work?".
     AnswerRecovery(bool),
+    /// "Not now" to the saved project offered for a video.
+    DismissProjectBeside,
     /// The text of the app's path field changed.
     PathEdited(String),
     /// The path field was confirmed (`Some`) or cancelled (`None`).

@@ -388,6 +388,10 @@ impl State {
     pub(super) fn remember_opened(&mut self, video: &Path) {
         if self.project_path.is_none() {
             self.remember(video);
+            self.project_beside = project_beside(video);
+            if let Some(p) = &self.project_beside {
+                self.status = format!("A saved project for this video: {}", p.display());
+            }
         }
     }
 
@@ -456,6 +460,7 @@ impl State {
         self.background = None;
         self.network_seen = None;
         self.project_path = None;
+        self.project_beside = None;
         self.history.clear();
         self.results_changed();
         self.current = 0;
@@ -469,6 +474,31 @@ impl State {
 }
 
 /// Whether `path` is a folder of point clouds (and no images): volume mode.
+/// A project file in `video`'s folder (`*.videomocap.json`) whose video is `video`, the newest
+/// first.
+fn project_beside(video: &Path) -> Option<PathBuf> {
+    let folder = video.parent()?;
+    let same = |p: &Path| match (p.canonicalize(), video.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => p == video,
+    };
+    let mut found: Vec<(std::time::SystemTime, PathBuf)> = std::fs::read_dir(folder)
+        .ok()?
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.to_string_lossy().ends_with(".videomocap.json"))
+        .filter(|p| Project::load(p).is_ok_and(|project| same(&project.video)))
+        .map(|p| {
+            let modified = std::fs::metadata(&p)
+                .and_then(|m| m.modified())
+                .unwrap_or(std::time::UNIX_EPOCH);
+            (modified, p)
+        })
+        .collect();
+    found.sort();
+    found.pop().map(|(_, p)| p)
+}
+
 /// Why `path` cannot be opened, in the user's words, checked before anything is closed (a
 /// video's own format is checked as it opens).
 fn openable(path: &Path) -> Result<(), String> {

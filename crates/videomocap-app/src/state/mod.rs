@@ -30,7 +30,7 @@ use frame_loader::FrameLoader;
 use jobs::Job;
 use nalgebra::Point2;
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use videomocap_core::export::WorldSkeleton;
 use videomocap_core::formats::{FrameIndex, FrameTracks, Skeleton3d};
@@ -142,6 +142,8 @@ pub struct State {
     dirty: bool,
     /// Where the user is going once "save changes?" is answered.
     leaving: Option<Leave>,
+    /// A saved project of the video just opened bare, offered to the user.
+    project_beside: Option<PathBuf>,
     /// The app's own path field, shown when no file dialog can be.
     path_request: Option<PathRequest>,
     /// A file dialog could not be shown once: use the path field from then on.
@@ -197,6 +199,7 @@ impl State {
             volume: None,
             dirty: false,
             leaving: None,
+            project_beside: None,
             path_request: None,
             no_native_dialogs: false,
             quitting: false,
@@ -218,6 +221,7 @@ impl State {
             Intent::Quit => self.leave(Leave::Quit),
             Intent::AnswerSave(answer) => self.answer_save(answer),
             Intent::AnswerRecovery(recover) => self.answer_recovery(recover),
+            Intent::DismissProjectBeside => self.project_beside = None,
             Intent::PathEdited(text) => self.path_edited(text),
             Intent::PathChosen(path) => self.path_chosen(path),
             Intent::Undo => self.undo(),
@@ -433,6 +437,11 @@ impl State {
     /// Whether a recovery prompt is showing.
     pub fn offers_recovery(&self) -> bool {
         self.recovery.is_some()
+    }
+
+    /// A saved project of the video that was just opened without it, to offer.
+    pub fn project_beside(&self) -> Option<&Path> {
+        self.project_beside.as_deref()
     }
 
     /// Where the user is going once "save changes?" is answered (the prompt shows meanwhile).

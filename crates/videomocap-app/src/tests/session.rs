@@ -368,6 +368,17 @@ fn mark_drag_undo_track_scrub_orbit_export_and_recover() {
         [other.clone(), saved.clone()]
     );
     assert!(!h.state().state().recent().contains(&video));
+    // Opening the video alone again offers the project saved for it.
+    h.state_mut().state_mut().apply(Intent::Open(video.clone()));
+    wait(&mut h, "the clip again", |a| a.frame_count() == 60);
+    assert_eq!(h.state().state().project_beside(), Some(saved.as_path()));
+    h.run_steps(2);
+    h.get_by_label("Open the project").click();
+    h.run_steps(2);
+    wait(&mut h, "the project", |a| a.frame_count() == 60);
+    assert!(h.state().state().project_beside().is_none());
+    assert_eq!(h.state().state().project().unwrap().keys, expected.keys);
+    assert_eq!(h.state().state().recent().first(), Some(&saved));
     // A project that does not open is not listed (the clip stays open).
     let broken = dir.path().join("broken.videomocap.json");
     std::fs::write(&broken, "{ not a project").unwrap();

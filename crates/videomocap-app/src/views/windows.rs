@@ -57,6 +57,8 @@ pub fn show(
     }
     if let Some(to) = state.leaving() {
         save_changes(ctx, to, out);
+    } else if let Some(project) = state.project_beside() {
+        project_beside(ctx, project, out);
     }
     if state.path_request().is_some() {
         path_field(ctx, state, out);
@@ -110,6 +112,23 @@ fn recovery(ctx: &egui::Context, out: &mut Vec<Intent>) {
             }
             if ui.button("Discard").clicked() {
                 out.push(Intent::AnswerRecovery(false));
+            }
+        });
+    });
+}
+
+fn project_beside(ctx: &egui::Context, project: &std::path::Path, out: &mut Vec<Intent>) {
+    modal("A saved project for this video").show(ctx, |ui| {
+        ui.label(format!(
+            "{} holds earlier work on this video (marks, corrections, results).",
+            project.display()
+        ));
+        ui.horizontal(|ui| {
+            if ui.button("Open the project").clicked() {
+                out.push(Intent::Open(project.to_owned()));
+            }
+            if ui.button("Not now").clicked() {
+                out.push(Intent::DismissProjectBeside);
             }
         });
     });
