@@ -29,6 +29,8 @@ pub enum Intent {
     AnswerRecovery(bool),
     /// "Not now" to the saved project offered for a video.
     DismissProjectBeside,
+    /// The subject is seen from behind (the marking guide mirrors its diagram) or not.
+    SeenFromBehind(bool),
     /// The text of the app's path field changed.
     PathEdited(String),
     /// The path field was confirmed (`Some`) or cancelled (`None`).

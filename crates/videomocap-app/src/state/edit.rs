@@ -330,6 +330,36 @@ mod tests {
         assert_eq!(s.undo_name(), Some(name.as_str()));
     }
 
+    /// A subject seen from behind: once both shoulders are placed with the left one on the
+    /// image's left, the guide says so (mirrored diagram, "on the image's left"), whatever the
+    /// toggle said; before that the toggle decides.
+    #[test]
+    fn the_marking_guide_follows_a_subject_seen_from_behind() {
+        use crate::views::marking::side_words;
+        let mut s = state_with_tracks(3);
+        s.apply(Intent::StartMarking);
+        assert!(!s.seen_from_behind());
+        s.apply(Intent::SeenFromBehind(true));
+        assert!(s.seen_from_behind());
+        s.apply(Intent::SeenFromBehind(false));
+        // Head, neck, chest, pelvis, then the left shoulder on the image's left and the left
+        // arm, then the right shoulder on the image's right.
+        for x in [30.0, 30.0, 30.0, 30.0, 20.0, 18.0, 16.0, 40.0] {
+            s.apply(Intent::Click(Point2::new(x, 20.0)));
+        }
+        assert!(s.seen_from_behind());
+        assert_eq!(s.asking().map(|(_, j)| j), Some(Joint::RightElbow));
+        assert_eq!(
+            side_words(Joint::RightElbow, s.seen_from_behind()).unwrap(),
+            "the subject's own right: on the image's right (seen from behind)"
+        );
+        assert_eq!(
+            side_words(Joint::LeftWrist, false).unwrap(),
+            "the subject's own left: on the image's right (facing you)"
+        );
+        assert!(side_words(Joint::Neck, true).is_none());
+    }
+
     /// With unsaved work, opening something that cannot open is refused before "save
     /// changes?" is asked: nothing is asked, nothing closed, the work still unsaved.
     #[test]

@@ -110,6 +110,9 @@ pub struct State {
     texture: Option<egui::TextureHandle>,
     /// Index into [`Joint::ALL`] of the joint the marking guide asks for.
     marking: Option<usize>,
+    /// The user said the subject is seen from behind (the marking guide's diagram mirrored),
+    /// until both shoulders or both hips are placed and say it themselves.
+    from_behind: bool,
     move_limb: bool,
     running: Option<Running>,
     /// Frames tracked so far by the running job (drawn as they arrive, over the earlier
@@ -179,6 +182,7 @@ impl State {
             preview: false,
             texture: None,
             marking: None,
+            from_behind: false,
             move_limb: false,
             running: None,
             partial: BTreeMap::new(),
@@ -229,6 +233,7 @@ impl State {
             Intent::StartMarking => self.start_marking(),
             Intent::SkipJoint => self.skip_joint(),
             Intent::StopMarking => self.marking = None,
+            Intent::SeenFromBehind(on) => self.from_behind = on,
             Intent::MoveLimb(on) => self.move_limb = on,
             Intent::Click(pos) => self.click(pos),
             Intent::Moved(joint, pos) => self.moved(joint, pos),
@@ -328,6 +333,25 @@ impl State {
     /// The running job (the progress bar reads it).
     pub fn job(&self) -> Option<&Job> {
         self.running.as_ref().map(|r| &r.job)
+    }
+
+    /// Whether the subject is seen from behind on the current frame (their own left on the
+    /// image's left): from the shoulders placed there, else the hips, else as the user said.
+    pub fn seen_from_behind(&self) -> bool {
+        let Some(keys) = self
+            .project
+            .as_ref()
+            .and_then(|p| p.keys.frames.get(&FrameIndex(self.current)))
+        else {
+            return self.from_behind;
+        };
+        [
+            (Joint::LeftShoulder, Joint::RightShoulder),
+            (Joint::LeftHip, Joint::RightHip),
+        ]
+        .into_iter()
+        .find_map(|(l, r)| Some(keys[l]?.x < keys[r]?.x))
+        .unwrap_or(self.from_behind)
     }
 
     /// The joint the marking guide asks for, if marking, and its place in the order.

@@ -279,7 +279,7 @@ impl FrameView {
                     painter.text(
                         s + Vec2::new(10.0, -10.0),
                         egui::Align2::LEFT_BOTTOM,
-                        j.name(),
+                        super::marking::joint_words(j),
                         egui::FontId::proportional(14.0),
                         Color32::WHITE,
                     );
@@ -290,7 +290,7 @@ impl FrameView {
             painter.text(
                 pos + Vec2::new(14.0, 14.0),
                 egui::Align2::LEFT_TOP,
-                format!("click: {}", j.name()),
+                format!("click: {}", super::marking::joint_words(j)),
                 egui::FontId::proportional(14.0),
                 Color32::YELLOW,
             );

@@ -4,12 +4,27 @@
 use crate::intent::Intent;
 use videomocap_core::skeleton::{Bone, Joint};
 
-/// Draws the guide for joint `k` of [`Joint::ALL`]; Skip and Done go to `out`.
-pub fn show(ui: &mut egui::Ui, k: usize, joint: Joint, out: &mut Vec<Intent>) {
+/// Draws the guide for joint `k` of [`Joint::ALL`], its diagram seen from the front or from
+/// behind; Skip, Done and the view go to `out`.
+pub fn show(ui: &mut egui::Ui, k: usize, joint: Joint, behind: bool, out: &mut Vec<Intent>) {
     ui.heading("Marking");
-    ui.label(format!("{} of 16: {}", k + 1, joint.name()));
+    ui.label(format!("{} of 16: {}", k + 1, joint_words(joint)));
+    if let Some(side) = side_words(joint, behind) {
+        ui.label(side);
+    }
     ui.label(egui::RichText::new(joint.definition()).italics());
-    body_diagram(ui, joint);
+    body_diagram(ui, joint, behind);
+    let mut from_behind = behind;
+    if ui
+        .checkbox(&mut from_behind, "seen from behind")
+        .on_hover_text(
+            "Mirror the diagram for a subject with their back to the camera (follows the \
+             shoulders or hips once both are placed)",
+        )
+        .changed()
+    {
+        out.push(Intent::SeenFromBehind(from_behind));
+    }
     ui.horizontal(|ui| {
         if ui.button("Skip").clicked() {
             out.push(Intent::SkipJoint);
@@ -21,11 +36,37 @@ pub fn show(ui: &mut egui::Ui, k: usize, joint: Joint, out: &mut Vec<Intent>) {
     ui.separator();
 }
 
-/// A small front view of the body with `asking` highlighted.
-fn body_diagram(ui: &mut egui::Ui, asking: Joint) {
+/// The joint in words: "left shoulder".
+pub fn joint_words(joint: Joint) -> String {
+    joint.name().replace('_', " ")
+}
+
+/// Which side of the image the subject's own left or right lies on, for a side's joint.
+pub fn side_words(joint: Joint, behind: bool) -> Option<String> {
+    let name = joint.name();
+    let left = name.starts_with("left");
+    if !left && !name.starts_with("right") {
+        return None;
+    }
+    let own = if left { "left" } else { "right" };
+    // Facing the camera the subject's left is on the image's right; from behind, on its left.
+    let image = if left != behind { "right" } else { "left" };
+    let view = if behind {
+        "seen from behind"
+    } else {
+        "facing you"
+    };
+    Some(format!(
+        "the subject's own {own}: on the image's {image} ({view})"
+    ))
+}
+
+/// A small view of the body with `asking` highlighted: from the front (the subject's left on
+/// the right), or mirrored from behind.
+fn body_diagram(ui: &mut egui::Ui, asking: Joint, behind: bool) {
     let (rect, _) = ui.allocate_exact_size(egui::vec2(120.0, 170.0), egui::Sense::hover());
     let painter = ui.painter_at(rect);
-    // Front view: the subject's left on the image's right.
+    let mirror = if behind { -1.0 } else { 1.0 };
     let at = |j: Joint| -> egui::Pos2 {
         let (x, y) = match j {
             Joint::HeadTop => (0.0, 0.0),
@@ -45,7 +86,10 @@ fn body_diagram(ui: &mut egui::Ui, asking: Joint) {
             Joint::RightKnee => (-0.11, 0.72),
             Joint::RightAnkle => (-0.12, 0.95),
         };
-        egui::pos2(rect.center().x + x * 160.0, rect.top() + 5.0 + y * 160.0)
+        egui::pos2(
+            rect.center().x + mirror * x * 160.0,
+            rect.top() + 5.0 + y * 160.0,
+        )
     };
     for b in Bone::ALL {
         painter.line_segment(

@@ -15,7 +15,7 @@ pub fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
         return;
     }
     if let Some((k, joint)) = state.asking() {
-        marking::show(ui, k, joint, out);
+        marking::show(ui, k, joint, state.seen_from_behind(), out);
     }
     ui.heading("Parameters");
     parameters(ui, state, out);

@@ -89,29 +89,29 @@ impl Joint {
         match self {
             Joint::HeadTop => "top of the skull (vertex), on the head's middle line",
             Joint::Neck => {
-                "base of the neck: midpoint between the shoulders at the level of the 7th cervical vertebra"
+                "base of the neck: midpoint between the shoulders at the level of the 7th cervical vertebra (the bump at the back of the base of the neck)"
             }
             Joint::Chest => {
-                "sternum, on the trunk's middle line about a third of the way from neck to pelvis"
+                "sternum (breastbone), on the trunk's middle line about a third of the way from neck to pelvis"
             }
             Joint::Pelvis => "midpoint of the two hip joints",
             Joint::LeftShoulder | Joint::RightShoulder => {
-                "centre of the shoulder joint (head of the humerus), under the acromion"
+                "centre of the shoulder joint (head of the humerus), under the acromion (the bony tip of the shoulder)"
             }
             Joint::LeftElbow | Joint::RightElbow => {
-                "centre of the elbow joint, between the epicondyles"
+                "centre of the elbow joint, between the epicondyles (the bony points either side of the elbow)"
             }
             Joint::LeftWrist | Joint::RightWrist => {
-                "centre of the wrist, between the styloid processes"
+                "centre of the wrist, between the styloid processes (the two bony knobs either side of the wrist)"
             }
             Joint::LeftHip | Joint::RightHip => {
-                "centre of the hip joint (head of the femur), at the level of the greater trochanter"
+                "centre of the hip joint (head of the femur), at the level of the greater trochanter (the bony point on the side of the hip)"
             }
             Joint::LeftKnee | Joint::RightKnee => {
-                "centre of the knee joint, between the femoral condyles"
+                "centre of the knee joint, between the femoral condyles (the rounded ends of the thigh bone)"
             }
             Joint::LeftAnkle | Joint::RightAnkle => {
-                "centre of the ankle joint, between the malleoli"
+                "centre of the ankle joint, between the malleoli (the ankle bones that stick out either side)"
             }
         }
     }
