@@ -254,7 +254,7 @@ fn strips_are_named_and_the_panel_says_how_much_is_weak() {
     let at = timeline_point(&h, Joint::LeftWrist, 4);
     h.hover_at(at);
     h.run_steps(3);
-    h.get_by_label_contains("left_wrist · frame 4 · weak");
+    h.get_by_label_contains("left wrist · frame 4 · weak");
 }
 
 /// The screen point of `joint`'s strip at `frame` (from the timeline's layout: the scrubber's

@@ -197,12 +197,21 @@ pub fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
             let joint = Joint::ALL.get(row as usize).copied();
             let point = joint.and_then(|j| state.strips()?.state_at(j, f));
             match (joint, point) {
-                (Some(j), Some(p)) => format!("{} · frame {f} · {}", j.name(), p.word()),
-                (Some(j), None) => format!("{} · frame {f} · not tracked yet", j.name()),
+                (Some(j), Some(p)) => format!(
+                    "{} · frame {f} · {}",
+                    super::marking::joint_words(j),
+                    p.word()
+                ),
+                (Some(j), None) => format!(
+                    "{} · frame {f} · not tracked yet",
+                    super::marking::joint_words(j)
+                ),
                 _ => format!("frame {f}"),
             }
         };
-        response.on_hover_text(text);
+        // At the pointer: the strip spans the window, and a tooltip placed by the widget sat at
+        // its far left.
+        response.on_hover_text_at_pointer(text);
     }
 }
 
