@@ -20,6 +20,8 @@ pub struct App {
     guide: egui_commonmark::CommonMarkCache,
     /// How many times something was opened when the views last reset to it.
     opened: u64,
+    /// The window was fitted to its screen (once, on the first frame that knows the screen).
+    fitted: bool,
 }
 
 impl App {
@@ -42,6 +44,7 @@ impl App {
             space: SpaceKey::default(),
             guide: egui_commonmark::CommonMarkCache::default(),
             opened: 0,
+            fitted: false,
         }
     }
 
@@ -138,6 +141,9 @@ impl eframe::App for App {
             self.frame_view.fit();
             self.orbit = Orbit::default();
         }
+        if !self.fitted {
+            self.fitted = fit_to_screen(&ctx);
+        }
         keys::read(&ctx, &self.state, &mut self.space, &mut out);
         // The window's close button asks like File ▸ Quit.
         if ctx.input(|i| i.viewport().close_requested()) && !self.state.quitting() {
@@ -182,4 +188,27 @@ impl eframe::App for App {
             ctx.request_repaint();
         }
     }
+}
+
+/// Where no window manager maximises the window (the viewport asks it to), sizes it to most of
+/// its screen, centred; `false` until the screen's size is known.
+fn fit_to_screen(ctx: &egui::Context) -> bool {
+    let (monitor, maximized) = ctx.input(|i| (i.viewport().monitor_size, i.viewport().maximized));
+    let Some(monitor) = monitor else {
+        return false;
+    };
+    if maximized != Some(true) {
+        let size = fitted_size(monitor);
+        ctx.send_viewport_cmd(egui::ViewportCommand::InnerSize(size));
+        ctx.send_viewport_cmd(egui::ViewportCommand::OuterPosition(
+            ((monitor - size) / 2.0).to_pos2(),
+        ));
+    }
+    true
+}
+
+/// The window's size on a screen of `monitor` points: nine tenths of it, at least the panels'
+/// minimum (960×600).
+pub(crate) fn fitted_size(monitor: egui::Vec2) -> egui::Vec2 {
+    (monitor * 0.9).max(egui::vec2(960.0, 600.0))
 }

@@ -18,9 +18,7 @@ use std::path::PathBuf;
 /// Opens the main window, optionally on a video, an image folder or a project file.
 pub fn run(video: Option<PathBuf>) -> anyhow::Result<()> {
     let options = eframe::NativeOptions {
-        viewport: egui::ViewportBuilder::default()
-            .with_title("videomocap")
-            .with_inner_size([1280.0, 800.0]),
+        viewport: viewport(),
         ..Default::default()
     };
     eframe::run_native(
@@ -29,6 +27,17 @@ pub fn run(video: Option<PathBuf>) -> anyhow::Result<()> {
         Box::new(move |cc| Ok(Box::new(app::App::new(&cc.egui_ctx, video)))),
     )
     .map_err(|e| anyhow::anyhow!("the desktop app could not start: {e}"))
+}
+
+/// The main window: maximised, so it fills the screen whatever its size (a fixed 1280×800
+/// overflowed a laptop's screen and left a large one mostly empty); 1280×800 when un-maximised,
+/// never smaller than the panels need.
+fn viewport() -> egui::ViewportBuilder {
+    egui::ViewportBuilder::default()
+        .with_title("videomocap")
+        .with_inner_size([1280.0, 800.0])
+        .with_min_inner_size([960.0, 600.0])
+        .with_maximized(true)
 }
 
 #[cfg(test)]

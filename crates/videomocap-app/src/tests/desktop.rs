@@ -310,3 +310,21 @@ fn progress_moves_nothing_and_the_last_skeleton_stays_during_a_job() {
     wait(&mut h, "the lift", |s| !s.busy());
     assert!(scene(h.state().state()).joints.is_some());
 }
+
+/// The window opens maximised (fitting whatever screen it is on), with a floor under which the
+/// panels would clip.
+#[test]
+fn the_window_opens_maximised_with_a_minimum_size() {
+    let v = crate::viewport();
+    assert_eq!(v.maximized, Some(true));
+    assert_eq!(v.min_inner_size, Some(egui::vec2(960.0, 600.0)));
+    // Where no window manager maximises it, it takes most of the screen, whatever its size.
+    assert_eq!(
+        crate::app::fitted_size(egui::vec2(2560.0, 1440.0)),
+        egui::vec2(2304.0, 1296.0)
+    );
+    assert_eq!(
+        crate::app::fitted_size(egui::vec2(1000.0, 600.0)),
+        egui::vec2(960.0, 600.0)
+    );
+}
