@@ -91,11 +91,8 @@ fn the_background_weight_is_an_undoable_tracker_setting() {
     };
     let d = TrackerParams::default();
     assert_eq!(now(&h), d.arm_foreground);
-    h.get_by_role_and_label(
-        egui::accesskit::Role::Slider,
-        "arms stand out from the background",
-    )
-    .set_value_accesskit(0.0);
+    h.get_by_role_and_label(egui::accesskit::Role::Slider, "arms vs. background")
+        .set_value_accesskit(0.0);
     h.run();
     assert_eq!(now(&h), 0.0);
     h.state_mut().state_mut().apply(Intent::Undo);

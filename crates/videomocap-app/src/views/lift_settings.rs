@@ -41,13 +41,13 @@ pub fn lift_settings_ui(ui: &mut egui::Ui, l: &mut LiftParams) {
             on_off(d.key_path_smoothing)
         ));
     let a = &mut l.ambiguity;
-    ui.add(egui::Slider::new(&mut a.arm_swing, 0.0..=3.0).text("arms swing against the legs"))
+    ui.add(egui::Slider::new(&mut a.arm_swing, 0.0..=3.0).text("arm swing vs. legs"))
         .on_hover_text(format!(
             "When walking or running, how strongly each arm is taken to swing against its own leg \
              when its depth is in doubt (0 = off); default {}",
             d.ambiguity.arm_swing
         ));
-    ui.add(egui::Slider::new(&mut a.contact, 0.0..=30.0).text("hands stay out of the body"))
+    ui.add(egui::Slider::new(&mut a.contact, 0.0..=30.0).text("hands outside the body"))
         .on_hover_text(format!(
             "How strongly a hand is kept out of the trunk and the thighs when its depth is in \
              doubt (0 = off); default {}",

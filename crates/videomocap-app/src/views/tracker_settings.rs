@@ -40,7 +40,7 @@ pub fn tracker_settings_ui(ui: &mut egui::Ui, t: &mut TrackerParams) {
     // The spring is part of the chain refinement: greyed out without it.
     ui.add_enabled(t.chain_refine, egui::Slider::new(&mut t.shoulder_spring, 0.0..=0.5).text("shoulder spring"))
         .on_hover_text(format!("Cost per square pixel that a shoulder pays for leaving the place the rigid trunk gives it, so it can rise with a raised arm (part of the chain refinement); higher holds it closer; 0 holds it on the trunk; default {}", d.shoulder_spring));
-    ui.add(egui::Slider::new(&mut t.arm_foreground, 0.0..=1.0).text("arms stand out from the background"))
+    ui.add(egui::Slider::new(&mut t.arm_foreground, 0.0..=1.0).text("arms vs. background"))
         .on_hover_text(format!("With a camera that stands still, the background is the median of 25 frames, and an arm's blocks must stand out from it where they did on the marked frame, so a forearm no longer settles on a wall of its colour; ignored when the camera moves (0 = off); default {}", d.arm_foreground));
     if ui.button("Defaults").clicked() {
         *t = d;
