@@ -993,18 +993,22 @@ fn viterbi(candidates: &[Vec<Candidate>]) -> (Vec<usize>, f64) {
     (path, cost[end])
 }
 
+/// A candidate whose first child sits at `x` on a line, for the Viterbi tests.
+#[cfg(test)]
+fn test_candidate(x: f64, unary: f64) -> Candidate {
+    Candidate {
+        absolute: [Point3::new(x, 0.0, 0.0), Point3::origin()],
+        too_long: [false; 2],
+        unary,
+        steer: 0.0,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn cand(x: f64, unary: f64) -> Candidate {
-        Candidate {
-            absolute: [Point3::new(x, 0.0, 0.0), Point3::origin()],
-            too_long: [false; 2],
-            unary,
-            steer: 0.0,
-        }
-    }
+    use super::test_candidate as cand;
 
     #[test]
     fn viterbi_prefers_a_smooth_crossing_to_a_bounce() {

@@ -84,18 +84,8 @@ pub(super) fn min_marginals(candidates: &[Vec<Candidate>]) -> Vec<Vec<f64>> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::viterbi;
+    use super::super::{test_candidate as cand, viterbi};
     use super::*;
-    use nalgebra::Point3;
-
-    fn cand(x: f64, unary: f64) -> Candidate {
-        Candidate {
-            absolute: [Point3::new(x, 0.0, 0.0), Point3::origin()],
-            too_long: [false; 2],
-            unary,
-            steer: 0.0,
-        }
-    }
 
     /// Brute force over every path: each frame's min-marginal is the best path through it, and
     /// the chosen path's candidates reach the optimum itself.
