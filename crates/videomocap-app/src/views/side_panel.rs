@@ -75,8 +75,15 @@ fn parameters(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
     ui.add(egui::Slider::new(&mut settings.height_m, 1.0..=2.3).text("subject height (m)"))
         .on_hover_text("The subject's stature (default 1.70 m): every length is read from the video and this fixes their overall scale, so the 3D skeleton's size and depth follow it. Lengths you know (below) set the scale instead.");
     let fit = state.subject_fit();
+    // One line whether or not a lift has read the lengths (the whole reading on hover), so the
+    // panel below does not jump when it arrives.
+    let line = match fit {
+        Some(_) => "body lengths: read from the video (hover for each)",
+        None => "body lengths: read from the video when lifted",
+    };
+    let label = ui.label(egui::RichText::new(line).small().weak());
     if let Some(fit) = fit {
-        ui.label(egui::RichText::new(fit.to_string()).small().weak());
+        label.on_hover_text(fit.to_string());
     }
     let read = |name: &str| {
         fit.and_then(|f| f.parts.iter().find(|p| p.name == name))
