@@ -22,6 +22,8 @@ pub struct App {
     opened: u64,
     /// The window was fitted to its screen (once, on the first frame that knows the screen).
     fitted: bool,
+    /// The 3D view was aimed from the video camera since the last open.
+    aimed: bool,
 }
 
 impl App {
@@ -45,6 +47,7 @@ impl App {
             guide: egui_commonmark::CommonMarkCache::default(),
             opened: 0,
             fitted: false,
+            aimed: false,
         }
     }
 
@@ -89,6 +92,16 @@ impl App {
     /// The 3D view with its header; a clicked limb asks for a flip.
     fn view3d(&mut self, ui: &mut egui::Ui, out: &mut Vec<Intent>) {
         let scene = scene::scene(&self.state);
+        // The first skeleton after opening is seen from the video camera, the floor below.
+        if !self.aimed
+            && let (Some((eye, _)), Some(joints)) = (&scene.camera, &scene.joints)
+        {
+            let p = joints[videomocap_core::skeleton::Joint::Pelvis];
+            self.orbit =
+                Orbit::from_camera(eye, nalgebra::Vector3::new(p.x as f32, 0.9, p.z as f32));
+            self.aimed = true;
+        }
+        let camera_eye = scene.camera.map(|(eye, _)| eye);
         ui.horizontal(|ui| {
             ui.label(if self.state.volume().is_some() {
                 "3D (point volumes)"
@@ -96,7 +109,10 @@ impl App {
                 "3D"
             });
             if ui.button("Reset view").clicked() {
-                self.orbit = Orbit::default();
+                self.orbit = match camera_eye {
+                    Some(eye) => Orbit::from_camera(&eye, self.orbit.target),
+                    None => Orbit::default(),
+                };
             }
             ui.checkbox(&mut self.orbit.follow, "Follow").on_hover_text(
                 "Keep the view on the subject as they move across the floor (panning turns it off)",
@@ -140,6 +156,7 @@ impl eframe::App for App {
             self.opened = self.state.opened();
             self.frame_view.fit();
             self.orbit = Orbit::default();
+            self.aimed = false;
         }
         if !self.fitted {
             self.fitted = fit_to_screen(&ctx);

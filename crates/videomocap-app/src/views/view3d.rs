@@ -64,6 +64,23 @@ impl Default for Orbit {
 }
 
 impl Orbit {
+    /// The view from the video camera's centre `eye` (world metres) towards `target`, so the
+    /// 3D skeleton first reads as the video does (a one-leg balance seen from an arbitrary
+    /// side read as standing with legs apart).
+    pub fn from_camera(eye: &Point3<f64>, target: Vector3<f32>) -> Orbit {
+        let eye = Vector3::new(eye.x as f32, eye.y as f32, eye.z as f32);
+        let back = eye - target;
+        let distance = back.norm().max(1.0);
+        let back = back / distance;
+        Orbit {
+            yaw: back.x.atan2(back.z),
+            pitch: back.y.clamp(-1.0, 1.0).asin().clamp(-1.5, 1.5),
+            distance,
+            target,
+            follow: true,
+        }
+    }
+
     fn basis(&self) -> (Vector3<f32>, Vector3<f32>, Vector3<f32>, Vector3<f32>) {
         let back = Vector3::new(
             self.pitch.cos() * self.yaw.sin(),
@@ -265,5 +282,25 @@ mod tests {
         h.state_mut().1 = 7.0;
         h.run();
         assert_eq!(h.state().0.target.x, 4.5);
+    }
+
+    /// Seen from the video camera: the target at the view's centre, the camera's own left and
+    /// right kept (a point beside the target away from the camera's side shows on that side),
+    /// the floor below the horizon.
+    #[test]
+    fn the_view_from_the_camera_looks_at_the_target_as_the_camera_does() {
+        let eye = Point3::new(1.0, 1.6, 4.0);
+        let target = Vector3::new(0.0, 0.9, 0.0);
+        let o = Orbit::from_camera(&eye, target);
+        let rect = Rect::from_min_size(Pos2::ZERO, Vec2::new(400.0, 300.0));
+        let at = o.project(rect, &Point3::new(0.0, 0.9, 0.0)).unwrap();
+        assert!((at - rect.center()).length() < 1e-3, "{at:?}");
+        assert!((o.distance - (eye.coords.cast::<f32>() - target).norm()).abs() < 1e-4);
+        // Looking down from 1.6 m: the floor under the target is below the centre.
+        let floor = o.project(rect, &Point3::new(0.0, 0.0, 0.0)).unwrap();
+        assert!(floor.y > rect.center().y);
+        // The camera's right (world +x from this eye, looking towards −z) is on the right.
+        let side = o.project(rect, &Point3::new(0.5, 0.9, 0.0)).unwrap();
+        assert!(side.x > rect.center().x);
     }
 }
