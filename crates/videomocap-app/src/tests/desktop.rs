@@ -266,7 +266,8 @@ fn timeline_point(h: &Harness<'_, App>, joint: Joint, frame: usize) -> egui::Pos
     let radius = rail.height() / 2.5;
     let (left, right) = (rail.min.x + radius, rail.max.x - radius);
     let x = left + (right - left) * frame as f32 / (frames - 1) as f32;
-    let y = rail.max.y + 4.0 + 12.0 + 9.0 * (joint.index() as f32 + 0.5);
+    let y =
+        rail.max.y + 4.0 + 12.0 + crate::views::timeline::STRIP_H * (joint.index() as f32 + 0.5);
     egui::pos2(x, y)
 }
 

@@ -13,8 +13,9 @@ use videomocap_core::track::KeyFrames;
 
 /// Width of the joint names left of the strips, points.
 pub const LABEL_W: f32 = 44.0;
-/// Height of one joint's strip, points.
-const STRIP_H: f32 = 9.0;
+/// Height of one joint's strip, points (and its label's font: at 9 the names read about 7 px
+/// tall, too small to read at a glance).
+pub(crate) const STRIP_H: f32 = 11.0;
 /// Height of the rows of ticks above the strips (key frames, then flagged frames), points.
 const TICKS_H: f32 = 5.0;
 
