@@ -93,12 +93,16 @@ impl State {
     /// (missing, a broken project, a folder with nothing to open) is refused first, with the
     /// session left as it was: nothing is asked and nothing is lost.
     pub(super) fn leave(&mut self, to: Leave) {
-        if let Leave::Open(path) = &to
-            && let Err(problem) = openable(path)
-        {
-            self.status = format!("Cannot open {}: {problem}", path.display());
-            self.forget(&path.clone());
-            return;
+        if let Leave::Open(path) = &to {
+            match openable(path) {
+                Err(problem) => {
+                    self.status = format!("Cannot open {}: {problem}", path.display());
+                    self.forget(&path.clone());
+                    return;
+                }
+                // Read once: opening takes it from here.
+                Ok(project) => self.checked_project = project.map(|p| (path.clone(), p)),
+            }
         }
         if self.dirty() {
             self.leaving = Some(to);
@@ -345,7 +349,12 @@ impl State {
             self.open_volume(path);
             self.remember(path);
         } else if path.is_file() && path.extension().is_some_and(|e| e == "json") {
-            match Project::load(path) {
+            let checked = self.checked_project.take().filter(|(p, _)| p == path);
+            let loaded = match checked {
+                Some((_, project)) => Ok(project),
+                None => Project::load(path),
+            };
+            match loaded {
                 Ok(p) => {
                     self.dirty = false;
                     self.open_video(&p.video.clone());
@@ -487,7 +496,7 @@ fn project_beside(video: &Path) -> Option<PathBuf> {
         .filter_map(Result::ok)
         .map(|e| e.path())
         .filter(|p| p.to_string_lossy().ends_with(".videomocap.json"))
-        .filter(|p| Project::load(p).is_ok_and(|project| same(&project.video)))
+        .filter(|p| video_of(p).is_some_and(|v| same(&v)))
         .map(|p| {
             let modified = std::fs::metadata(&p)
                 .and_then(|m| m.modified())
@@ -499,15 +508,28 @@ fn project_beside(video: &Path) -> Option<PathBuf> {
     found.pop().map(|(_, p)| p)
 }
 
+/// The video a project file is for, reading that field alone (the folder may hold several
+/// large projects, and this runs as a video opens).
+fn video_of(project: &Path) -> Option<PathBuf> {
+    #[derive(serde::Deserialize)]
+    struct VideoOnly {
+        video: PathBuf,
+    }
+    let file = std::fs::File::open(project).ok()?;
+    serde_json::from_reader::<_, VideoOnly>(std::io::BufReader::new(file))
+        .ok()
+        .map(|v| v.video)
+}
+
 /// Why `path` cannot be opened, in the user's words, checked before anything is closed (a
-/// video's own format is checked as it opens).
-fn openable(path: &Path) -> Result<(), String> {
+/// video's own format is checked as it opens); a project is read here, once.
+fn openable(path: &Path) -> Result<Option<Project>, String> {
     if !path.exists() {
         return Err("there is no such file or folder".to_owned());
     }
     if path.is_file() && path.extension().is_some_and(|e| e == "json") {
         return Project::load(path)
-            .map(|_| ())
+            .map(Some)
             .map_err(|e| format!("it is not a project this app can read ({e})"));
     }
     if path.is_dir() && !is_volume_dir(path) && !has_images(path) {
@@ -517,7 +539,7 @@ fn openable(path: &Path) -> Result<(), String> {
                 .to_owned(),
         );
     }
-    Ok(())
+    Ok(None)
 }
 
 fn is_volume_dir(path: &Path) -> bool {

@@ -147,6 +147,8 @@ pub struct State {
     leaving: Option<Leave>,
     /// A saved project of the video just opened bare, offered to the user.
     project_beside: Option<PathBuf>,
+    /// A project read while checking it could open, kept for the open (not read twice).
+    checked_project: Option<(PathBuf, Project)>,
     /// The app's own path field, shown when no file dialog can be.
     path_request: Option<PathRequest>,
     /// A file dialog could not be shown once: use the path field from then on.
@@ -204,6 +206,7 @@ impl State {
             dirty: false,
             leaving: None,
             project_beside: None,
+            checked_project: None,
             path_request: None,
             no_native_dialogs: false,
             quitting: false,

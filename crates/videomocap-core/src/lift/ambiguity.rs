@@ -927,6 +927,50 @@ fn acceleration(a: &Candidate, b: &Candidate, c: &Candidate) -> f64 {
 /// clips, where there is no acceleration).
 const VELOCITY_WEIGHT: f64 = 0.01;
 
+/// The best totals of the first two frames, `[a·k + b]` with frame 0 at `a` and frame 1 at `b`
+/// (their unaries and the velocity between them). Needs two frames or more.
+fn first_pair(candidates: &[Vec<Candidate>]) -> Vec<f64> {
+    let k = candidates[0].len();
+    let mut cost = vec![f64::INFINITY; k * k];
+    for a in 0..k {
+        for b in 0..k {
+            let (ca, cb) = (&candidates[0][a], &candidates[1][b]);
+            let v: f64 = (0..2)
+                .map(|i| (cb.absolute[i] - ca.absolute[i]).norm_squared())
+                .sum();
+            cost[a * k + b] = ca.unary + cb.unary + VELOCITY_WEIGHT * v;
+        }
+    }
+    cost
+}
+
+/// One step of the second-order Viterbi: from the best totals `cost[a·k + b]` of frames
+/// `t − 2`, `t − 1`, those of frames `t − 1`, `t` (`[b·k + c]`), with the `a` each came from.
+fn forward_step(candidates: &[Vec<Candidate>], t: usize, cost: &[f64]) -> (Vec<f64>, Vec<usize>) {
+    let k = candidates[t].len();
+    let mut next = vec![f64::INFINITY; k * k];
+    let mut from = vec![0usize; k * k];
+    for b in 0..k {
+        for c in 0..k {
+            let cc = &candidates[t][c];
+            for a in 0..k {
+                let prev = cost[a * k + b];
+                if !prev.is_finite() {
+                    continue;
+                }
+                let total = prev
+                    + cc.unary
+                    + acceleration(&candidates[t - 2][a], &candidates[t - 1][b], cc);
+                if total < next[b * k + c] {
+                    next[b * k + c] = total;
+                    from[b * k + c] = a;
+                }
+            }
+        }
+    }
+    (next, from)
+}
+
 /// The sequence of candidate indices minimising priors plus squared accelerations.
 fn viterbi(candidates: &[Vec<Candidate>]) -> (Vec<usize>, f64) {
     let n = candidates.len();
@@ -946,38 +990,10 @@ fn viterbi(candidates: &[Vec<Candidate>]) -> (Vec<usize>, f64) {
     }
     let k = candidates[0].len();
     // cost[a * k + b]: best total with frame t−1 at a and frame t at b.
-    let mut cost = vec![f64::INFINITY; k * k];
-    for a in 0..k {
-        for b in 0..k {
-            let (ca, cb) = (&candidates[0][a], &candidates[1][b]);
-            let v: f64 = (0..2)
-                .map(|i| (cb.absolute[i] - ca.absolute[i]).norm_squared())
-                .sum();
-            cost[a * k + b] = ca.unary + cb.unary + VELOCITY_WEIGHT * v;
-        }
-    }
+    let mut cost = first_pair(candidates);
     let mut back: Vec<Vec<usize>> = Vec::with_capacity(n);
     for t in 2..n {
-        let mut next = vec![f64::INFINITY; k * k];
-        let mut from = vec![0usize; k * k];
-        for b in 0..k {
-            for c in 0..k {
-                let cc = &candidates[t][c];
-                for a in 0..k {
-                    let prev = cost[a * k + b];
-                    if !prev.is_finite() {
-                        continue;
-                    }
-                    let total = prev
-                        + cc.unary
-                        + acceleration(&candidates[t - 2][a], &candidates[t - 1][b], cc);
-                    if total < next[b * k + c] {
-                        next[b * k + c] = total;
-                        from[b * k + c] = a;
-                    }
-                }
-            }
-        }
+        let (next, from) = forward_step(candidates, t, &cost);
         cost = next;
         back.push(from);
     }

@@ -5,7 +5,7 @@
 use super::error::LiftError;
 use super::focal::{default_focal, estimate_focal};
 use super::solve::{LiftJob, LiftOutput, LiftParams, lift};
-use super::subject_fit::{SubjectFit, fit_in_perspective};
+use super::subject_fit::{SubjectFit, subject_from_height};
 use super::{DepthOverrides, LiftProgress};
 use crate::camera::PinholeCamera;
 use crate::formats::{KnownLengths, Tracks2d};
@@ -142,8 +142,7 @@ pub fn reconstruct(
     progress(&stage(LiftStage::Subject));
     let (subject, fit) = match subject {
         SubjectChoice::Height { height_m, known } => {
-            let table = SubjectModel::from_height(*height_m, Proportions::default())?;
-            let (s, fit) = fit_in_perspective(&table, tracks, camera, params, known)?;
+            let (s, fit) = subject_from_height(*height_m, tracks, camera, params, known)?;
             (s, Some(fit))
         }
         SubjectChoice::Model(s) => (s.as_ref().clone(), None),

@@ -3,7 +3,7 @@
 //! candidate (the forward pass of [`super::viterbi`] met by the same pass run backwards), so a
 //! bone's margin on a frame is what taking its other root there would cost the clip at best.
 
-use super::{Candidate, VELOCITY_WEIGHT, acceleration};
+use super::{Candidate, acceleration, first_pair, forward_step};
 
 /// Per frame and candidate, the least total of the sequence with that frame at that candidate
 /// (the same costs as [`super::viterbi`]: unaries, the first two frames' velocity, squared
@@ -20,35 +20,9 @@ pub(super) fn min_marginals(candidates: &[Vec<Candidate>]) -> Vec<Vec<f64>> {
     let pair = |a: usize, b: usize| a * k + b;
     // forward[t][a·k + b]: the best total of frames 0..=t with t−1 at a and t at b (t ≥ 1).
     let mut forward: Vec<Vec<f64>> = vec![Vec::new(); n];
-    let mut first = vec![f64::INFINITY; k * k];
-    for a in 0..k {
-        for b in 0..k {
-            let (ca, cb) = (&candidates[0][a], &candidates[1][b]);
-            let v: f64 = (0..2)
-                .map(|i| (cb.absolute[i] - ca.absolute[i]).norm_squared())
-                .sum();
-            first[pair(a, b)] = ca.unary + cb.unary + VELOCITY_WEIGHT * v;
-        }
-    }
-    forward[1] = first;
+    forward[1] = first_pair(candidates);
     for t in 2..n {
-        let mut next = vec![f64::INFINITY; k * k];
-        for b in 0..k {
-            for c in 0..k {
-                let cc = &candidates[t][c];
-                for a in 0..k {
-                    let prev = forward[t - 1][pair(a, b)];
-                    if !prev.is_finite() {
-                        continue;
-                    }
-                    let total = prev
-                        + cc.unary
-                        + acceleration(&candidates[t - 2][a], &candidates[t - 1][b], cc);
-                    next[pair(b, c)] = next[pair(b, c)].min(total);
-                }
-            }
-        }
-        forward[t] = next;
+        forward[t] = forward_step(candidates, t, &forward[t - 1]).0;
     }
     // backward[t][a·k + b]: the best total of frames t+1.. given t−1 at a and t at b.
     let mut backward: Vec<Vec<f64>> = vec![vec![0.0; k * k]; n];
@@ -84,7 +58,7 @@ pub(super) fn min_marginals(candidates: &[Vec<Candidate>]) -> Vec<Vec<f64>> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{test_candidate as cand, viterbi};
+    use super::super::{VELOCITY_WEIGHT, test_candidate as cand, viterbi};
     use super::*;
 
     /// Brute force over every path: each frame's min-marginal is the best path through it, and
