@@ -16,6 +16,8 @@ pub struct VolumeSequence {
     pub world: Option<WorldSkeleton>,
     /// What the 3D view draws.
     pub layers: Layers,
+    /// Why the pipeline failed on this sequence, in the user's words (the 3D view says it).
+    pub failed: Option<String>,
 }
 
 /// The layers volume mode can draw (the skeleton always shows).
@@ -47,6 +49,7 @@ impl VolumeSequence {
             processed: None,
             world: None,
             layers: Layers::default(),
+            failed: None,
         }
     }
 
@@ -59,5 +62,19 @@ impl VolumeSequence {
     pub fn set(&mut self, processed: Processed) {
         self.world = WorldSkeleton::new(&processed.assembled.skeleton, None).ok();
         self.processed = Some(Arc::new(processed));
+        self.failed = None;
+    }
+
+    /// Records why the pipeline failed on this sequence.
+    pub fn fail(&mut self, error: &str) {
+        // The pipeline's error starts with the folder, which the sentence names already.
+        let prefix = format!("{}: ", self.dir.display());
+        let error = error.strip_prefix(&prefix).unwrap_or(error);
+        let error = error.trim_end_matches(['.', ' ']);
+        self.failed = Some(format!(
+            "The point volumes in {} could not be turned into a skeleton: {error}. Check that \
+             each file is a complete PLY, XYZ or voxel file, or open another folder.",
+            self.dir.display()
+        ));
     }
 }

@@ -124,7 +124,11 @@ impl State {
                             );
                             v.set(p);
                         }
-                        (Err(e), _) => self.status = format!("Cannot process the volumes: {e}"),
+                        (Err(e), Some(v)) => {
+                            v.fail(&e);
+                            self.status = v.failed.clone().unwrap_or_default();
+                        }
+                        (Err(e), None) => self.status = format!("Cannot process the volumes: {e}"),
                         (Ok(_), None) => {}
                     }
                 }

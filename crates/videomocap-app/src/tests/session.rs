@@ -122,6 +122,49 @@ fn volume_mode_opens_a_point_volume_folder_and_steps_through_it() {
     assert!(scene.cloud.is_empty() && scene.joints.is_some());
 }
 
+/// A folder of broken PLY files: the 3D view says what went wrong with which file and what
+/// to do (it said "mark, then Track", the video mode's hint), and so does the status line.
+#[test]
+fn broken_point_volumes_are_explained_in_the_3d_view() {
+    let dir = tempfile::tempdir().unwrap();
+    let vols = dir.path().join("vols");
+    std::fs::create_dir(&vols).unwrap();
+    let cut_short = "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\n\
+                     property float y\nproperty float z\nend_header\n1 2 3\n";
+    for k in 0..3 {
+        std::fs::write(vols.join(format!("frame_{k:04}.ply")), cut_short).unwrap();
+    }
+    let dialogs = PreparedDialogs::default();
+    dialogs.answers.borrow_mut().push_back(vols.clone());
+    let mut h = harness(None, &dialogs, &dir.path().join("state"));
+    h.step();
+    h.get_by_label("File").click();
+    h.run_steps(3);
+    h.get_by_label("Open point volumes…").click();
+    h.run_steps(3);
+    let scene = crate::views::scene::scene(h.state().state());
+    let text = scene.empty_text.unwrap_or_default();
+    assert!(
+        h.state().state().busy() || text.contains("could not"),
+        "while processing: {text}"
+    );
+    wait(&mut h, "the volumes to fail", |s| !s.busy());
+    let scene = crate::views::scene::scene(h.state().state());
+    let text = scene.empty_text.unwrap_or_default();
+    assert!(
+        text.contains("could not be turned into a skeleton")
+            && text.contains("frame_0000.ply")
+            && text.contains("PLY, XYZ or voxel"),
+        "{text}"
+    );
+    assert!(!text.contains("mark, then Track"));
+    assert!(
+        h.state().state().status().contains("frame_0000.ply"),
+        "{}",
+        h.state().state().status()
+    );
+}
+
 /// The whole session a user has: open a clip, mark 16 joints by clicking, drag one, undo,
 /// track and lift, scrub, orbit the 3D view, export a BVH, and after the app dies, recover
 /// the work from the autosave.

@@ -122,6 +122,13 @@ fn plain_flag(flag: &str) -> String {
 pub fn volume_scene(v: &VolumeSequence, index: usize) -> Scene {
     let mut scene = Scene::default();
     let (Some(p), Some(world)) = (&v.processed, &v.world) else {
+        scene.empty_text = Some(v.failed.clone().unwrap_or_else(|| {
+            if v.processed.is_some() {
+                "no frame of these point volumes gave a skeleton".to_owned()
+            } else {
+                "reading the point volumes… (progress below)".to_owned()
+            }
+        }));
         return scene;
     };
     let to_world = |q: &Point3<f64>| world.world.to_world(q);

@@ -28,6 +28,9 @@ pub struct Scene {
     pub unsure: Vec<Bone>,
     /// Lines written over the view's top-left corner (what the lift flagged, a stale view).
     pub notes: Vec<String>,
+    /// What the view says when it has nothing to draw (`None`: the video mode's "mark, then
+    /// Track").
+    pub empty_text: Option<String>,
 }
 
 /// Colour of a bone the lift flagged.
@@ -220,13 +223,18 @@ impl Orbit {
                 clicked = response.interact_pointer_pos().and_then(near_bone);
             }
         } else if scene.cloud.is_empty() {
-            painter.text(
-                rect.center(),
-                egui::Align2::CENTER_CENTER,
-                "no 3D skeleton yet: mark, then Track",
+            let text = scene
+                .empty_text
+                .clone()
+                .unwrap_or_else(|| "no 3D skeleton yet: mark, then Track".to_owned());
+            let galley = painter.layout(
+                text,
                 egui::FontId::proportional(14.0),
                 Color32::GRAY,
+                (rect.width() - 32.0).clamp(100.0, 640.0),
             );
+            let at = rect.center() - galley.size() / 2.0;
+            painter.galley(at, galley, Color32::GRAY);
         }
         for (k, note) in scene.notes.iter().enumerate() {
             painter.text(
