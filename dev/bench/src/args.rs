@@ -42,6 +42,9 @@ pub enum Command {
     /// 3D accuracy from true, noisy and tracked 2D with true lengths or a stated height, beside
     /// the flat cut-out; speed.
     Lift(BenchArgs),
+    /// Motion an animator sees: jitter, foot sliding, the root's path and acceleration error
+    /// of the lift beside the reference's own and the cut-out's.
+    Motion(BenchArgs),
     /// The point-volume pipeline: topology, joint error, labels, dev and test takes, carved
     /// from clean and faulty silhouettes, time per frame at 3k/10k/30k points.
     Volume(BenchArgs),
@@ -210,10 +213,15 @@ pub struct BenchArgs {
     /// Stale after any change to the tracker or the network: delete the files then.
     #[arg(long)]
     pub reuse: bool,
-    /// `correct` only: track as the product does, with the pose network's evidence (without
-    /// it, VBA alone).
+    /// `correct`: track as the product does, with the pose network's evidence (without it,
+    /// VBA alone). `lift`: the lift alone, the network's 3D body alone and the two together
+    /// (with `--reuse`, the network's frames on the true 2D are kept in `lift-net.json`).
     #[arg(long)]
     pub network: bool,
+    /// `lift --network` only: the image-depth weights to compare (dev sweeps), comma-separated;
+    /// default the lift's own.
+    #[arg(long, value_delimiter = ',')]
+    pub depth_weights: Option<Vec<f64>>,
     /// `bench lift` only: leave out input (c), the tracker's output (tracking is most of the
     /// bench's time; for quick looks at the lift from true and noisy 2D).
     #[arg(long)]

@@ -26,6 +26,16 @@ pub fn run(what: &str, a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitErr
     if what == "correct" {
         return crate::bench_correct::run(a, global);
     }
+    if what == "lift" && a.network {
+        let default = videomocap_core::lift::LiftParams::default()
+            .ambiguity
+            .image_depth;
+        return crate::bench_lift_network::run(
+            a,
+            global,
+            a.depth_weights.as_deref().unwrap_or(&[default]),
+        );
+    }
     if what == "lift" {
         return crate::bench_lift::run(a, global);
     }

@@ -8,6 +8,8 @@ mod bench_baselines;
 mod bench_correct;
 mod bench_learned;
 mod bench_lift;
+mod bench_lift_network;
+mod bench_motion;
 mod bench_scrub;
 mod bench_suite;
 mod bench_track;
@@ -29,6 +31,7 @@ fn main() -> ExitCode {
         Command::Correct(a) => bench::run("correct", a, global),
         Command::Lift(a) => bench::run("lift", a, global),
         Command::Volume(a) => bench::run("volume", a, global),
+        Command::Motion(a) => bench_motion::run(a, global),
         Command::Scrub(a) => bench::run("scrub", a, global),
         Command::Learned(a) => bench_learned::run(a, global),
         Command::Speed { what, args } => bench::run(what, args, global),

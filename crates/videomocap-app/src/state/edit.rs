@@ -275,6 +275,7 @@ mod tests {
             frames: (0..frames)
                 .map(|index| FrameTracks {
                     index: FrameIndex(index),
+                    body3d: None,
                     points: PerJoint::from_fn(|_| TrackedPoint {
                         pos: Point2::new(10.0, 10.0),
                         confidence: 0.9,

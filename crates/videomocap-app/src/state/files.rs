@@ -393,11 +393,14 @@ impl State {
     }
 
     /// A video that opened: remembered in Recent unless a project holds it (the project is
-    /// what the user opened, and what Recent should bring back).
+    /// what the user opened, and what Recent should bring back), and a project saved beside it
+    /// offered.
     pub(super) fn remember_opened(&mut self, video: &Path) {
         if self.project_path.is_none() {
             self.remember(video);
-            self.project_beside = project_beside(video);
+            // Work recovered or begun on this video is newer than any saved project: none is
+            // offered over it.
+            self.project_beside = project_beside(video).filter(|_| !self.dirty);
             if let Some(p) = &self.project_beside {
                 self.status = format!("A saved project for this video: {}", p.display());
             }

@@ -211,7 +211,8 @@ impl Job {
     pub fn progress_text(&self) -> String {
         let (share, _, left) = self.rate();
         let mut text = self.what.to_owned();
-        if !self.stage.is_empty() {
+        // The stage in brackets when it says more than the job's name ("Tracking (tracking)").
+        if !self.stage.is_empty() && !self.stage.eq_ignore_ascii_case(self.what) {
             text += &format!(" ({})", self.stage);
         }
         if self.total > 0 {
@@ -275,6 +276,13 @@ mod tests {
         assert_eq!(j.started.1, 0);
         assert!(j.started.0.elapsed().as_secs_f64() < 5.0);
         assert!(j.progress_text().contains("(global refinement) 5 %"));
+        // A stage named as the job is not said twice.
+        tx.send(progress(2, 20, &j.what.to_lowercase())).unwrap();
+        j.poll();
+        assert!(!j.progress_text().contains('('), "{}", j.progress_text());
+        tx.send(progress(1, 20, "global refinement")).unwrap();
+        j.poll();
+        j.started = (Instant::now(), 0);
         // Within one stage the clock runs on.
         j.started.0 -= std::time::Duration::from_secs(4);
         tx.send(progress(11, 20, "global refinement")).unwrap();

@@ -194,6 +194,7 @@ fn weak_wrist_tracks(dir: &Path, n: usize) -> Tracks2d {
         frames: (0..n)
             .map(|i| FrameTracks {
                 index: videomocap_core::formats::FrameIndex(i),
+                body3d: None,
                 points: PerJoint::from_fn(|j| TrackedPoint {
                     pos: Point2::new(4.0, 3.0),
                     confidence: if j == Joint::LeftWrist && (3..=5).contains(&i) {

@@ -122,6 +122,46 @@ fn volume_mode_opens_a_point_volume_folder_and_steps_through_it() {
     assert!(scene.cloud.is_empty() && scene.joints.is_some());
 }
 
+/// A session that died with unsaved work on a video that also has a saved project: the app
+/// asks one question at a time (recovery first; the two windows opened one over the other),
+/// and once the work is recovered it offers no older project over it.
+#[test]
+fn recovery_comes_before_the_project_beside_and_wins() {
+    let dir = tempfile::tempdir().unwrap();
+    let sample = videomocap_testkit::repo_root().join("sample_videos/synth_walk_oblique");
+    let video = dir.path().join("clip.mp4");
+    std::fs::copy(sample.join("video.mp4"), &video).unwrap();
+    let marks = Marks::load(&sample.join("marks.json")).unwrap();
+    let saved = Project::new(video.clone());
+    saved
+        .save(&dir.path().join("clip.videomocap.json"))
+        .unwrap();
+    let state = dir.path().join("state");
+    std::fs::create_dir(&state).unwrap();
+    let mut unsaved = Project::new(video.clone());
+    unsaved.keys = videomocap_core::track::KeyFrames::from_marks(&marks);
+    let autosave = crate::state::autosave::Autosaver::new(&state);
+    unsaved.save(autosave.path()).unwrap();
+    let dialogs = PreparedDialogs::default();
+    let mut h = harness(Some(video.clone()), &dialogs, &state);
+    wait(&mut h, "the clip to open", |a| a.frame_count() == 60);
+    h.run_steps(2);
+    assert!(h.state().state().offers_recovery());
+    assert!(
+        h.query_by_label("Open the project").is_none(),
+        "the project is not offered over the recovery"
+    );
+    h.get_by_label("Recover").click();
+    h.run_steps(2);
+    wait(&mut h, "the recovered clip", |a| a.frame_count() == 60);
+    h.run_steps(2);
+    assert_eq!(h.state().state().project().unwrap().keys, unsaved.keys);
+    assert!(
+        h.query_by_label("Open the project").is_none(),
+        "no older project offered over recovered work"
+    );
+}
+
 /// A folder of broken PLY files: the 3D view says what went wrong with which file and what
 /// to do (it said "mark, then Track", the video mode's hint), and so does the status line.
 #[test]

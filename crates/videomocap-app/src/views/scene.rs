@@ -79,14 +79,14 @@ pub fn scene(state: &State) -> Scene {
     }
     if !too_long.is_empty() {
         let what = if too_long.len() == 1 {
-            "1 bone (red) looks".to_owned()
+            "1 bone (red) looks longer in the image than it can be".to_owned()
         } else {
-            format!("{} bones (red) look", too_long.len())
+            format!(
+                "{} bones (red) look longer in the image than they can be",
+                too_long.len()
+            )
         };
-        scene.notes.insert(
-            0,
-            format!("flagged: {what} longer in the image than it can be"),
-        );
+        scene.notes.insert(0, format!("flagged: {what}"));
         scene.flagged = too_long;
     }
     let unsure: Vec<Bone> = state

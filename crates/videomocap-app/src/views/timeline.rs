@@ -246,6 +246,7 @@ mod tests {
                 .enumerate()
                 .map(|(i, &(confidence, source))| FrameTracks {
                     index: FrameIndex(i),
+                    body3d: None,
                     points: PerJoint::from_fn(|j| TrackedPoint {
                         pos: Point2::new(10.0, 10.0),
                         confidence: if j == Joint::LeftWrist {

@@ -57,7 +57,10 @@ pub fn show(
     }
     if let Some(to) = state.leaving() {
         save_changes(ctx, to, out);
-    } else if let Some(project) = state.project_beside() {
+    } else if let Some(project) = state.project_beside()
+        && !state.offers_recovery()
+    {
+        // One question at a time: both windows open in the middle, one over the other.
         project_beside(ctx, project, out);
     }
     if state.path_request().is_some() {

@@ -19,7 +19,8 @@ pub use lengths::{KnownLengths, LENGTH_RANGE_M, LENGTHS_FORMAT, SHOULDER_WIDTH_K
 pub use marks::{MARKS_FORMAT, Marks};
 pub use skeleton3d::{Frame3d, LOST_FLAG, OFF_FRAME_FLAG, SKELETON3D_FORMAT, Skeleton3d};
 pub use tracks2d::{
-    FrameTracks, PointSource, SourceInfo, TRACKS2D_FORMAT, TRACKS2D_VERSION, TrackedPoint, Tracks2d,
+    FrameTracks, NetworkBody, PointSource, SourceInfo, TRACKS2D_FORMAT, TRACKS2D_VERSION,
+    TrackedPoint, Tracks2d,
 };
 
 use crate::skeleton::{JOINT_COUNT, Joint};

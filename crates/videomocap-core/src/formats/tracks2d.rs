@@ -7,18 +7,18 @@ use super::{
 };
 use crate::camera::point_in_frame;
 use crate::skeleton::{Joint, PerJoint};
-use nalgebra::Point2;
+use nalgebra::{Point2, Vector3};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 /// The `format` tag of tracks2d files.
 pub const TRACKS2D_FORMAT: &str = "videomocap.tracks2d";
 
-/// The tracks2d version this build writes (it reads 1 to 3). Version 2 added `off_frame` (a
+/// The tracks2d version this build writes (it reads 1 to 4). Version 2 added `off_frame` (a
 /// version 1 reader would refuse its points outside the frame) and `lost`; version 3 added
 /// `gait` (a far limb completed from the gait by versions before 2026-11-28; read as
-/// interpolated, no longer written).
-pub const TRACKS2D_VERSION: u32 = 3;
+/// interpolated, no longer written); version 4 added `body3d` (the pose network's 3D body).
+pub const TRACKS2D_VERSION: u32 = 4;
 
 /// The video the tracks belong to.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -61,6 +61,17 @@ pub struct TrackedPoint {
     pub source: PointSource,
 }
 
+/// The pose network's 3D body on one frame: evidence for the lift's depth order, never the
+/// answer.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NetworkBody {
+    /// Each joint in the network's body frame: metres, origin between the hips, x to the
+    /// image's right, y down, z away from the camera.
+    pub points: PerJoint<Vector3<f64>>,
+    /// How sure the network is that each joint is there and seen, 0–1.
+    pub confidence: PerJoint<f32>,
+}
+
 /// All 16 joints in one frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameTracks {
@@ -68,6 +79,9 @@ pub struct FrameTracks {
     pub index: FrameIndex,
     /// The joints.
     pub points: PerJoint<TrackedPoint>,
+    /// The pose network's 3D body on this frame (`None`: tracked without the network, or it
+    /// saw no person here). Boxed: most frames of most files have none.
+    pub body3d: Option<Box<NetworkBody>>,
 }
 
 impl FrameTracks {
@@ -102,6 +116,10 @@ struct FrameFile {
     /// 2026-11-28, seen nowhere, migrated on load to an interpolated point.
     #[serde(default, skip_serializing)]
     gait: Option<Vec<bool>>,
+    /// Version 4; omitted on frames without the network's body: per joint x, y, z (metres)
+    /// and the network's confidence.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    body3d: Option<Vec<[f64; 4]>>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -156,6 +174,7 @@ impl Tracks2d {
                 ("off_frame", off_frame.len()),
                 ("lost", lost.len()),
                 ("gait", gait.len()),
+                ("body3d", f.body3d.as_ref().map_or(n, Vec::len)),
             ] {
                 if found != n {
                     return Err(FormatError::WrongLength {
@@ -238,9 +257,26 @@ impl Tracks2d {
                     },
                 });
             }
+            let body3d = match &f.body3d {
+                Some(b) => {
+                    if b.iter().flatten().any(|v| !v.is_finite()) {
+                        return Err(FormatError::Invalid {
+                            path: path.to_owned(),
+                            problem: format!("frame {}: body3d holds a non-number", f.index),
+                        });
+                    }
+                    let at = |j: Joint| b[columns[j.index()]];
+                    Some(Box::new(NetworkBody {
+                        points: PerJoint::from_fn(|j| Vector3::new(at(j)[0], at(j)[1], at(j)[2])),
+                        confidence: PerJoint::from_fn(|j| at(j)[3].clamp(0.0, 1.0) as f32),
+                    }))
+                }
+                None => None,
+            };
             frames.push(FrameTracks {
                 index: f.index,
                 points: PerJoint::from_fn(|j| points[j.index()]),
+                body3d,
             });
         }
         Ok(Tracks2d {
@@ -287,6 +323,14 @@ impl Tracks2d {
                     off_frame: flags(f, PointSource::OffFrame),
                     lost: flags(f, PointSource::Lost),
                     gait: None,
+                    body3d: f.body3d.as_ref().map(|b| {
+                        Joint::ALL
+                            .map(|j| {
+                                let p = b.points[j];
+                                [p.x, p.y, p.z, f64::from(b.confidence[j])]
+                            })
+                            .to_vec()
+                    }),
                 })
                 .collect(),
         }
@@ -316,6 +360,7 @@ mod tests {
             frames: (0..2)
                 .map(|i| FrameTracks {
                     index: FrameIndex(i),
+                    body3d: None,
                     points: PerJoint::from_fn(|j| TrackedPoint {
                         pos: Point2::new(100.0 + j.index() as f64, 50.0 + i as f64),
                         confidence: 0.75,
@@ -376,9 +421,9 @@ mod tests {
     }
 
     #[test]
-    fn off_frame_and_lost_points_round_trip_as_version_3() {
+    fn off_frame_and_lost_points_round_trip() {
         let (_dir, path, v) = saved_json(&with_off_frame());
-        assert_eq!(v["version"], 3);
+        assert_eq!(v["version"], TRACKS2D_VERSION);
         // Only the frame with an off-frame (lost) joint carries the array.
         assert!(v["frames"][0].get("off_frame").is_none());
         assert_eq!(v["frames"][1]["off_frame"][6], true);
@@ -387,6 +432,24 @@ mod tests {
         assert_eq!(v["frames"][0]["lost"][9], true);
         assert!(v["frames"][0].get("gait").is_none());
         assert_eq!(Tracks2d::load(&path).unwrap(), with_off_frame());
+    }
+
+    /// The network's 3D body rides with the frame it was seen on (version 4), in the file's
+    /// joint order; frames without it carry no array; a wrong length is refused.
+    #[test]
+    fn the_network_body_round_trips_and_is_checked() {
+        let mut t = sample();
+        t.frames[1].body3d = Some(Box::new(NetworkBody {
+            points: PerJoint::from_fn(|j| Vector3::new(j.index() as f64 * 0.01, -0.5, 0.25)),
+            confidence: PerJoint::from_fn(|j| if j == Joint::LeftWrist { 0.25 } else { 1.0 }),
+        }));
+        let (_dir, path, mut v) = saved_json(&t);
+        assert!(v["frames"][0].get("body3d").is_none());
+        assert_eq!(v["frames"][1]["body3d"][6][3], 0.25);
+        assert_eq!(Tracks2d::load(&path).unwrap(), t);
+        v["frames"][1]["body3d"].as_array_mut().unwrap().pop();
+        let err = Tracks2d::parse(&v.to_string(), &path).unwrap_err();
+        assert!(err.to_string().contains("body3d"), "{err}");
     }
 
     /// Files from versions before 2026-11-28 may mark a point completed from the gait: it is
@@ -415,12 +478,12 @@ mod tests {
         let (_dir, path, mut v) = saved_json(&sample());
         v["version"] = serde_json::json!(1);
         assert_eq!(Tracks2d::parse(&v.to_string(), &path).unwrap(), sample());
-        v["version"] = serde_json::json!(4);
+        v["version"] = serde_json::json!(5);
         let err = Tracks2d::parse(&v.to_string(), &path)
             .unwrap_err()
             .to_string();
         assert!(
-            err.contains("t.json") && err.contains("version 4") && err.contains("up to version 3"),
+            err.contains("t.json") && err.contains("version 5") && err.contains("up to version 4"),
             "{err}"
         );
     }

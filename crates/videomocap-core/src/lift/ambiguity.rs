@@ -23,7 +23,7 @@ mod margins;
 
 use super::backproject::{Root, bone_roots};
 use super::error::{LiftError, check_setting};
-use crate::formats::FrameIndex;
+use crate::formats::{FrameIndex, NetworkBody};
 use crate::skeleton::{
     BONE_COUNT, BodyPart, Bone, Joint, PerJoint, SubjectModel, segment_distance,
 };
@@ -147,6 +147,17 @@ pub struct AmbiguityWeights {
     /// tracker 80.6 → 80.5 (from the height 87.9 → 88.0); the real sample (balancing, no gait)
     /// unchanged; the per-frame solve 2009 → 1820 frames/s (the arms solved three times).
     pub gait_symmetry: f64,
+    /// The image's depth evidence: where the pose network saw the body (the tracks' `body3d`),
+    /// each bone pays the squared difference between its depth step (child minus parent, along
+    /// the camera's axis) and the network's, times the network's confidence in both ends. It
+    /// steers the choice and stays out of the reported cost. Measured in `docs/method.md`.
+    pub image_depth: f64,
+    /// The image's evidence for which way the body faces: how strongly the shoulders' depth
+    /// order against the network's (each frame's squared difference of the two depth steps,
+    /// times the network's confidence, summed over the clip) counts in the choice of the key
+    /// triangle's pose and facing, as one more part of the fit's sum of logarithms (0: not at
+    /// all). Measured in `docs/method.md`.
+    pub image_facing: f64,
 }
 
 impl Default for AmbiguityWeights {
@@ -168,6 +179,8 @@ impl Default for AmbiguityWeights {
             miss: 10.0,
             lookahead: 0.3,
             gait_symmetry: 0.3,
+            image_depth: IMAGE_DEPTH,
+            image_facing: IMAGE_FACING,
         }
     }
 }
@@ -194,6 +207,8 @@ impl AmbiguityWeights {
             miss,
             lookahead,
             gait_symmetry,
+            image_depth,
+            image_facing,
         } = *self;
         [
             ("ambiguity.trunk_up", trunk_up),
@@ -212,6 +227,8 @@ impl AmbiguityWeights {
             ("ambiguity.miss", miss),
             ("ambiguity.lookahead", lookahead),
             ("ambiguity.gait_symmetry", gait_symmetry),
+            ("ambiguity.image_depth", image_depth),
+            ("ambiguity.image_facing", image_facing),
         ]
         .into_iter()
         .try_for_each(|(name, value)| check_setting(name, value, false))
@@ -307,6 +324,51 @@ const TRUNK_DEPTH: f64 = 0.35;
 /// The radius of a thigh around its bone that [`AmbiguityWeights::contact`] keeps a wrist out
 /// of, as a share of the thigh's breadth (0.45 of the default subject's 0.16 m is 0.07 m).
 const THIGH_DEPTH: f64 = 0.45;
+
+/// [`AmbiguityWeights::image_depth`]'s default: chosen on the suite's dev split.
+const IMAGE_DEPTH: f64 = 1.0;
+
+/// [`AmbiguityWeights::image_facing`]'s default: chosen on the suite's dev split.
+const IMAGE_FACING: f64 = 1.0;
+
+/// [`AmbiguityWeights::image_facing`]'s cost of a key path (unweighted, squared metres): each
+/// frame's shoulders' depth step (left minus right) against the network's, squared, times
+/// the network's confidence in both shoulders; `None` without any network body.
+pub fn image_facing_cost(key: &[[Point3<f64>; 3]], bodies: &[Option<NetworkBody>]) -> Option<f64> {
+    let mut seen = false;
+    let cost = key
+        .iter()
+        .zip(bodies)
+        .filter_map(|(k, b)| Some((k, b.as_ref()?)))
+        .map(|(k, b)| {
+            seen = true;
+            let ours = k[0].z - k[1].z;
+            let net = b.points[LeftShoulder].z - b.points[RightShoulder].z;
+            let sure = f64::from(b.confidence[LeftShoulder].min(b.confidence[RightShoulder]));
+            sure * (ours - net).powi(2)
+        })
+        .sum();
+    seen.then_some(cost)
+}
+
+/// [`AmbiguityWeights::image_depth`]'s cost of a group's candidate placed in `p` (unweighted,
+/// squared metres): each bone's depth step against the network's (scaled to the bone's
+/// length), times the network's confidence in both its ends.
+fn image_depth_cost(group: &Group, p: &PerJoint<Point3<f64>>, body: &NetworkBody) -> f64 {
+    group
+        .bones
+        .iter()
+        .map(|bone| {
+            let (known, solved) = lift_order(*bone);
+            // The network's step at our bone's length (its body has its own proportions).
+            let ours = p[solved].z - p[known].z;
+            let theirs = body.points[solved] - body.points[known];
+            let net = theirs.z * (p[solved] - p[known]).norm() / theirs.norm().max(1e-6);
+            let sure = f64::from(body.confidence[known].min(body.confidence[solved]));
+            sure * (ours - net).powi(2)
+        })
+        .sum()
+}
 
 /// Forced root choices: `(frame index, bone) → root`, set by a user flipping a limb.
 pub type DepthOverrides = BTreeMap<(FrameIndex, Bone), Root>;
@@ -669,6 +731,7 @@ pub fn resolve(
     key: &[[Point3<f64>; 3]],
     rays: &[PerJoint<Vector3<f64>>],
     frame_index: &[FrameIndex],
+    bodies: &[Option<NetworkBody>],
     subject: &SubjectModel,
     weights: &AmbiguityWeights,
     overrides: &DepthOverrides,
@@ -688,6 +751,7 @@ pub fn resolve(
     let inputs = Inputs {
         rays,
         frame_index,
+        bodies,
         subject,
         weights,
         overrides,
@@ -730,6 +794,8 @@ pub fn resolve(
 struct Inputs<'a> {
     rays: &'a [PerJoint<Vector3<f64>>],
     frame_index: &'a [FrameIndex],
+    /// The network's 3D body per frame (empty, or `None` on a frame: no such evidence).
+    bodies: &'a [Option<NetworkBody>],
     subject: &'a SubjectModel,
     weights: &'a AmbiguityWeights,
     overrides: &'a DepthOverrides,
@@ -748,6 +814,7 @@ fn solve_group(
     let Inputs {
         rays,
         frame_index,
+        bodies,
         subject,
         weights,
         overrides,
@@ -796,6 +863,11 @@ fn solve_group(
                         }
                         if let Some(symmetry) = symmetry {
                             c.steer += weights.gait_symmetry * symmetry.cost(group, &p, t);
+                        }
+                        if let Some(Some(body)) = bodies.get(t)
+                            && weights.image_depth > 0.0
+                        {
+                            c.steer += weights.image_depth * image_depth_cost(group, &p, body);
                         }
                         c.unary += posture_cost(group, &p, &trunks[t], subject, weights) + c.steer;
                     }
@@ -1318,7 +1390,7 @@ mod tests {
                 arm_swing,
                 ..AmbiguityWeights::default()
             };
-            resolve(&key, &rays, &index, &subject, &w, overrides)
+            resolve(&key, &rays, &index, &[], &subject, &w, overrides)
         };
         // The frames whose elbow (the upper arm's root) is not where the body put it.
         let wrong = |r: &Resolved| -> Vec<(usize, Joint)> {
@@ -1383,7 +1455,15 @@ mod tests {
                 lookahead,
                 ..AmbiguityWeights::default()
             };
-            resolve(&key, &rays, &index, &subject, &w, &DepthOverrides::new())
+            resolve(
+                &key,
+                &rays,
+                &index,
+                &[],
+                &subject,
+                &w,
+                &DepthOverrides::new(),
+            )
         };
         let pelvis_wrong = |r: &Resolved| {
             (0..frames.len())
@@ -1438,5 +1518,75 @@ mod tests {
         frames[2][0].unary = f64::INFINITY;
         assert_eq!(viterbi(&frames).0[2], 1);
         assert_eq!(viterbi(&frames[..1]).0[0], 0);
+    }
+
+    /// The network's 3D body steers a bone to the root whose depth step it shares, in
+    /// proportion to its confidence: sure evidence for the other root on every frame turns the
+    /// forearm over; evidence at confidence 0 changes nothing.
+    #[test]
+    fn the_image_depth_evidence_turns_a_bone_it_is_sure_of() {
+        let subject = SubjectModel::default();
+        let frames = striding(
+            &subject,
+            10,
+            0.4,
+            Vector3::new(0.0, 0.0, 3.0),
+            |phase, s| {
+                let arm = Vector3::new(0.15 * s, -1.0, 0.1 * phase).normalize();
+                let forearm = Vector3::new(0.1 * s, -0.6, 0.7).normalize();
+                [arm, forearm, -Vector3::y(), -Vector3::y()]
+            },
+        );
+        let (key, rays, index) = seen(&frames);
+        let w = AmbiguityWeights::default();
+        let none = DepthOverrides::new();
+        let alone = resolve(&key, &rays, &index, &[], &subject, &w, &none);
+        let forearm = Bone::new(LeftElbow, LeftWrist);
+        // The network's body: the lift's own, but the forearm on its other root.
+        let other_body = |sure: f32| -> Vec<Option<NetworkBody>> {
+            (0..frames.len())
+                .map(|t| {
+                    let mut p = alone.points[t];
+                    let roots = bone_roots(
+                        &p[LeftElbow],
+                        &rays[t][LeftWrist],
+                        subject.bone_length(forearm),
+                    );
+                    let other = match alone.choices[t][forearm.index()] {
+                        Root::Near => Root::Far,
+                        Root::Far => Root::Near,
+                    };
+                    p.0[LeftWrist.index()] = roots.get(other);
+                    Some(NetworkBody {
+                        points: p.map(|_, q| q.coords),
+                        confidence: PerJoint([sure; crate::skeleton::JOINT_COUNT]),
+                    })
+                })
+                .collect()
+        };
+        let apart: Vec<usize> = (0..frames.len())
+            .filter(|&t| {
+                let r = bone_roots(
+                    &alone.points[t][LeftElbow],
+                    &rays[t][LeftWrist],
+                    subject.bone_length(forearm),
+                );
+                (r.get(Root::Near) - r.get(Root::Far)).norm() > 0.1
+            })
+            .collect();
+        assert!(apart.len() >= 8, "the roots differ on most frames");
+        let sure = resolve(&key, &rays, &index, &other_body(1.0), &subject, &w, &none);
+        let turned = apart
+            .iter()
+            .filter(|&&t| sure.choices[t][forearm.index()] != alone.choices[t][forearm.index()])
+            .count();
+        assert_eq!(turned, apart.len(), "sure evidence turns the forearm");
+        let unsure = resolve(&key, &rays, &index, &other_body(0.0), &subject, &w, &none);
+        assert_eq!(
+            unsure.choices, alone.choices,
+            "confidence 0 changes nothing"
+        );
+        // It steers and stays out of the reported cost.
+        assert_eq!(unsure.group_costs, alone.group_costs);
     }
 }

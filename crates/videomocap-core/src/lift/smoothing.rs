@@ -183,6 +183,7 @@ mod tests {
                 .enumerate()
                 .map(|(index, p)| FrameTracks {
                     index: FrameIndex(index),
+                    body3d: None,
                     points: PerJoint::from_fn(|_| TrackedPoint {
                         pos: p + Vector2::new(normal.sample(&mut rng), normal.sample(&mut rng)),
                         confidence: 1.0,

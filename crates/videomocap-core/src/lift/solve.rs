@@ -244,6 +244,11 @@ fn per_frame_solve(
     let images = smoothed_images(tracks, &sigma);
     let rays: Vec<_> = images.iter().map(|im| im.map(|_, p| cam.ray(p))).collect();
     let frame_index: Vec<FrameIndex> = tracks.frames.iter().map(|f| f.index).collect();
+    let bodies: Vec<_> = tracks
+        .frames
+        .iter()
+        .map(|f| f.body3d.as_deref().cloned())
+        .collect();
 
     // The calibration frame: the best-shaped key triangle, weighted by the trust in its points
     // and by its size in the image (a pixel of noise turns a small triangle further: with one
@@ -335,6 +340,7 @@ fn per_frame_solve(
                 key,
                 &rays,
                 &frame_index,
+                &bodies,
                 &job.subject,
                 &job.params.ambiguity,
                 &job.overrides,
@@ -342,7 +348,13 @@ fn per_frame_solve(
             let miss: f64 = (0..n)
                 .map(|t| miss_m(cam, &resolved.points[t], &images[t]))
                 .sum();
-            let score = fit_score(miss, &resolved.group_costs);
+            let mut score = fit_score(miss, &resolved.group_costs);
+            let facing_weight = job.params.ambiguity.image_facing;
+            if facing_weight > 0.0
+                && let Some(cost) = super::ambiguity::image_facing_cost(key, &bodies)
+            {
+                score += facing_weight * cost.max(FIT_FLOOR).ln();
+            }
             (resolved, score)
         };
         // The facing decided stretch by stretch over the whole clip (see `facing_by_segments`).

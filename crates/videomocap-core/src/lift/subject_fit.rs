@@ -747,6 +747,7 @@ mod tests {
                     * Rotation3::from_axis_angle(&Vector3::x_axis(), 0.1);
                 FrameTracks {
                     index: FrameIndex(t),
+                    body3d: None,
                     points: PerJoint::from_fn(|j| {
                         let q = r * body[j].coords;
                         let c = Point3::new(q.x, -q.y + 0.2, q.z + 4.0);

@@ -7,11 +7,13 @@
 
 use super::run::TrackError;
 use crate::camera::point_in_frame;
-use crate::formats::{FrameIndex, FrameTracks, KeyFrames, PointSource, TrackedPoint, Tracks2d};
+use crate::formats::{
+    FrameIndex, FrameTracks, KeyFrames, NetworkBody, PointSource, TrackedPoint, Tracks2d,
+};
 use crate::network::{Crop, NetJoint, PoseNetwork};
 use crate::skeleton::{Joint, PerJoint};
 use crate::video::Video;
-use nalgebra::Point2;
+use nalgebra::{Point2, Vector3};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// How the evidence is weighed. Costs are in the unit of one torso² of motion between frames.
@@ -58,6 +60,21 @@ pub struct NetFrame {
     pub joints: Option<PerJoint<NetJoint>>,
     /// The crop it proposes for the next frame.
     pub next: Option<Crop>,
+    /// Its 3D body (metres, origin between the hips, y down, z away from the camera; `None`:
+    /// no person, or a cache written before the body was kept).
+    #[serde(default)]
+    pub world: Option<PerJoint<Vector3<f64>>>,
+}
+
+impl NetFrame {
+    /// The network's 3D body on this frame with its joints' confidences, for the lift.
+    pub fn body(&self) -> Option<NetworkBody> {
+        let (joints, world) = (self.joints.as_ref()?, self.world?);
+        Some(NetworkBody {
+            points: world,
+            confidence: joints.map(|_, j| j.confidence as f32),
+        })
+    }
 }
 
 /// What the network saw on each frame of a clip, in order.
@@ -113,6 +130,7 @@ pub fn run_network(
                 NetFrame {
                     crop: Some(c),
                     next: pose.as_ref().and_then(|p| p.next_crop),
+                    world: pose.as_ref().map(|p| p.world),
                     joints: pose.map(|p| p.joints),
                 }
             }
@@ -120,6 +138,7 @@ pub fn run_network(
                 crop: None,
                 joints: None,
                 next: None,
+                world: None,
             },
         };
         next = frame.next;
@@ -194,6 +213,10 @@ pub fn weigh(
         })
         .collect();
     let mut out = tracks.clone();
+    // The network's 3D body goes with the tracks, evidence for the lift's depth order.
+    for (frame, seen) in out.frames.iter_mut().zip(net) {
+        frame.body3d = seen.body().map(Box::new);
+    }
     for j in Joint::ALL {
         let candidates: Vec<Vec<Candidate>> = (0..n)
             .map(|t| {
@@ -340,6 +363,7 @@ mod tests {
         let frames = (0..n)
             .map(|t| FrameTracks {
                 index: FrameIndex(t),
+                body3d: None,
                 points: PerJoint::from_fn(|j| TrackedPoint {
                     pos: match j {
                         Joint::Neck => Point2::new(100.0, 100.0),
@@ -371,6 +395,7 @@ mod tests {
             .iter()
             .map(|f| NetFrame {
                 crop: None,
+                world: None,
                 joints: Some(f.points.map(|_, p| NetJoint {
                     pos: p.pos,
                     confidence: 0.95,
@@ -425,7 +450,8 @@ mod tests {
             NetFrame {
                 crop: None,
                 joints: None,
-                next: None
+                next: None,
+                world: None,
             };
             20
         ];
@@ -448,7 +474,8 @@ mod tests {
             NetFrame {
                 crop: None,
                 joints: None,
-                next: None
+                next: None,
+                world: None,
             };
             12
         ];

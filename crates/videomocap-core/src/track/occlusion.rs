@@ -239,6 +239,7 @@ mod tests {
             .enumerate()
             .map(|(i, &c)| FrameTracks {
                 index: FrameIndex(i),
+                body3d: None,
                 points: PerJoint::from_fn(|_| TrackedPoint {
                     pos: Point2::new(i as f64 * 10.0 + if c < 0.5 { 100.0 } else { 0.0 }, 0.0),
                     confidence: c,

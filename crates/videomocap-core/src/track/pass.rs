@@ -232,6 +232,7 @@ impl PassContext<'_, '_> {
                 total,
                 frame: Some(FrameTracks {
                     index: FrameIndex(index),
+                    body3d: None,
                     points: r.map(|_, j| TrackedPoint {
                         pos: j.pos,
                         confidence: j.reliability,

@@ -484,6 +484,7 @@ fn track_at_working_scale(
         .enumerate()
         .map(|(index, r)| FrameTracks {
             index: FrameIndex(index),
+            body3d: None,
             points: r
                 .unwrap_or_else(|| {
                     first_pose.map(|_, p| JointResult {

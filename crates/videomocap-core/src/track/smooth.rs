@@ -111,6 +111,7 @@ mod tests {
             .enumerate()
             .map(|(index, &(x, confidence, source))| FrameTracks {
                 index: FrameIndex(index),
+                body3d: None,
                 points: PerJoint::from_fn(|_| TrackedPoint {
                     pos: Point2::new(x, 10.0),
                     confidence,

@@ -6,6 +6,7 @@
 
 pub mod correction;
 pub mod doubt;
+pub mod motion;
 pub mod pose3d;
 pub mod suite;
 pub mod volume;

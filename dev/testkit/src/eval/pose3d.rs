@@ -320,6 +320,7 @@ pub fn tracks_from_truth(gt: &GroundTruth, noise_px: f64, seed: u64) -> Tracks2d
                 let p = f.points2d();
                 FrameTracks {
                     index: FrameIndex(f.index),
+                    body3d: None,
                     points: PerJoint::from_fn(|j| TrackedPoint {
                         pos: Point2::new(p[j].x + jitter(), p[j].y + jitter()),
                         confidence: 1.0,
@@ -381,7 +382,15 @@ pub fn lift_on_reference_key(
         .map(|f| f.points2d().map(|_, p| camera.ray(p)))
         .collect();
     let index: Vec<FrameIndex> = gt.frames.iter().map(|f| FrameIndex(f.index)).collect();
-    let resolved = resolve(&key, &rays, &index, subject, weights, &Default::default());
+    let resolved = resolve(
+        &key,
+        &rays,
+        &index,
+        &[],
+        subject,
+        weights,
+        &Default::default(),
+    );
     Skeleton3d {
         camera,
         fps: Some(gt.fps),

@@ -1,0 +1,307 @@
+//! `videomocap bench lift --network`: the lift alone, the pose network's 3D body alone and the
+//! two together (the network's body as depth evidence in the lift's choice of roots), with the
+//! flat cut-out, on the same input and in the same run.
+//!
+//! Inputs: (a) the true 2D points, the network run on the clip's frames from the clicked marks
+//! (as the tracker runs it: each crop the one it proposed on the frame before); (c) unless
+//! `--no-tracker`, the tracker's output with the network weighed in (the product's default),
+//! which carries the network's body itself. Every lift from the height a person would state
+//! and the true focal length.
+
+use crate::args::{BenchArgs, GlobalArgs};
+use crate::bench_suite::{BenchClip, Merge, Tally, bench_clips};
+use crate::{ExitError, say};
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+use videomocap_core::formats::{Frame3d, Marks, Skeleton3d, Tracks2d};
+use videomocap_core::lift::{CameraChoice, LiftParams, SubjectChoice, reconstruct};
+use videomocap_core::network::PoseNetwork;
+use videomocap_core::skeleton::{Bone, DEFAULT_HEIGHT_M, Joint, PerJoint};
+use videomocap_core::track::{NetworkFrames, TrackJob, TrackerParams, run_network, track_video};
+use videomocap_core::video::{OpenOptions, Video};
+use videomocap_testkit::eval::pose3d::{Pose3dScore, cutout, score_skeleton, tracks_from_truth};
+use videomocap_testkit::eval::suite::{CLICK_NOISE_PX, clicked_marks};
+use videomocap_testkit::synth::GroundTruth;
+
+/// A bone's depth order counts when the reference's ends differ in depth by more than this,
+/// metres (as the probe counted it).
+const ORDER_SHOWS_M: f64 = 0.05;
+
+/// How often a 3D body puts a bone's ends in the reference's depth order, over the bone-frames
+/// where the reference's ends differ by more than [`ORDER_SHOWS_M`].
+#[derive(Debug, Clone, Copy, Default)]
+struct Agreement {
+    agree: usize,
+    total: usize,
+}
+
+impl Merge for Agreement {
+    fn merge_from(&mut self, o: &Self) {
+        self.agree += o.agree;
+        self.total += o.total;
+    }
+}
+
+impl Agreement {
+    fn share(&self) -> f64 {
+        self.agree as f64 / self.total.max(1) as f64
+    }
+
+    /// Adds a frame: `ours` against the reference's points (any origin: differences only).
+    fn add(&mut self, ours: &PerJoint<[f64; 3]>, truth: &PerJoint<[f64; 3]>) {
+        for b in Bone::ALL {
+            let dz = |p: &PerJoint<[f64; 3]>| p[b.child][2] - p[b.parent][2];
+            if dz(truth).abs() > ORDER_SHOWS_M {
+                self.total += 1;
+                self.agree += usize::from(dz(ours) * dz(truth) > 0.0);
+            }
+        }
+    }
+}
+
+/// One column's scores: the 3D error and the depth order's agreement.
+type Column = (Pose3dScore, Agreement);
+
+/// A clip's columns per input: cut-out, lift alone, network alone, then the lift together with
+/// the network at each weight; `None` where the input was not run.
+type Scores = [Vec<Column>; 2];
+
+const INPUT_NAMES: [&str; 2] = [
+    "(a) true 2D, network run from the clicked marks",
+    "(c) the tracker's output (with the network)",
+];
+
+fn agreement(gt: &GroundTruth, skeleton: &Skeleton3d) -> Agreement {
+    let mut a = Agreement::default();
+    for f in &skeleton.frames {
+        if let Some(t) = gt.frames.get(f.index.get()) {
+            let truth = t.points3d().map(|_, p| [p.x, p.y, p.z]);
+            a.add(&f.points.map(|_, p| [p.x, p.y, p.z]), &truth);
+        }
+    }
+    a
+}
+
+/// The network's 3D body as the answer: each frame's body at the reference pelvis (as the
+/// cut-out stands at its depth: scores are pelvis-aligned), the cut-out's frame where it saw
+/// no body.
+fn network_alone(gt: &GroundTruth, tracks: &Tracks2d, flat: &Skeleton3d) -> Skeleton3d {
+    let frames = tracks
+        .frames
+        .iter()
+        .zip(&flat.frames)
+        .map(|(f, cut)| match (&f.body3d, gt.frames.get(f.index.get())) {
+            (Some(body), Some(t)) => {
+                let pelvis = t.points3d()[Joint::Pelvis];
+                let origin = body.points[Joint::Pelvis];
+                Frame3d {
+                    index: f.index,
+                    points: body.points.map(|_, p| pelvis + (p - origin)),
+                    flags: Vec::new(),
+                }
+            }
+            _ => cut.clone(),
+        })
+        .collect();
+    Skeleton3d {
+        frames,
+        ..flat.clone()
+    }
+}
+
+/// `tracks` with the network's bodies taken off (the lift alone).
+fn without_bodies(tracks: &Tracks2d) -> Tracks2d {
+    let mut t = tracks.clone();
+    for f in &mut t.frames {
+        f.body3d = None;
+    }
+    t
+}
+
+/// The network's frames on the true 2D, cached in the clip's folder with `--reuse`.
+pub(crate) fn network_on_truth(
+    clip: &BenchClip,
+    video: &mut Video,
+    exact: &Tracks2d,
+    marks: &Marks,
+    network: &PoseNetwork,
+    reuse: bool,
+) -> Result<NetworkFrames, ExitError> {
+    let cache = clip.dir.join("lift-net.json");
+    if reuse
+        && let Ok(text) = std::fs::read_to_string(&cache)
+        && let Ok(net) = serde_json::from_str::<NetworkFrames>(&text)
+        && net.len() == exact.frames.len()
+    {
+        return Ok(net);
+    }
+    let keys = videomocap_core::track::KeyFrames::from_marks(marks);
+    let net = run_network(
+        video,
+        exact,
+        network,
+        &keys,
+        None,
+        &mut || {},
+        &AtomicBool::new(false),
+    )
+    .map_err(ExitError::failed)?;
+    if reuse {
+        let text = serde_json::to_string(&net).map_err(ExitError::failed)?;
+        std::fs::write(&cache, text).map_err(ExitError::failed)?;
+    }
+    Ok(net)
+}
+
+/// Scores one input of one clip: cut-out, lift alone, network alone, together per weight.
+fn score_input(
+    gt: &GroundTruth,
+    tracks: &Tracks2d,
+    params: &LiftParams,
+    weights: &[f64],
+) -> Result<Vec<Column>, ExitError> {
+    let camera = gt.camera();
+    let subject = SubjectChoice::Height {
+        height_m: gt.stated_height_m.unwrap_or(DEFAULT_HEIGHT_M),
+        known: Default::default(),
+    };
+    let lift = |tracks: &Tracks2d, params: &LiftParams| {
+        reconstruct(
+            tracks,
+            CameraChoice::Given(camera),
+            &subject,
+            params,
+            Default::default(),
+            &mut |_| {},
+            &AtomicBool::new(false),
+        )
+        .map(|r| r.output.skeleton)
+        .map_err(ExitError::failed)
+    };
+    let column = |s: &Skeleton3d| -> Result<Column, ExitError> {
+        Ok((
+            score_skeleton(gt, s).map_err(ExitError::failed)?,
+            agreement(gt, s),
+        ))
+    };
+    let flat = cutout(gt, tracks, camera);
+    let mut out = vec![
+        column(&flat)?,
+        column(&lift(&without_bodies(tracks), params)?)?,
+        column(&network_alone(gt, tracks, &flat))?,
+    ];
+    for &w in weights {
+        let mut p = *params;
+        p.ambiguity.image_depth = w;
+        out.push(column(&lift(tracks, &p)?)?);
+    }
+    Ok(out)
+}
+
+fn score_clip(
+    clip: &BenchClip,
+    network: &Arc<PoseNetwork>,
+    params: &LiftParams,
+    weights: &[f64],
+    a: &BenchArgs,
+    threads: usize,
+) -> Result<Scores, ExitError> {
+    let dir = &clip.dir;
+    let gt = GroundTruth::load(&dir.join("gt.json")).map_err(ExitError::failed)?;
+    let marks = clicked_marks(
+        &Marks::load(&dir.join("marks.json")).map_err(ExitError::failed)?,
+        CLICK_NOISE_PX,
+        &clip.name,
+    );
+    let mut video =
+        Video::open(&dir.join("video.mp4"), &OpenOptions::default()).map_err(ExitError::failed)?;
+    let mut exact = tracks_from_truth(&gt, 0.0, 1);
+    let net = network_on_truth(clip, &mut video, &exact, &marks, network, a.reuse)?;
+    for (f, seen) in exact.frames.iter_mut().zip(&net) {
+        f.body3d = seen.body().map(Box::new);
+    }
+    let mut scores: Scores = Default::default();
+    scores[0] = score_input(&gt, &exact, params, weights)?;
+    if !a.no_tracker {
+        let job = TrackJob::from_marks(&marks, TrackerParams::default(), threads)
+            .with_network(Some(network.clone()));
+        let tracked = track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false))
+            .map_err(ExitError::failed)?
+            .tracks;
+        scores[1] = score_input(&gt, &tracked, params, weights)?;
+    }
+    Ok(scores)
+}
+
+fn cell(c: Option<&Column>) -> String {
+    c.map_or_else(
+        || format!("{:>21}", "—"),
+        |(s, a)| {
+            format!(
+                "{:>6.1} {:>5.1} {:>4.0}% {:>3.0}%",
+                s.mpjpe_mm(),
+                s.pa_mpjpe_mm(),
+                100.0 * s.facing_mirrored_share(),
+                100.0 * a.share()
+            )
+        },
+    )
+}
+
+/// Runs the comparison and prints its tables.
+pub fn run(a: &BenchArgs, global: &GlobalArgs, weights: &[f64]) -> Result<(), ExitError> {
+    let threads = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1);
+    let params = match &a.lift_settings {
+        Some(p) => videomocap::cli::lift::load_settings(p)?,
+        None => LiftParams::default(),
+    };
+    let network = Arc::new(
+        PoseNetwork::bundled()
+            .map_err(ExitError::failed)?
+            .with_threads(threads),
+    );
+    let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;
+    let mut tally: Tally<Scores> = Tally::default();
+    let mut names = vec![
+        "cut-out".to_owned(),
+        "lift alone".to_owned(),
+        "network alone".to_owned(),
+    ];
+    names.extend(weights.iter().map(|w| format!("together ({w})")));
+    let mut per_clip = Vec::new();
+    for clip in &clips {
+        say(global, &format!("lifting {} with the network …", clip.name));
+        let s = score_clip(clip, &network, &params, weights, a, threads)?;
+        per_clip.push(format!(
+            "{:<26} {:<5} {}",
+            clip.name,
+            clip.split.name(),
+            s[0].iter()
+                .map(|c| format!("{:>7.1}", c.0.mpjpe_mm()))
+                .collect::<Vec<_>>()
+                .join(" ")
+        ));
+        tally.add(clip, &s);
+    }
+    let mut out = vec![
+        "lift alone / network alone / together (the network's 3D body as depth evidence), stated height, true focal: per column MPJPE, PA-MPJPE (mm), frames mirrored, bones in the reference's depth order (where its ends differ by > 5 cm)".to_owned(),
+    ];
+    for (i, input) in INPUT_NAMES.iter().enumerate() {
+        for (c, name) in names.iter().enumerate() {
+            out.push(String::new());
+            out.push(format!("{input}: {name}"));
+            let columns = format!("{:>6} {:>5} {:>5} {:>4}", "mm", "PA", "mirr", "ord");
+            out.extend(Tally::<Scores>::heading(21, &columns));
+            out.extend(tally.lines(21, |s: &Scores| cell(s[i].get(c))));
+        }
+    }
+    out.push(String::new());
+    out.push(format!("per clip, (a) MPJPE mm: {}", names.join(" | ")));
+    out.extend(per_clip);
+    for l in out {
+        println!("{l}");
+    }
+    Ok(())
+}
