@@ -16,7 +16,7 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use videomocap_core::camera::default_focal;
 use videomocap_core::formats::{Marks, Skeleton3d, Tracks2d};
-use videomocap_core::lift::{CameraChoice, LiftParams, SubjectChoice, reconstruct};
+use videomocap_core::lift::{CameraChoice, FEET, LiftParams, SubjectChoice, reconstruct};
 use videomocap_core::network::PoseNetwork;
 use videomocap_core::skeleton::DEFAULT_HEIGHT_M;
 use videomocap_core::track::{TrackJob, TrackerParams, track_video};
@@ -32,39 +32,85 @@ impl Merge for MotionScore {
     }
 }
 
-/// Per input, the lift's motion and the cut-out's.
-type Scores = [[MotionScore; 2]; 2];
+/// How far the foot lock moved the ankles in the image on the frames it held them, pixels.
+#[derive(Debug, Clone, Copy, Default)]
+struct LockShift {
+    sum_px: f64,
+    max_px: f64,
+    n: usize,
+}
+
+impl Merge for LockShift {
+    fn merge_from(&mut self, o: &Self) {
+        self.sum_px += o.sum_px;
+        self.max_px = self.max_px.max(o.max_px);
+        self.n += o.n;
+    }
+}
+
+/// Per input: the lift without the foot lock, with it, the cut-out; the lock's image shift.
+type Scores = [([MotionScore; 3], LockShift); 2];
 
 const INPUTS: [&str; 2] = [
     "(a) true 2D with the network's body",
     "(c) the tracker's output (with the network)",
 ];
 
-/// The lift (stated height, default camera) and the cut-out of one input.
-fn score_input(gt: &GroundTruth, tracks: &Tracks2d) -> Result<[MotionScore; 2], ExitError> {
+/// The lift (stated height, default camera) without and with the foot lock, and the cut-out,
+/// of one input.
+fn score_input(
+    gt: &GroundTruth,
+    tracks: &Tracks2d,
+) -> Result<([MotionScore; 3], LockShift), ExitError> {
     let mut camera = gt.camera();
     camera.focal_px = default_focal(gt.width, gt.height);
     let subject = SubjectChoice::Height {
         height_m: gt.stated_height_m.unwrap_or(DEFAULT_HEIGHT_M),
         known: Default::default(),
     };
-    let lifted: Skeleton3d = reconstruct(
-        tracks,
-        CameraChoice::Given(camera),
-        &subject,
-        &LiftParams::default(),
-        Default::default(),
-        &mut |_| {},
-        &AtomicBool::new(false),
-    )
-    .map_err(ExitError::failed)?
-    .output
-    .skeleton;
+    let lift = |foot_lock: bool| {
+        let params = LiftParams {
+            foot_lock,
+            ..LiftParams::default()
+        };
+        reconstruct(
+            tracks,
+            CameraChoice::Given(camera),
+            &subject,
+            &params,
+            Default::default(),
+            &mut |_| {},
+            &AtomicBool::new(false),
+        )
+        .map_err(ExitError::failed)
+        .map(|r| r.output)
+    };
+    let free = lift(false)?.skeleton;
+    let locked = lift(true)?;
+    let mut shift = LockShift::default();
+    for ((a, b), c) in free
+        .frames
+        .iter()
+        .zip(&locked.skeleton.frames)
+        .zip(&locked.contacts)
+    {
+        for (k, ankle) in FEET.iter().enumerate() {
+            if c[k]
+                && let (Some(p), Some(q)) = (
+                    camera.project(&a.points[*ankle]),
+                    camera.project(&b.points[*ankle]),
+                )
+            {
+                let d = (p - q).norm();
+                shift.sum_px += d;
+                shift.max_px = shift.max_px.max(d);
+                shift.n += 1;
+            }
+        }
+    }
     let flat = cutout(gt, tracks, gt.camera());
-    Ok([
-        score_motion(gt, &lifted).unwrap_or_default(),
-        score_motion(gt, &flat).unwrap_or_default(),
-    ])
+    let score = |s: &Skeleton3d| score_motion(gt, s).unwrap_or_default();
+    Ok(([score(&free), score(&locked.skeleton), score(&flat)], shift))
 }
 
 fn score_clip(
@@ -100,24 +146,28 @@ fn score_clip(
     Ok(scores)
 }
 
-const WIDTH: usize = 44;
+const WIDTH: usize = 55;
 
-fn cell(s: &[MotionScore; 2]) -> String {
-    if s[0].jitter_n == 0 {
+fn cell(s: &([MotionScore; 3], LockShift)) -> String {
+    let [free, locked, flat] = &s.0;
+    if free.jitter_n == 0 {
         return format!("{:>WIDTH$}", "—");
     }
-    let (j, rj) = s[0].jitter();
-    let (sl, rsl) = s[0].slide_cm();
-    let (cut_sl, _) = s[1].slide_cm();
+    let (_, rj) = free.jitter();
+    let (_, rsl) = free.slide_cm();
     format!(
-        "{:>5.0}/{:<4.0} {:>5.1}/{:<4.1} {:>5.1} {:>6.0} {:>6.1}",
-        j,
+        "{:>4.0}/{:<4.0} {:>4.1}>{:<4.1}/{:<3.1} {:>4.1} {:>4.0}>{:<4.0} {:>5.1} {:>3.1}/{:<4.1}",
+        locked.jitter().0,
         rj,
-        sl,
+        free.slide_cm().0,
+        locked.slide_cm().0,
         rsl,
-        cut_sl,
-        s[0].root_mm(),
-        s[0].accel()
+        flat.slide_cm().0,
+        free.root_mm(),
+        locked.root_mm(),
+        locked.accel(),
+        s.1.sum_px / s.1.n.max(1) as f64,
+        s.1.max_px
     )
 }
 
@@ -139,11 +189,11 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         tally.add(clip, &s);
     }
     let columns = format!(
-        "{:>10} {:>10} {:>5} {:>6} {:>6}",
-        "jitter/ref", "slide/ref", "cut", "root", "accel"
+        "{:>9} {:>14} {:>4} {:>9} {:>5} {:>8}",
+        "jitter/ref", "slide>lock/ref", "cut", "root>lock", "accel", "px m/max"
     );
     let mut out = vec![
-        "motion of the lift (stated height, default camera): jitter m/s³ (the reference's own after /), foot sliding cm per contact phase (the reference's own after /, the cut-out's), root path error mm (first frame aligned), acceleration error m/s²".to_owned(),
+        "motion of the lift (stated height, default camera): jitter m/s³ with the foot lock (the reference's own after /); foot sliding, cm per reference contact phase, without > with the lock (the reference's own after /), the cut-out's; root path error mm (first frame aligned) without > with; acceleration error m/s²; how far the lock moved a held ankle in the image, px mean / max".to_owned(),
     ];
     for (i, input) in INPUTS.iter().enumerate() {
         out.push(String::new());

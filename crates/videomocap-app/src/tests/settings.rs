@@ -123,8 +123,8 @@ fn each_tracker_switch_is_an_undoable_setting() {
     }
 }
 
-/// The lift's global refinement can be turned off from the Parameters panel: an undoable
-/// project setting, which the next lift uses.
+/// The lift's global refinement and the foot lock can be turned off from the Parameters
+/// panel: undoable project settings, which the next lift uses.
 #[test]
 fn the_global_refinement_is_switched_in_the_lift_settings() {
     let dir = tempfile::tempdir().unwrap();
@@ -138,6 +138,14 @@ fn the_global_refinement_is_switched_in_the_lift_settings() {
     assert!(!refine(&h));
     h.state_mut().state_mut().apply(Intent::Undo);
     assert!(refine(&h));
+    // The foot lock likewise (on by default, as in the exports).
+    let lock = |h: &Harness<'_, App>| h.state().state().project().unwrap().settings.lift.foot_lock;
+    assert!(lock(&h));
+    h.get_by_label("keep planted feet still").click();
+    h.run();
+    assert!(!lock(&h));
+    h.state_mut().state_mut().apply(Intent::Undo);
+    assert!(lock(&h));
 }
 
 /// A fixed smoothing width replaces the adaptive smoothing: its checkbox is greyed out

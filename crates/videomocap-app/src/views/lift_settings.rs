@@ -40,6 +40,13 @@ pub fn lift_settings_ui(ui: &mut egui::Ui, l: &mut LiftParams) {
              and turn); default {}",
             on_off(d.key_path_smoothing)
         ));
+    ui.checkbox(&mut l.foot_lock, "keep planted feet still")
+        .on_hover_text(format!(
+            "A foot found planted on the floor (slow in the image, not above the other foot) \
+             keeps one depth over its contact and the body follows, so the exported feet do not \
+             slide; default {}",
+            on_off(d.foot_lock)
+        ));
     let a = &mut l.ambiguity;
     ui.add(egui::Slider::new(&mut a.arm_swing, 0.0..=3.0).text("arm swing vs. legs"))
         .on_hover_text(format!(

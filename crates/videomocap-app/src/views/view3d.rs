@@ -236,14 +236,19 @@ impl Orbit {
             let at = rect.center() - galley.size() / 2.0;
             painter.galley(at, galley, Color32::GRAY);
         }
-        for (k, note) in scene.notes.iter().enumerate() {
-            painter.text(
-                rect.left_top() + Vec2::new(8.0, 8.0 + 16.0 * k as f32),
-                egui::Align2::LEFT_TOP,
-                note,
+        // Notes wrap to the view's width (a narrow 3D panel cut them off).
+        let mut y = 8.0;
+        for note in &scene.notes {
+            let colour = Color32::from_rgb(240, 170, 90);
+            let galley = painter.layout(
+                note.clone(),
                 egui::FontId::proportional(13.0),
-                Color32::from_rgb(240, 170, 90),
+                colour,
+                (rect.width() - 16.0).max(60.0),
             );
+            let height = galley.size().y;
+            painter.galley(rect.left_top() + Vec2::new(8.0, y), galley, colour);
+            y += height + 3.0;
         }
         clicked
     }

@@ -13,6 +13,8 @@
 //! `subject_fit` reads every length from the whole clip when only the subject's height (or
 //! some lengths) are known, and marks read lengths as uncertain: the lift solves those bones
 //! shorter, leaning towards lying square to their rays, and gives their lengths back after.
+//! Last, each foot's contacts with the floor are found and the body is moved in depth so that
+//! a planted foot stays put (`contact`).
 //! Its input is [`crate::formats::Tracks2d`], its output [`crate::formats::Skeleton3d`].
 //! Every front end runs it through [`reconstruct`] (`pipeline`): the camera, the subject's
 //! lengths, then the skeleton, reporting each [`LiftStage`] as it starts.
@@ -20,6 +22,7 @@
 mod ambiguity;
 mod backproject;
 mod calibrate;
+mod contact;
 mod error;
 mod focal;
 mod key_path;
@@ -37,6 +40,7 @@ pub use ambiguity::{AmbiguityWeights, DepthOverrides, lift_order, resolve};
 pub use backproject::Root;
 pub use backproject::bone_roots;
 pub use calibrate::{KEY_JOINTS, KeyTriangle};
+pub use contact::{FEET, FootContacts};
 pub use error::LiftError;
 pub use focal::{DEFAULT_FOV_LONG_SIDE_DEG, default_focal};
 pub use pipeline::{

@@ -62,6 +62,10 @@ pub struct LiftParams {
     pub ambiguity: AmbiguityWeights,
     /// Weights of the global refinement.
     pub refinement: RefineParams,
+    /// Hold a planted foot in place (default true): each foot's contacts with the floor are
+    /// found and the body is moved along the planted ankle's viewing ray so the ankle keeps one
+    /// depth over each (it stays on its 2D track).
+    pub foot_lock: bool,
 }
 
 impl Default for LiftParams {
@@ -75,6 +79,7 @@ impl Default for LiftParams {
             key_path_smoothing: true,
             ambiguity: AmbiguityWeights::default(),
             refinement: RefineParams::default(),
+            foot_lock: true,
         }
     }
 }
@@ -134,6 +139,9 @@ pub struct LiftOutput {
     pub calibration_frame: usize,
     /// What the refinement did, if it ran.
     pub refinement: Option<RefineSummary>,
+    /// Per frame, whether each foot (left, right) was found planted (all false with
+    /// `foot_lock` off).
+    pub contacts: super::contact::FootContacts,
 }
 
 impl LiftParams {
@@ -149,6 +157,7 @@ impl LiftParams {
             smoothing_s,
             adaptive_smoothing: _,
             key_path_smoothing: _,
+            foot_lock: _,
             ambiguity,
             refinement,
         } = *self;
@@ -842,6 +851,8 @@ fn lift_leaning(
     } else {
         (per_frame.clone(), None, per.reports)
     };
+    // Last, the feet: a planted foot holds its depth and the body follows.
+    let (final_skeleton, contacts) = plant(job, &per.images, final_skeleton);
     Ok(LiftOutput {
         skeleton: final_skeleton,
         per_frame,
@@ -862,7 +873,29 @@ fn lift_leaning(
         reports,
         calibration_frame: per.calibration_frame,
         refinement,
+        contacts,
     })
+}
+
+/// The lift's last stage ([`super::contact`]): each foot's contacts found on `skeleton`, and
+/// with `foot_lock` the body moved in depth so a planted foot stays put.
+fn plant(
+    job: &LiftJob<'_>,
+    images: &[PerJoint<Point2<f64>>],
+    mut skeleton: Skeleton3d,
+) -> (Skeleton3d, super::contact::FootContacts) {
+    let n = skeleton.frames.len();
+    if !job.params.foot_lock {
+        return (skeleton, vec![[false; 2]; n]);
+    }
+    let mut points: Vec<PerJoint<Point3<f64>>> = skeleton.frames.iter().map(|f| f.points).collect();
+    let fps = skeleton.fps.unwrap_or(30.0);
+    let contacts = super::contact::foot_contacts(&job.camera, images, &points, fps);
+    super::contact::plant_feet(&mut points, &contacts);
+    for (f, p) in skeleton.frames.iter_mut().zip(points) {
+        f.points = p;
+    }
+    (skeleton, contacts)
 }
 
 #[cfg(test)]

@@ -118,6 +118,11 @@ pub struct LiftOptions {
     /// video instead of the height.
     #[arg(long)]
     pub lengths: Option<PathBuf>,
+    /// Leave planted feet where the lift put them (by default a foot found planted on the
+    /// floor keeps one depth over its contact and the body follows; overrides the settings
+    /// file's `foot_lock`).
+    #[arg(long)]
+    pub no_foot_lock: bool,
 }
 
 /// `lift`.

@@ -217,6 +217,7 @@ fn run_row(a: &BatchArgs, row: &Row, threads: usize, quiet: &GlobalArgs) {
                 height_m: row.height_m,
                 lift_settings: row.lift_settings.clone(),
                 lengths: row.lengths.clone(),
+                no_foot_lock: false,
             };
             let (marks, keys) = match row.keys.as_deref() {
                 Some(k) if is_marks(k) => (Some(k), None),

@@ -36,10 +36,13 @@ pub fn check_options(o: &LiftOptions) -> Result<(LiftParams, KnownLengths), Exit
             "--height-m must be a person's height in metres (0.3 to 3), got {h}"
         )));
     }
-    let params = match &o.lift_settings {
+    let mut params = match &o.lift_settings {
         Some(p) => load_settings(p)?,
         None => LiftParams::default(),
     };
+    if o.no_foot_lock {
+        params.foot_lock = false;
+    }
     let known = match &o.lengths {
         Some(p) => KnownLengths::load(p).map_err(ExitError::bad_input)?,
         None => KnownLengths::default(),
