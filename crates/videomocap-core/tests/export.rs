@@ -9,7 +9,7 @@ use videomocap_core::camera::PinholeCamera;
 use videomocap_core::export::rig::{RIG, rig_index_of};
 use videomocap_core::export::{WorldSkeleton, bvh, skeleton_csv, trc};
 use videomocap_core::formats::FrameIndex;
-use videomocap_core::formats::{Frame3d, Skeleton3d};
+use videomocap_core::formats::{CONTACT_FLAG, Frame3d, Skeleton3d};
 use videomocap_core::skeleton::{Bone, Joint, PerJoint, SubjectModel};
 
 /// Camera-from-world for a camera at `centre` turned by `yaw` about world up and tilted down by
@@ -292,10 +292,26 @@ fn csv_and_trc_hold_every_joint_of_every_frame() {
         turn: 0.0,
         height: 1.7,
     };
-    let ws = WorldSkeleton::new(&to_camera(&frames_of(&m, 5), 0.0, 0.0), None).unwrap();
+    let mut skeleton = to_camera(&frames_of(&m, 5), 0.0, 0.0);
+    // A planted left foot on frame 1: a contact, not a problem.
+    skeleton.frames[1]
+        .flags
+        .push(format!("{CONTACT_FLAG}left_ankle"));
+    assert!(!skeleton.frames[1].flagged());
+    let ws = WorldSkeleton::new(&skeleton, None).unwrap();
     let csv = skeleton_csv(&ws);
     let lines: Vec<&str> = csv.lines().collect();
-    assert_eq!(lines[0], "frame,time_s,joint,x_m,y_m,z_m,off_frame,lost");
+    assert_eq!(
+        lines[0],
+        "frame,time_s,joint,x_m,y_m,z_m,off_frame,lost,contact"
+    );
+    let contact_rows: Vec<&str> = lines[1..]
+        .iter()
+        .filter(|l| l.ends_with(",1"))
+        .copied()
+        .collect();
+    assert_eq!(contact_rows.len(), 1, "{contact_rows:?}");
+    assert!(contact_rows[0].starts_with("1,") && contact_rows[0].contains(",left_ankle,"));
     assert_eq!(lines.len(), 1 + 5 * 16);
     let row: Vec<&str> = lines[1 + 16 * 2 + 3].split(',').collect();
     assert_eq!(row[0], "2");

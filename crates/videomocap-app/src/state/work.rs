@@ -274,11 +274,7 @@ impl State {
                 }
                 self.subject_fit = fit;
                 let skeleton = Arc::new(out.skeleton);
-                let flagged = skeleton
-                    .frames
-                    .iter()
-                    .filter(|f| !f.flags.is_empty())
-                    .count();
+                let flagged = skeleton.frames.iter().filter(|f| f.flagged()).count();
                 self.choices.push(LiftChoices {
                     skeleton: skeleton.clone(),
                     bones: out.bones,

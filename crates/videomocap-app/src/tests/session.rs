@@ -290,6 +290,31 @@ fn mark_drag_undo_track_scrub_orbit_export_and_recover() {
             .len(),
         60
     );
+    // A walk plants its feet: the lift held them (contact flags, drawn on the timeline) and
+    // a contact is not a problem (the status's flagged count leaves them out).
+    let skeleton = h
+        .state()
+        .state()
+        .project()
+        .unwrap()
+        .skeleton
+        .clone()
+        .unwrap();
+    let planted = skeleton
+        .frames
+        .iter()
+        .filter(|f| f.flags.iter().any(|g| g.starts_with("contact:")))
+        .count();
+    assert!(planted >= 10, "{planted} frames with a planted foot");
+    let flagged = skeleton.frames.iter().filter(|f| f.flagged()).count();
+    assert!(
+        h.state()
+            .state()
+            .status()
+            .contains(&format!("({flagged} frames flagged)")),
+        "{}",
+        h.state().state().status()
+    );
     // The Parameters panel has the lengths the lift used and where each came from (on hover
     // of its one line: the tooltip is not in the accessibility tree), and the weak list below
     // has not moved.

@@ -7,8 +7,8 @@ use super::frame_view::PointState;
 use crate::intent::Intent;
 use crate::state::State;
 use egui::{Color32, Rect, Sense, Stroke, Vec2};
-use videomocap_core::formats::{FrameIndex, Tracks2d};
-use videomocap_core::skeleton::{JOINT_COUNT, Joint};
+use videomocap_core::formats::{CONTACT_FLAG, FrameIndex, Tracks2d};
+use videomocap_core::skeleton::{JOINT_COUNT, Joint, PerJoint};
 use videomocap_core::track::KeyFrames;
 
 /// Width of the joint names left of the strips, points.
@@ -90,11 +90,27 @@ pub fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
         .map(|(_, s)| {
             s.frames
                 .iter()
-                .filter(|f| !f.flags.is_empty())
+                .filter(|f| f.flagged())
                 .map(|f| f.index.get())
                 .collect()
         })
         .unwrap_or_default();
+    // The frames where the lift held each ankle planted (drawn under the ankles' strips).
+    let planted: Vec<(usize, PerJoint<bool>)> = state
+        .shown_world()
+        .map(|(_, s)| {
+            s.frames
+                .iter()
+                .map(|f| (f.index.get(), f.joint_flags(CONTACT_FLAG)))
+                .filter(|(_, c)| c.0.iter().any(|&b| b))
+                .collect()
+        })
+        .unwrap_or_default();
+    let planted_at = |f: usize, j: Joint| {
+        planted
+            .binary_search_by_key(&f, |(k, _)| *k)
+            .is_ok_and(|i| planted[i].1[j])
+    };
     // The strips below line up with the slider's rail: frame k is under the slider's handle
     // at k (egui keeps the handle's centre a radius inside the rail's ends).
     let (rail_left, rail_right) = ui
@@ -154,6 +170,17 @@ pub fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
             );
             painter.rect_filled(r, 0.0, point.colour());
         }
+        // A planted foot: a dark bar along the bottom of its ankle's strip.
+        for (f, _) in planted.iter().filter(|(_, c)| c[j]) {
+            let r = Rect::from_min_max(
+                egui::pos2(x_of(*f as f32 - 0.5), top + STRIP_H - 4.0),
+                egui::pos2(
+                    x_of(*f as f32 + 0.5).max(x_of(*f as f32 - 0.5) + 1.0),
+                    top + STRIP_H - 1.0,
+                ),
+            );
+            painter.rect_filled(r, 0.0, Color32::from_rgb(20, 40, 90));
+        }
     }
     let tick = |f: usize, row: f32, colour: Color32| {
         let x = x_of(f as f32);
@@ -199,9 +226,14 @@ pub fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
             let point = joint.and_then(|j| state.strips()?.state_at(j, f));
             match (joint, point) {
                 (Some(j), Some(p)) => format!(
-                    "{} · frame {f} · {}",
+                    "{} · frame {f} · {}{}",
                     super::marking::joint_words(j),
-                    p.word()
+                    p.word(),
+                    if planted_at(f, j) {
+                        " · planted: the foot is held still (dark bar)"
+                    } else {
+                        ""
+                    }
                 ),
                 (Some(j), None) => format!(
                     "{} · frame {f} · not tracked yet",
@@ -221,7 +253,6 @@ mod tests {
     use super::*;
     use nalgebra::Point2;
     use videomocap_core::formats::{FrameTracks, PointSource, SourceInfo, TrackedPoint};
-    use videomocap_core::skeleton::PerJoint;
 
     #[test]
     fn strips_keep_each_state_and_say_which_at_a_frame() {

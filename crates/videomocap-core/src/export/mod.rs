@@ -18,7 +18,7 @@ pub use tables::{skeleton_csv, tracks_csv, trc};
 pub use world::{UpSource, WorldFrame};
 
 use crate::formats::{
-    FormatError, FrameIndex, LOST_FLAG, OFF_FRAME_FLAG, Skeleton3d, write_atomically,
+    CONTACT_FLAG, FormatError, FrameIndex, LOST_FLAG, OFF_FRAME_FLAG, Skeleton3d, write_atomically,
 };
 use crate::skeleton::{Joint, PerJoint};
 use nalgebra::Point3;
@@ -66,6 +66,8 @@ pub struct WorldSkeleton {
     /// Per frame, the joints whose 2D track was lost (from the `lost:` flags): guesses,
     /// handled like `off_frame`.
     pub lost: Vec<PerJoint<bool>>,
+    /// Per frame, the ankles the lift found planted on the floor (from the `contact:` flags).
+    pub contact: Vec<PerJoint<bool>>,
 }
 
 impl WorldSkeleton {
@@ -96,6 +98,11 @@ impl WorldSkeleton {
                 .frames
                 .iter()
                 .map(|f| f.joint_flags(LOST_FLAG))
+                .collect(),
+            contact: skeleton
+                .frames
+                .iter()
+                .map(|f| f.joint_flags(CONTACT_FLAG))
                 .collect(),
         })
     }

@@ -50,9 +50,9 @@ pub fn tracks_csv(tracks: &Tracks2d) -> String {
     finish(w)
 }
 
-/// 3D CSV: `frame,time_s,joint,x_m,y_m,z_m,off_frame,lost` in the exports' Y-up world
+/// 3D CSV: `frame,time_s,joint,x_m,y_m,z_m,off_frame,lost,contact` in the exports' Y-up world
 /// (metres); `off_frame` or `lost` is 1 where the joint's 2D track was off the frame or lost
-/// (an estimate).
+/// (an estimate); `contact` is 1 on an ankle the lift found planted on the floor.
 pub fn skeleton_csv(skeleton: &WorldSkeleton) -> String {
     let mut w = csv::Writer::from_writer(Vec::new());
     let _ = w.write_record([
@@ -64,6 +64,7 @@ pub fn skeleton_csv(skeleton: &WorldSkeleton) -> String {
         "z_m",
         "off_frame",
         "lost",
+        "contact",
     ]);
     let flag = |b: bool| if b { "1" } else { "0" }.to_owned();
     for (k, p) in skeleton.frames.iter().enumerate() {
@@ -77,6 +78,7 @@ pub fn skeleton_csv(skeleton: &WorldSkeleton) -> String {
                 format!("{:.5}", p[j].z),
                 flag(skeleton.off_frame[k][j]),
                 flag(skeleton.lost[k][j]),
+                flag(skeleton.contact[k][j]),
             ]);
         }
     }

@@ -17,7 +17,9 @@ pub(crate) use keys::KeyEntry;
 pub use keys::{KEYS_FORMAT, KeyFrames};
 pub use lengths::{KnownLengths, LENGTH_RANGE_M, LENGTHS_FORMAT, SHOULDER_WIDTH_KEY, TapeLengths};
 pub use marks::{MARKS_FORMAT, Marks};
-pub use skeleton3d::{Frame3d, LOST_FLAG, OFF_FRAME_FLAG, SKELETON3D_FORMAT, Skeleton3d};
+pub use skeleton3d::{
+    CONTACT_FLAG, Frame3d, LOST_FLAG, OFF_FRAME_FLAG, SKELETON3D_FORMAT, Skeleton3d,
+};
 pub use tracks2d::{
     FrameTracks, NetworkBody, PointSource, SourceInfo, TRACKS2D_FORMAT, TRACKS2D_VERSION,
     TrackedPoint, Tracks2d,

@@ -23,6 +23,11 @@ pub const OFF_FRAME_FLAG: &str = "off_frame:";
 /// long to interpolate, `lost:left_wrist`): its 3D position rests on the tracker's guess.
 pub const LOST_FLAG: &str = "lost:";
 
+/// The prefix of the frame flag that marks a planted foot (`contact:left_ankle`): the lift
+/// found the foot on the floor there and held it still. A state, not a problem: not counted
+/// by [`Frame3d::flagged`].
+pub const CONTACT_FLAG: &str = "contact:";
+
 /// The 16 joints of one frame in camera space.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Frame3d {
@@ -50,6 +55,12 @@ pub struct Skeleton3d {
 }
 
 impl Frame3d {
+    /// Whether the reconstruction noticed something on this frame (any flag but a foot's
+    /// contact).
+    pub fn flagged(&self) -> bool {
+        self.flags.iter().any(|f| !f.starts_with(CONTACT_FLAG))
+    }
+
     /// Per joint, whether the frame has the flag `<prefix><joint>` (e.g. [`OFF_FRAME_FLAG`]).
     pub fn joint_flags(&self, prefix: &str) -> PerJoint<bool> {
         let mut out = PerJoint::from_fn(|_| false);

@@ -892,8 +892,14 @@ fn plant(
     let fps = skeleton.fps.unwrap_or(30.0);
     let contacts = super::contact::foot_contacts(&job.camera, images, &points, fps);
     super::contact::plant_feet(&mut points, &contacts);
-    for (f, p) in skeleton.frames.iter_mut().zip(points) {
+    for ((f, p), c) in skeleton.frames.iter_mut().zip(points).zip(&contacts) {
         f.points = p;
+        for (k, ankle) in super::contact::FEET.iter().enumerate() {
+            if c[k] {
+                f.flags
+                    .push(format!("{}{}", crate::formats::CONTACT_FLAG, ankle.name()));
+            }
+        }
     }
     (skeleton, contacts)
 }
