@@ -17,11 +17,10 @@ use std::collections::BTreeSet;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 use videomocap_core::formats::FrameIndex;
-use videomocap_core::formats::{Marks, Tracks2d};
+use videomocap_core::formats::Tracks2d;
 use videomocap_core::track::{KeyFrames, TrackJob, TrackProgress, TrackerParams, track_video};
 use videomocap_core::video::{OpenOptions, Video};
 use videomocap_testkit::eval::correction::next_correction;
-use videomocap_testkit::eval::suite::{CLICK_NOISE_PX, clicked_marks};
 use videomocap_testkit::eval::{Accuracy, score_positions, score_tracks};
 use videomocap_testkit::synth::GroundTruth;
 
@@ -57,15 +56,11 @@ fn correct_clip(
     params: TrackerParams,
     network: Option<std::sync::Arc<videomocap_core::network::PoseNetwork>>,
 ) -> Result<Rounds, ExitError> {
-    let dir = &clip.dir;
-    let gt = GroundTruth::load(&dir.join("gt.json")).map_err(ExitError::failed)?;
-    let marks = clicked_marks(
-        &Marks::load(&dir.join("marks.json")).map_err(ExitError::failed)?,
-        CLICK_NOISE_PX,
-        &clip.name,
-    );
-    let mut video =
-        Video::open(&dir.join("video.mp4"), &OpenOptions::default()).map_err(ExitError::failed)?;
+    let crate::bench_suite::OpenedClip {
+        gt,
+        marks,
+        mut video,
+    } = clip.open()?;
     let first = track_video(
         &mut video,
         &TrackJob::from_marks(&marks, params, threads).with_network(network.clone()),
@@ -122,7 +117,7 @@ fn correct_clip(
         // Timed as the app re-tracks: the job opens the video, reuses the background of the
         // first run, and draws frames as they arrive.
         let started = Instant::now();
-        let mut video = Video::open(&dir.join("video.mp4"), &OpenOptions::default())
+        let mut video = Video::open(&clip.dir.join("video.mp4"), &OpenOptions::default())
             .map_err(ExitError::failed)?;
         let mut arrived_s = None;
         let mut on_progress = |p: &TrackProgress| {

@@ -11,25 +11,24 @@
 //! [`videomocap_testkit::eval::pose3d`], after the global refinement; then the per-frame solve's speed.
 
 use crate::args::{BenchArgs, GlobalArgs};
-use crate::bench_suite::{BenchClip, Merge, Tally, bench_clips};
+use crate::bench_suite::{BenchClip, Merge, OpenedClip, Tally, bench_clips};
 use crate::bench_track::track_opened;
 use crate::{ExitError, say};
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 use videomocap_core::camera::default_focal;
-use videomocap_core::formats::{Marks, Tracks2d};
+use videomocap_core::formats::Tracks2d;
 
 use videomocap_core::lift::{
     CameraChoice, LiftJob, LiftParams, SubjectChoice, lift_per_frame, reconstruct,
 };
 use videomocap_core::skeleton::{Bone, DEFAULT_HEIGHT_M};
 use videomocap_core::track::TrackerParams;
-use videomocap_core::video::{OpenOptions, Video};
 use videomocap_testkit::eval::doubt::{DoubtTally, UNSURE_SWEEP, tally_doubt};
 use videomocap_testkit::eval::pose3d::{
     Pose3dScore, cutout, score_skeleton, subject_from_truth, tracks_from_truth,
 };
-use videomocap_testkit::eval::suite::{CLICK_NOISE_PX, Split, clicked_marks};
+use videomocap_testkit::eval::suite::Split;
 use videomocap_testkit::synth::GroundTruth;
 
 /// The seeds of the noise draws of (b).
@@ -133,15 +132,11 @@ fn run_clip(
     params: &LiftParams,
     with_tracker: bool,
 ) -> Result<(Cases, usize, f64, f64), ExitError> {
-    let dir = &clip.dir;
-    let gt = GroundTruth::load(&dir.join("gt.json")).map_err(ExitError::failed)?;
-    let marks = clicked_marks(
-        &Marks::load(&dir.join("marks.json")).map_err(ExitError::failed)?,
-        CLICK_NOISE_PX,
-        &clip.name,
-    );
-    let mut video =
-        Video::open(&dir.join("video.mp4"), &OpenOptions::default()).map_err(ExitError::failed)?;
+    let OpenedClip {
+        gt,
+        marks,
+        mut video,
+    } = clip.open()?;
     let mut inputs: Vec<(usize, Tracks2d)> = vec![(0, tracks_from_truth(&gt, 0.0, 1))];
     inputs.extend(NOISE_SEEDS.map(|seed| (1, tracks_from_truth(&gt, 2.0, seed))));
     if with_tracker {

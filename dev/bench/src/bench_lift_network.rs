@@ -9,7 +9,7 @@
 //! and the true focal length.
 
 use crate::args::{BenchArgs, GlobalArgs};
-use crate::bench_suite::{BenchClip, Merge, Tally, bench_clips};
+use crate::bench_suite::{BenchClip, Merge, OpenedClip, Tally, bench_clips};
 use crate::{ExitError, say};
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
@@ -18,9 +18,8 @@ use videomocap_core::lift::{CameraChoice, LiftParams, SubjectChoice, reconstruct
 use videomocap_core::network::PoseNetwork;
 use videomocap_core::skeleton::{Bone, DEFAULT_HEIGHT_M, Joint, PerJoint};
 use videomocap_core::track::{NetworkFrames, TrackJob, TrackerParams, run_network, track_video};
-use videomocap_core::video::{OpenOptions, Video};
+use videomocap_core::video::Video;
 use videomocap_testkit::eval::pose3d::{Pose3dScore, cutout, score_skeleton, tracks_from_truth};
-use videomocap_testkit::eval::suite::{CLICK_NOISE_PX, clicked_marks};
 use videomocap_testkit::synth::GroundTruth;
 
 /// A bone's depth order counts when the reference's ends differ in depth by more than this,
@@ -198,6 +197,44 @@ fn score_input(
     Ok(out)
 }
 
+/// The clip's true 2D carrying the network's body (run from the clicked marks as the tracker
+/// runs it), and, unless `--no-tracker`, the tracker's output with the network.
+pub(crate) fn inputs_with_network(
+    clip: &BenchClip,
+    opened: &mut OpenedClip,
+    network: &Arc<PoseNetwork>,
+    a: &BenchArgs,
+    threads: usize,
+) -> Result<(Tracks2d, Option<Tracks2d>), ExitError> {
+    let mut exact = tracks_from_truth(&opened.gt, 0.0, 1);
+    let net = network_on_truth(
+        clip,
+        &mut opened.video,
+        &exact,
+        &opened.marks,
+        network,
+        a.reuse,
+    )?;
+    for (f, seen) in exact.frames.iter_mut().zip(&net) {
+        f.body3d = seen.body().map(Box::new);
+    }
+    let tracked = if a.no_tracker {
+        None
+    } else {
+        let job = TrackJob::from_marks(&opened.marks, TrackerParams::default(), threads)
+            .with_network(Some(network.clone()));
+        let out = track_video(
+            &mut opened.video,
+            &job,
+            &mut |_| {},
+            &AtomicBool::new(false),
+        )
+        .map_err(ExitError::failed)?;
+        Some(out.tracks)
+    };
+    Ok((exact, tracked))
+}
+
 fn score_clip(
     clip: &BenchClip,
     network: &Arc<PoseNetwork>,
@@ -206,29 +243,13 @@ fn score_clip(
     a: &BenchArgs,
     threads: usize,
 ) -> Result<Scores, ExitError> {
-    let dir = &clip.dir;
-    let gt = GroundTruth::load(&dir.join("gt.json")).map_err(ExitError::failed)?;
-    let marks = clicked_marks(
-        &Marks::load(&dir.join("marks.json")).map_err(ExitError::failed)?,
-        CLICK_NOISE_PX,
-        &clip.name,
-    );
-    let mut video =
-        Video::open(&dir.join("video.mp4"), &OpenOptions::default()).map_err(ExitError::failed)?;
-    let mut exact = tracks_from_truth(&gt, 0.0, 1);
-    let net = network_on_truth(clip, &mut video, &exact, &marks, network, a.reuse)?;
-    for (f, seen) in exact.frames.iter_mut().zip(&net) {
-        f.body3d = seen.body().map(Box::new);
-    }
+    let mut opened = clip.open()?;
+    let (exact, tracked) = inputs_with_network(clip, &mut opened, network, a, threads)?;
+    let gt = &opened.gt;
     let mut scores: Scores = Default::default();
-    scores[0] = score_input(&gt, &exact, params, weights)?;
-    if !a.no_tracker {
-        let job = TrackJob::from_marks(&marks, TrackerParams::default(), threads)
-            .with_network(Some(network.clone()));
-        let tracked = track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false))
-            .map_err(ExitError::failed)?
-            .tracks;
-        scores[1] = score_input(&gt, &tracked, params, weights)?;
+    scores[0] = score_input(gt, &exact, params, weights)?;
+    if let Some(tracked) = tracked {
+        scores[1] = score_input(gt, &tracked, params, weights)?;
     }
     Ok(scores)
 }

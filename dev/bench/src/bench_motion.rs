@@ -9,21 +9,18 @@
 //! person would state and the default camera.
 
 use crate::args::{BenchArgs, GlobalArgs};
-use crate::bench_lift_network::network_on_truth;
+use crate::bench_lift_network::inputs_with_network;
 use crate::bench_suite::{BenchClip, Merge, Tally, bench_clips};
 use crate::{ExitError, say};
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use videomocap_core::camera::default_focal;
-use videomocap_core::formats::{Marks, Skeleton3d, Tracks2d};
+use videomocap_core::formats::{Skeleton3d, Tracks2d};
 use videomocap_core::lift::{CameraChoice, FEET, LiftParams, SubjectChoice, reconstruct};
 use videomocap_core::network::PoseNetwork;
 use videomocap_core::skeleton::DEFAULT_HEIGHT_M;
-use videomocap_core::track::{TrackJob, TrackerParams, track_video};
-use videomocap_core::video::{OpenOptions, Video};
 use videomocap_testkit::eval::motion::{MotionScore, score_motion};
-use videomocap_testkit::eval::pose3d::{cutout, tracks_from_truth};
-use videomocap_testkit::eval::suite::{CLICK_NOISE_PX, clicked_marks};
+use videomocap_testkit::eval::pose3d::cutout;
 use videomocap_testkit::synth::GroundTruth;
 
 impl Merge for MotionScore {
@@ -119,29 +116,13 @@ fn score_clip(
     a: &BenchArgs,
     threads: usize,
 ) -> Result<Scores, ExitError> {
-    let dir = &clip.dir;
-    let gt = GroundTruth::load(&dir.join("gt.json")).map_err(ExitError::failed)?;
-    let marks = clicked_marks(
-        &Marks::load(&dir.join("marks.json")).map_err(ExitError::failed)?,
-        CLICK_NOISE_PX,
-        &clip.name,
-    );
-    let mut video =
-        Video::open(&dir.join("video.mp4"), &OpenOptions::default()).map_err(ExitError::failed)?;
-    let mut exact = tracks_from_truth(&gt, 0.0, 1);
-    let net = network_on_truth(clip, &mut video, &exact, &marks, network, a.reuse)?;
-    for (f, seen) in exact.frames.iter_mut().zip(&net) {
-        f.body3d = seen.body().map(Box::new);
-    }
+    let mut opened = clip.open()?;
+    let (exact, tracked) = inputs_with_network(clip, &mut opened, network, a, threads)?;
+    let gt = &opened.gt;
     let mut scores = Scores::default();
-    scores[0] = score_input(&gt, &exact)?;
-    if !a.no_tracker {
-        let job = TrackJob::from_marks(&marks, TrackerParams::default(), threads)
-            .with_network(Some(network.clone()));
-        let tracked = track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false))
-            .map_err(ExitError::failed)?
-            .tracks;
-        scores[1] = score_input(&gt, &tracked)?;
+    scores[0] = score_input(gt, &exact)?;
+    if let Some(tracked) = tracked {
+        scores[1] = score_input(gt, &tracked)?;
     }
     Ok(scores)
 }

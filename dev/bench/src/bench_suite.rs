@@ -5,7 +5,9 @@ use crate::args::GlobalArgs;
 use crate::{ExitError, say};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use videomocap_testkit::eval::suite::{Family, REAL_CLIPS, Split, Suite};
+use videomocap_testkit::eval::suite::{
+    CLICK_NOISE_PX, Family, REAL_CLIPS, Split, Suite, clicked_marks,
+};
 use videomocap_testkit::repo_root;
 
 /// One clip a benchmark scores.
@@ -19,6 +21,35 @@ pub struct BenchClip {
     pub split: Split,
     /// Its folder (video.mp4, gt.json, marks.json).
     pub dir: PathBuf,
+}
+
+/// A clip opened for scoring: its reference, the marks as a user clicks them, and its video.
+pub struct OpenedClip {
+    /// The reference (gt.json).
+    pub gt: videomocap_testkit::synth::GroundTruth,
+    /// The marks with [`CLICK_NOISE_PX`] of clicking noise.
+    pub marks: videomocap_core::formats::Marks,
+    /// The clip's video.
+    pub video: videomocap_core::video::Video,
+}
+
+impl BenchClip {
+    /// Opens the clip's reference, clicked marks and video.
+    pub fn open(&self) -> Result<OpenedClip, ExitError> {
+        use videomocap_core::formats::Marks;
+        use videomocap_core::video::{OpenOptions, Video};
+        let dir = &self.dir;
+        let gt = videomocap_testkit::synth::GroundTruth::load(&dir.join("gt.json"))
+            .map_err(ExitError::failed)?;
+        let marks = clicked_marks(
+            &Marks::load(&dir.join("marks.json")).map_err(ExitError::failed)?,
+            CLICK_NOISE_PX,
+            &self.name,
+        );
+        let video = Video::open(&dir.join("video.mp4"), &OpenOptions::default())
+            .map_err(ExitError::failed)?;
+        Ok(OpenedClip { gt, marks, video })
+    }
 }
 
 /// `--split`: all (`None`), dev or test.
