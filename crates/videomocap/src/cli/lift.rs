@@ -116,8 +116,8 @@ pub fn lift_with_progress(
     Ok(done.output)
 }
 
-/// Prints what the lift found.
-pub fn report(out: &LiftOutput, global: &GlobalArgs) {
+/// Prints what the lift found (`foot_lock`: whether the lift was asked to hold planted feet).
+pub fn report(out: &LiftOutput, foot_lock: bool, global: &GlobalArgs) {
     let n = out.reports.len();
     let count = |pred: &dyn Fn(&FrameFlag) -> bool| {
         out.reports
@@ -149,6 +149,27 @@ pub fn report(out: &LiftOutput, global: &GlobalArgs) {
             ),
         );
     }
+    if foot_lock {
+        say(global, &feet_report(&out.contacts));
+    } else {
+        say(global, "planted feet: left as lifted (--no-foot-lock)");
+    }
+}
+
+/// What the foot lock did, in a line: the frames each foot was held planted, or that no
+/// planted foot was found (the feet never seen still on the floor: a jump, a swim, feet out of
+/// the picture) and nothing was held.
+fn feet_report(contacts: &[[bool; 2]]) -> String {
+    let held = |k: usize| contacts.iter().filter(|c| c[k]).count();
+    let (left, right) = (held(0), held(1));
+    if left + right == 0 {
+        "planted feet: none found (no foot seen still on the floor), nothing held".to_owned()
+    } else {
+        format!(
+            "planted feet held still: left on {left} frames, right on {right} (--no-foot-lock \
+             leaves them as lifted)"
+        )
+    }
 }
 
 /// `lift`.
@@ -157,7 +178,7 @@ pub fn run(a: &LiftArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let tracks = Tracks2d::load(&a.tracks).map_err(ExitError::bad_input)?;
     let out = lift_with_progress(&tracks, &a.tracks, &a.options, params, &known, global)?;
     out.skeleton.save(&a.output).map_err(ExitError::failed)?;
-    report(&out, global);
+    report(&out, params.foot_lock, global);
     say(global, &format!("wrote {}", a.output.display()));
     if let Some(bvh) = &a.bvh {
         let outputs = super::export::Outputs3d {
@@ -168,4 +189,16 @@ pub fn run(a: &LiftArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         super::export::report_3d(&written, global);
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_feet_line_says_when_nothing_was_held() {
+        assert!(feet_report(&[[false; 2]; 5]).contains("none found"));
+        let line = feet_report(&[[true, false], [true, true], [false, false]]);
+        assert!(line.contains("left on 2 frames, right on 1"), "{line}");
+    }
 }

@@ -98,7 +98,7 @@ pub fn run_into(
     )?;
     let path = out_dir.join(SKELETON_JSON);
     lifted.skeleton.save(&path).map_err(ExitError::failed)?;
-    super::lift::report(&lifted, global);
+    super::lift::report(&lifted, params.foot_lock, global);
     say(global, &format!("wrote {}", path.display()));
     let outputs = Outputs3d {
         bvh: Some(out_dir.join(BVH)),
