@@ -176,12 +176,8 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;
     let network = a
         .network
-        .then(|| {
-            videomocap_core::network::PoseNetwork::bundled()
-                .map(|n| std::sync::Arc::new(n.with_threads(threads)))
-        })
-        .transpose()
-        .map_err(ExitError::failed)?;
+        .then(|| crate::bench_suite::bundled_network(threads))
+        .transpose()?;
     let mut results = Vec::with_capacity(clips.len());
     let mut tally: Tally<[Accuracy; 3]> = Tally::default();
     for clip in &clips {

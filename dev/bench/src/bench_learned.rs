@@ -160,11 +160,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let (threads, params) = threads_and_settings(a)?;
     let settings = sweep(a.evidence.as_deref())?;
     let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;
-    let network = Arc::new(
-        PoseNetwork::bundled()
-            .map_err(ExitError::failed)?
-            .with_threads(threads),
-    );
+    let network = crate::bench_suite::bundled_network(threads)?;
     let mut tally: Tally<Scores> = Tally::default();
     let mut lines = vec![format!(
         "{:<26} {:<5} limbs PCK@0.2: {:>6} {:>6} {:>9}",

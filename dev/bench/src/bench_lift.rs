@@ -213,13 +213,8 @@ fn run_clip(
 
 /// Runs the lift benchmark and prints its tables.
 pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
-    let threads = std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1);
-    let params = match &a.lift_settings {
-        Some(p) => videomocap::cli::lift::load_settings(p)?,
-        None => LiftParams::default(),
-    };
+    let threads = crate::bench_suite::machine_threads();
+    let params = crate::bench_suite::lift_settings(a)?;
     let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;
     let mut tally: Tally<Cases> = Tally::default();
     let mut per_clip = vec![format!(

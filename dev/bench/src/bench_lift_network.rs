@@ -271,18 +271,9 @@ fn cell(c: Option<&Column>) -> String {
 
 /// Runs the comparison and prints its tables.
 pub fn run(a: &BenchArgs, global: &GlobalArgs, weights: &[f64]) -> Result<(), ExitError> {
-    let threads = std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1);
-    let params = match &a.lift_settings {
-        Some(p) => videomocap::cli::lift::load_settings(p)?,
-        None => LiftParams::default(),
-    };
-    let network = Arc::new(
-        PoseNetwork::bundled()
-            .map_err(ExitError::failed)?
-            .with_threads(threads),
-    );
+    let threads = crate::bench_suite::machine_threads();
+    let params = crate::bench_suite::lift_settings(a)?;
+    let network = crate::bench_suite::bundled_network(threads)?;
     let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;
     let mut tally: Tally<Scores> = Tally::default();
     let mut names = vec![

@@ -154,14 +154,8 @@ fn cell(s: &([MotionScore; 3], LockShift)) -> String {
 
 /// Runs the motion benchmark and prints its tables.
 pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
-    let threads = std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1);
-    let network = Arc::new(
-        PoseNetwork::bundled()
-            .map_err(ExitError::failed)?
-            .with_threads(threads),
-    );
+    let threads = crate::bench_suite::machine_threads();
+    let network = crate::bench_suite::bundled_network(threads)?;
     let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;
     let mut tally: Tally<Scores> = Tally::default();
     for clip in &clips {

@@ -52,6 +52,32 @@ impl BenchClip {
     }
 }
 
+/// The threads the benchmarks use: all the machine has.
+pub fn machine_threads() -> usize {
+    std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1)
+}
+
+/// `--lift-settings`, else the lift's defaults.
+pub fn lift_settings(
+    a: &crate::args::BenchArgs,
+) -> Result<videomocap_core::lift::LiftParams, ExitError> {
+    match &a.lift_settings {
+        Some(p) => videomocap::cli::lift::load_settings(p),
+        None => Ok(videomocap_core::lift::LiftParams::default()),
+    }
+}
+
+/// The bundled pose network on `threads` threads, shareable between jobs.
+pub fn bundled_network(
+    threads: usize,
+) -> Result<std::sync::Arc<videomocap_core::network::PoseNetwork>, ExitError> {
+    videomocap_core::network::PoseNetwork::bundled()
+        .map(|n| std::sync::Arc::new(n.with_threads(threads)))
+        .map_err(ExitError::failed)
+}
+
 /// `--split`: all (`None`), dev or test.
 pub fn parse_split(split: &str) -> Result<Option<Split>, ExitError> {
     match split {

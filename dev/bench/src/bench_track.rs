@@ -136,9 +136,7 @@ const SPEED_RUNS: usize = 3;
 /// The tracking benchmarks' threads (all the machine has) and tracker settings (`--tracker-
 /// settings`, else the defaults).
 pub fn threads_and_settings(a: &BenchArgs) -> Result<(usize, TrackerParams), ExitError> {
-    let threads = std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1);
+    let threads = crate::bench_suite::machine_threads();
     let params = match &a.tracker_settings {
         Some(p) => videomocap::cli::track::load_settings(p)?,
         None => TrackerParams::default(),
