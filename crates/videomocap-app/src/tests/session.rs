@@ -66,6 +66,19 @@ fn arrow_keys_step_through_frames_and_stop_at_the_ends() {
     assert_eq!(h.state().state().current_frame(), 0);
 }
 
+/// A fresh app that opens the point-volume folder `vols` through File ▸ Open point volumes.
+fn open_point_volumes(vols: &std::path::Path, state: &std::path::Path) -> Harness<'static, App> {
+    let dialogs = PreparedDialogs::default();
+    dialogs.answers.borrow_mut().push_back(vols.to_owned());
+    let mut h = harness(None, &dialogs, state);
+    h.step();
+    h.get_by_label("File").click();
+    h.run_steps(3);
+    h.get_by_label("Open point volumes…").click();
+    h.run_steps(3);
+    h
+}
+
 /// Volume mode: File ▸ Open point volumes processes a folder of PLY frames off the UI
 /// thread, then the 3D viewport shows the frame's points, skeleton curve, bodies and
 /// skeleton; arrow keys step through the frames.
@@ -86,14 +99,7 @@ fn volume_mode_opens_a_point_volume_folder_and_steps_through_it() {
         |_, _| {},
     )
     .unwrap();
-    let dialogs = PreparedDialogs::default();
-    dialogs.answers.borrow_mut().push_back(vols.clone());
-    let mut h = harness(None, &dialogs, &dir.path().join("state"));
-    h.step();
-    h.get_by_label("File").click();
-    h.run_steps(3);
-    h.get_by_label("Open point volumes…").click();
-    h.run_steps(3);
+    let mut h = open_point_volumes(&vols, &dir.path().join("state"));
     assert!(
         h.state().state().volume().is_some(),
         "{}",
@@ -174,14 +180,7 @@ fn broken_point_volumes_are_explained_in_the_3d_view() {
     for k in 0..3 {
         std::fs::write(vols.join(format!("frame_{k:04}.ply")), cut_short).unwrap();
     }
-    let dialogs = PreparedDialogs::default();
-    dialogs.answers.borrow_mut().push_back(vols.clone());
-    let mut h = harness(None, &dialogs, &dir.path().join("state"));
-    h.step();
-    h.get_by_label("File").click();
-    h.run_steps(3);
-    h.get_by_label("Open point volumes…").click();
-    h.run_steps(3);
+    let mut h = open_point_volumes(&vols, &dir.path().join("state"));
     let scene = crate::views::scene::scene(h.state().state());
     let text = scene.empty_text.unwrap_or_default();
     assert!(
