@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# Checks the BVH that `videomocap run` writes for the bundled sample with two independent
-# readers: Blender (Debian's package; imports it, counts frames, compares every joint on every
-# frame with joints3d.csv) and the Python `bvh` package (its own forward kinematics, same
-# comparison). Installs what is missing. Not part of CI (Blender is large).
+# Checks the BVHs that `videomocap run` and `export --rig mixamo` write for the bundled sample
+# with two independent readers: Blender (Debian's package; imports each rig, counts frames and
+# bones, compares every joint on every frame with joints3d.csv) and the Python `bvh` package
+# (its own forward kinematics, same comparison). Installs what is missing. Not part of CI
+# (Blender is large).
 #
 #   bash scripts/check_bvh.sh            # runs the sample into out/check_bvh/ first
-#   bash scripts/check_bvh.sh DIR        # checks DIR/motion.bvh against DIR/joints3d.csv
+#   bash scripts/check_bvh.sh DIR        # checks DIR/motion.bvh (and DIR/motion.mixamo.bvh if
+#                                        # there) against DIR/joints3d.csv
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export PATH="$HOME/.cargo/bin:$PATH"
@@ -18,6 +20,7 @@ if [ -z "$dir" ]; then
     sample=sample_videos/pose2sim_balancing_cam01
     cargo build --release --quiet
     ./target/release/videomocap --quiet run "$sample/video.mp4" --marks "$sample/marks.json" --out-dir "$dir"
+    ./target/release/videomocap --quiet export "$dir/skeleton3d.json" --bvh "$dir/motion.mixamo.bvh" --rig mixamo
 fi
 for f in motion.bvh joints3d.csv; do
     [ -f "$dir/$f" ] || { echo "$dir/$f: missing (run \`videomocap run\` into $dir first)" >&2; exit 2; }
@@ -32,9 +35,13 @@ if ! command -v blender >/dev/null; then
 fi
 
 status=0
-python3 scripts/check_bvh_reader.py "$dir/motion.bvh" "$dir/joints3d.csv" || status=1
-out=$(blender -b --factory-startup --python scripts/check_bvh_blender.py -- "$dir/motion.bvh" "$dir/joints3d.csv" 2>&1)
-echo "$out" | grep -E "^blender " || { echo "$out" | tail -20; status=1; }
-echo "$out" | grep -q BLENDER_CHECK_OK || status=1
-if [ "$status" -eq 0 ]; then echo "BVH check passed: $dir/motion.bvh"; else echo "BVH check FAILED: $dir/motion.bvh" >&2; fi
+check() { # file rig
+    python3 scripts/check_bvh_reader.py "$1" "$dir/joints3d.csv" "$2" || status=1
+    out=$(blender -b --factory-startup --python scripts/check_bvh_blender.py -- "$1" "$dir/joints3d.csv" "$2" 2>&1)
+    echo "$out" | grep -E "^blender " || { echo "$out" | tail -20; status=1; }
+    echo "$out" | grep -q BLENDER_CHECK_OK || status=1
+}
+check "$dir/motion.bvh" cmu
+if [ -f "$dir/motion.mixamo.bvh" ]; then check "$dir/motion.mixamo.bvh" mixamo; fi
+if [ "$status" -eq 0 ]; then echo "BVH check passed: $dir"; else echo "BVH check FAILED: $dir" >&2; fi
 exit "$status"

@@ -2,7 +2,7 @@
 forward kinematics, and compares every joint of every frame with the 3D CSV written beside it
 (world metres, Y up). Exit 0 when all lie within 1 mm.
 
-Usage: python3 scripts/check_bvh_reader.py motion.bvh joints3d.csv
+Usage: python3 scripts/check_bvh_reader.py motion.bvh joints3d.csv [cmu|mixamo]
 """
 import csv
 import math
@@ -10,7 +10,7 @@ import sys
 
 from bvh import Bvh
 
-from bvh_rig import JOINTS
+from bvh_rig import joints
 
 CM_PER_M = 100.0
 
@@ -72,6 +72,7 @@ def forward_kinematics(mocap, frame):
 
 def main():
     bvh_path, csv_path = sys.argv[1], sys.argv[2]
+    table = joints(sys.argv[3] if len(sys.argv) > 3 else "cmu")
     with open(bvh_path) as f:
         mocap = Bvh(f.read())
     truth = {}
@@ -86,7 +87,7 @@ def main():
     worst = (0.0, None, None)
     for k, index in enumerate(frames):
         pos, ends = forward_kinematics(mocap, k)
-        for joint, (name, end) in JOINTS.items():
+        for joint, (name, end) in table.items():
             p = ends[name] if end else pos[name]
             err = math.dist([v / CM_PER_M for v in p], truth[index][joint])
             if err > worst[0]:

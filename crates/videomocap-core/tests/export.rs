@@ -7,7 +7,7 @@ use std::path::Path;
 use videomocap_core::bvh::{Bvh, map_to_model};
 use videomocap_core::camera::PinholeCamera;
 use videomocap_core::export::rig::{RIG, rig_index_of};
-use videomocap_core::export::{WorldSkeleton, bvh, skeleton_csv, trc};
+use videomocap_core::export::{RigNames, WorldSkeleton, bvh, skeleton_csv, trc};
 use videomocap_core::formats::FrameIndex;
 use videomocap_core::formats::{CONTACT_FLAG, Frame3d, Skeleton3d};
 use videomocap_core::skeleton::{Bone, Joint, PerJoint, SubjectModel};
@@ -138,7 +138,7 @@ fn frames_of(m: &Motion, n: usize) -> Vec<PerJoint<Point3<f64>>> {
 /// stepped a channel 25.8° there while no joint turned more than 15.2° a frame; under 30° it
 /// is at most 1.73 times.
 fn steps(motion: &videomocap_core::export::kinematics::RigMotion) -> (f64, f64) {
-    let (_, angles) = videomocap_core::export::bvh_text(motion);
+    let (_, angles) = videomocap_core::export::bvh_text(motion, RigNames::Cmu);
     let rotating: Vec<usize> = (0..RIG.len()).filter(|&i| !RIG[i].is_end()).collect();
     let mut geodesic: f64 = 0.0;
     let mut euler: f64 = 0.0;
@@ -172,7 +172,7 @@ proptest! {
             }
         }
         let motion = videomocap_core::export::kinematics::solve(&ws.frames, 1.0 / 30.0).unwrap();
-        let out = bvh(&ws).unwrap();
+        let out = bvh(&ws, RigNames::Cmu).unwrap();
         prop_assert!(out.max_round_trip_m < 1e-3, "round trip {} m", out.max_round_trip_m);
         // Independently of the exporter's own check: read the text back here.
         let read = Bvh::parse(&out.text, Path::new("t.bvh")).unwrap();
@@ -205,7 +205,7 @@ fn the_written_hierarchy_is_the_rig_in_order() {
         height: 1.7,
     };
     let ws = WorldSkeleton::new(&to_camera(&frames_of(&m, 3), 0.0, 0.0), None).unwrap();
-    let out = bvh(&ws).unwrap();
+    let out = bvh(&ws, RigNames::Cmu).unwrap();
     let read = Bvh::parse(&out.text, Path::new("t.bvh")).unwrap();
     assert_eq!(read.joints.len(), RIG.len());
     for (r, j) in RIG.iter().zip(&read.joints) {
@@ -223,6 +223,135 @@ fn the_written_hierarchy_is_the_rig_in_order() {
     assert!(!out.text.contains("-0.0000"));
 }
 
+/// The Mixamo names: the same hierarchy and numbers with other bone names, every one of them
+/// Mixamo's (`mixamorig:` and a name from its rig), and the file maps back onto the 16 joints
+/// through the reader's name table like any other rig.
+#[test]
+fn the_mixamo_rig_is_the_same_motion_under_mixamo_names() {
+    let m = Motion {
+        base: vec![[0.1, 0.0, 0.0]; 15],
+        swing: vec![[0.0, 0.2, 0.0]; 15],
+        phase: vec![0.0; 15],
+        turn: 0.0,
+        height: 1.7,
+    };
+    let ws = WorldSkeleton::new(&to_camera(&frames_of(&m, 3), 0.0, 0.0), None).unwrap();
+    let cmu = bvh(&ws, RigNames::Cmu).unwrap();
+    let mixamo = bvh(&ws, RigNames::Mixamo).unwrap();
+    assert!(mixamo.max_round_trip_m < 1e-3);
+    let (a, b) = (
+        Bvh::parse(&cmu.text, Path::new("cmu.bvh")).unwrap(),
+        Bvh::parse(&mixamo.text, Path::new("mixamo.bvh")).unwrap(),
+    );
+    assert_eq!(a.joints.len(), b.joints.len());
+    for k in 0..3 {
+        assert_eq!(a.frame(k), b.frame(k), "same motion");
+    }
+    const MIXAMO: [&str; 15] = [
+        "Hips",
+        "Spine",
+        "Spine2",
+        "Neck",
+        "Head",
+        "LeftShoulder",
+        "LeftArm",
+        "LeftForeArm",
+        "LeftHand",
+        "LeftUpLeg",
+        "LeftLeg",
+        "LeftFoot",
+        "RightHand",
+        "RightUpLeg",
+        "RightFoot",
+    ];
+    let names: Vec<&str> = b
+        .joints
+        .iter()
+        .filter(|j| !j.end_site)
+        .map(|j| j.name.as_str())
+        .collect();
+    for n in &names {
+        assert!(n.starts_with("mixamorig:"), "{n}");
+    }
+    for n in MIXAMO {
+        assert!(
+            names.contains(&format!("mixamorig:{n}").as_str()),
+            "{n} missing"
+        );
+    }
+    let mapped = map_to_model(&b, Path::new("mixamo.bvh")).unwrap();
+    assert_eq!(mapped.frames.len(), 3);
+    for j in [Joint::LeftWrist, Joint::RightAnkle, Joint::LeftKnee] {
+        let got = mapped.frames[1][j];
+        let want = ws.frames[1][j];
+        assert!((got - want).norm() < 1e-3, "{j:?}: {got} against {want}");
+    }
+}
+
+/// The hands continue the forearms by a hand's length; the feet point to the body's front with
+/// the toes at the floor at rest, and turn with the shanks.
+#[test]
+fn hands_continue_the_forearms_and_feet_point_forward_to_the_floor() {
+    let m = Motion {
+        base: vec![[0.0, 0.0, 0.0]; 15],
+        swing: vec![[0.0, 0.0, 0.0]; 15],
+        phase: vec![0.0; 15],
+        turn: 0.0,
+        height: 1.7,
+    };
+    let ws = WorldSkeleton::new(&to_camera(&frames_of(&m, 3), 0.7, 0.1), None).unwrap();
+    let out = bvh(&ws, RigNames::Cmu).unwrap();
+    let read = Bvh::parse(&out.text, Path::new("t.bvh")).unwrap();
+    let p = read.positions(0);
+    let f = &ws.frames[0];
+    let end_of = |name: &str| {
+        let i = read.find(name).unwrap();
+        let e = (0..read.joints.len())
+            .find(|&k| read.joints[k].end_site && read.joints[k].parent == Some(i))
+            .unwrap();
+        p[e] / 100.0
+    };
+    // Hand: along elbow → wrist, 0.74 of the forearm beyond the wrist.
+    let hand = end_of("LeftHand");
+    let forearm = f[Joint::LeftWrist] - f[Joint::LeftElbow];
+    let beyond = hand - f[Joint::LeftWrist];
+    assert!(beyond.normalize().dot(&forearm.normalize()) > 0.999);
+    assert!((beyond.norm() / forearm.norm() - 0.108 / 0.146).abs() < 1e-3);
+    // Foot, at rest: in front of the ankle (the rest pose faces +Z) and down by the ankle's
+    // height over the floor (0.039 of the stature), square-ish to the shank.
+    let rest = read.rest_positions();
+    let at = |name: &str| rest[read.find(name).unwrap()];
+    let toe_rest = {
+        let i = read.find("RightFoot").unwrap();
+        let e = (0..read.joints.len())
+            .find(|&k| read.joints[k].end_site && read.joints[k].parent == Some(i))
+            .unwrap();
+        rest[e]
+    };
+    let foot_rest = (toe_rest - at("RightFoot")) / 100.0;
+    let shank_rest = (at("RightFoot") - at("RightLeg")) / 100.0;
+    assert!(foot_rest.z > 0.0 && foot_rest.x.abs() < 1e-9, "{foot_rest}");
+    assert!(
+        (foot_rest.y / shank_rest.norm() + 0.039 / 0.246).abs() < 1e-3,
+        "toes {} m under the ankle",
+        -foot_rest.y
+    );
+    // In motion the foot turns with the shank: the same angle to it on every frame.
+    let rest_angle = shank_rest.angle(&foot_rest);
+    for k in 0..3 {
+        let p = read.positions(k);
+        let i = read.find("RightFoot").unwrap();
+        let e = (0..read.joints.len())
+            .find(|&q| read.joints[q].end_site && read.joints[q].parent == Some(i))
+            .unwrap();
+        let angle = (p[i] - p[read.find("RightLeg").unwrap()]).angle(&(p[e] - p[i]));
+        assert!(
+            (angle - rest_angle).abs() < 1e-3,
+            "{angle} against {rest_angle}"
+        );
+    }
+}
+
 /// The golden file: a fixed three-frame motion must give these exact bytes. After a deliberate
 /// change of the format, regenerate with `UPDATE_GOLDEN=1 cargo test --test export`.
 #[test]
@@ -237,7 +366,7 @@ fn golden_bvh() {
         height: 1.75,
     };
     let ws = WorldSkeleton::new(&to_camera(&frames_of(&m, 3), 0.3, 0.2), None).unwrap();
-    let text = bvh(&ws).unwrap().text;
+    let text = bvh(&ws, RigNames::Cmu).unwrap().text;
     let path = videomocap_testkit::repo_root().join("tests/golden/three_frames.bvh");
     if std::env::var_os("UPDATE_GOLDEN").is_some() {
         std::fs::write(&path, &text).unwrap();
@@ -344,7 +473,7 @@ fn gaps_and_missing_frame_rates_are_refused() {
     let mut skeleton = to_camera(&frames_of(&m, 4), 0.0, 0.0);
     skeleton.frames[3].index = FrameIndex(7);
     let ws = WorldSkeleton::new(&skeleton, None).unwrap();
-    let err = bvh(&ws).unwrap_err().to_string();
+    let err = bvh(&ws, RigNames::Cmu).unwrap_err().to_string();
     assert!(err.contains("frame 7 follows frame 2"), "{err}");
     skeleton.fps = None;
     let err = WorldSkeleton::new(&skeleton, None).unwrap_err().to_string();
@@ -377,7 +506,7 @@ fn the_real_sample_round_trips_within_a_millimetre() {
     .unwrap();
     let ws = WorldSkeleton::new(&out.skeleton, None).unwrap();
     assert_eq!(ws.fps, 60.0);
-    let b = bvh(&ws).unwrap();
+    let b = bvh(&ws, RigNames::Cmu).unwrap();
     eprintln!(
         "real sample: {} frames, round trip {:.4} mm, largest Euler step {:.1}°, up from {}",
         b.frames,

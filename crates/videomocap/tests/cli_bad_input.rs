@@ -377,6 +377,25 @@ fn lift_writes_a_skeleton_and_refuses_a_bad_focal_length() {
     assert!(!Path::new(&p("x.bvh")).exists());
     let (code, stderr) = run(&["export", &old_path, "--bvh", &p("x.bvh"), "--fps", "30"]);
     assert_eq!(code, 0, "{stderr}");
+    // The Mixamo rig: the same motion under Mixamo's names; an unknown rig is refused with
+    // the choices named.
+    let (code, stderr) = run(&["export", outs, "--bvh", &p("mx.bvh"), "--rig", "mixamo"]);
+    assert_eq!(code, 0, "{stderr}");
+    let mixamo = std::fs::read_to_string(p("mx.bvh")).unwrap();
+    assert!(mixamo.starts_with("HIERARCHY\nROOT mixamorig:Hips\n"));
+    assert!(
+        mixamo.contains("JOINT mixamorig:LeftFoot") && mixamo.contains("JOINT mixamorig:Spine2")
+    );
+    let cmu = std::fs::read_to_string(p("m.bvh")).unwrap();
+    assert_eq!(
+        cmu.split("MOTION").nth(1),
+        mixamo.split("MOTION").nth(1),
+        "the same motion"
+    );
+    let (code, stderr) = run(&["export", outs, "--bvh", &p("no.bvh"), "--rig", "maya"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("cmu, mixamo"), "{stderr}");
+    assert!(!Path::new(&p("no.bvh")).exists());
 }
 
 #[test]

@@ -31,6 +31,7 @@ pub fn run(a: &StressWriteArgs) -> Result<(), ExitError> {
         bvh: Some(a.out_dir.join("motion.bvh")),
         csv: Some(a.out_dir.join("joints3d.csv")),
         trc: Some(a.out_dir.join("motion.trc")),
+        rig: Default::default(),
     };
     let frames = skeleton.frames.len();
     let mut round = 0u64;

@@ -9,8 +9,10 @@ use videomocap_core::export;
 /// Things the export menu can write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ExportKind {
-    /// The motion as BVH.
+    /// The motion as BVH (CMU bone names).
     Bvh,
+    /// The motion as BVH with Mixamo's bone names, for retargeting onto Mixamo characters.
+    BvhMixamo,
     /// The 2D tracks (tracks2d.json).
     TracksJson,
     /// The 3D skeleton (skeleton3d.json).
@@ -27,8 +29,9 @@ pub enum ExportKind {
 
 impl ExportKind {
     /// Every export, in menu order.
-    pub const ALL: [ExportKind; 7] = [
+    pub const ALL: [ExportKind; 8] = [
         ExportKind::Bvh,
+        ExportKind::BvhMixamo,
         ExportKind::TracksJson,
         ExportKind::SkeletonJson,
         ExportKind::TracksCsv,
@@ -41,6 +44,7 @@ impl ExportKind {
     pub fn label(self) -> &'static str {
         match self {
             ExportKind::Bvh => "BVH (Blender, motion builders)…",
+            ExportKind::BvhMixamo => "BVH, Mixamo bone names (retargeting)…",
             ExportKind::TracksJson => "2D tracks (tracks2d.json)…",
             ExportKind::SkeletonJson => "3D skeleton (skeleton3d.json)…",
             ExportKind::TracksCsv => "2D tracks CSV…",
@@ -54,6 +58,7 @@ impl ExportKind {
     pub(super) fn file_name(self, stem: &str) -> String {
         let suffix = match self {
             ExportKind::Bvh => ".bvh",
+            ExportKind::BvhMixamo => ".mixamo.bvh",
             ExportKind::TracksJson => ".tracks2d.json",
             ExportKind::SkeletonJson => ".skeleton3d.json",
             ExportKind::TracksCsv => ".tracks2d.csv",
@@ -116,8 +121,13 @@ impl State {
                 .ok_or_else(|| anyhow::anyhow!("no 3D skeleton yet (Track > Track and lift)"))
         };
         match kind {
-            ExportKind::Bvh => {
-                let b = export::bvh(need_world()?)?;
+            ExportKind::Bvh | ExportKind::BvhMixamo => {
+                let names = if kind == ExportKind::Bvh {
+                    export::RigNames::Cmu
+                } else {
+                    export::RigNames::Mixamo
+                };
+                let b = export::bvh(need_world()?, names)?;
                 export::save_text(path, &b.text)?;
             }
             ExportKind::TracksJson => need_tracks()?.save(path)?,

@@ -420,6 +420,17 @@ fn mark_drag_undo_track_scrub_orbit_export_and_recover() {
     );
     let read = videomocap_core::bvh::Bvh::load(&bvh).unwrap();
     assert_eq!(read.frame_count(), 60);
+    // And with Mixamo's bone names, for retargeting: the same motion.
+    let mixamo = dir.path().join("out.mixamo.bvh");
+    dialogs.answers.borrow_mut().push_back(mixamo.clone());
+    h.get_by_label("Export").click();
+    h.run_steps(3);
+    h.get_by_label(ExportKind::BvhMixamo.label()).click();
+    h.run_steps(3);
+    let text = std::fs::read_to_string(&mixamo).unwrap();
+    assert!(text.contains("ROOT mixamorig:Hips"), "{}", &text[..60]);
+    let read_mixamo = videomocap_core::bvh::Bvh::load(&mixamo).unwrap();
+    assert_eq!(read_mixamo.frame(30), read.frame(30));
 
     // The app dies without saving: the autosave holds the work, and the next start offers it.
     h.state_mut().state_mut().flush_autosave();

@@ -218,11 +218,14 @@ impl Bvh {
         self.values.get(f * n..(f + 1) * n).unwrap_or(&[])
     }
 
-    /// Index of the joint with this name (case-insensitive), End Sites excluded.
+    /// Index of the joint with this name (case-insensitive, any `namespace:` before it
+    /// ignored), End Sites excluded.
     pub fn find(&self, name: &str) -> Option<usize> {
-        self.joints
-            .iter()
-            .position(|j| !j.end_site && j.name.eq_ignore_ascii_case(name))
+        self.joints.iter().position(|j| {
+            // A namespace before the name (Mixamo's `mixamorig:`) is not part of it.
+            let bare = j.name.rsplit(':').next().unwrap_or(&j.name);
+            !j.end_site && bare.eq_ignore_ascii_case(name)
+        })
     }
 }
 

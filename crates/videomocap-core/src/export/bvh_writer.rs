@@ -1,11 +1,12 @@
 //! The BVH writer: the rig of [`super::rig::RIG`] as HIERARCHY (root `Hips` with six channels,
-//! every other joint three, Z-X-Y rotation order, End Sites at head top, wrists and ankles),
+//! every other joint three, Z-X-Y rotation order, End Sites at head top, fingertips and toes,
+//! bone names from a [`RigNames`] set),
 //! then MOTION with one line per frame. Lengths in centimetres, angles in degrees, every number
 //! with four decimals, so the same input always gives the same bytes.
 
 use super::euler::zxy_degrees;
 use super::kinematics::RigMotion;
-use super::rig::RIG;
+use super::rig::{RIG, RigNames};
 use std::fmt::Write as _;
 
 /// BVH lengths are written in centimetres: Blender's importer (scale 1.0) then gives a
@@ -16,11 +17,11 @@ pub const BVH_UNITS_PER_METRE: f64 = 100.0;
 /// The channels of non-root joints, in order.
 pub const ROTATION_CHANNELS: &str = "Zrotation Xrotation Yrotation";
 
-/// The BVH text of a rig motion, and the Euler angles written (per frame, per non-End-Site
-/// joint in rig order, Z X Y in degrees).
-pub fn bvh_text(motion: &RigMotion) -> (String, Vec<Vec<[f64; 3]>>) {
+/// The BVH text of a rig motion with the bone names of `names`, and the Euler angles written
+/// (per frame, per non-End-Site joint in rig order, Z X Y in degrees).
+pub fn bvh_text(motion: &RigMotion, names: RigNames) -> (String, Vec<Vec<[f64; 3]>>) {
     let mut out = String::from("HIERARCHY\n");
-    write_joint(&mut out, motion, 0, 0);
+    write_joint(&mut out, motion, names, 0, 0);
     let _ = writeln!(out, "MOTION");
     let _ = writeln!(out, "Frames: {}", motion.frames.len());
     let _ = writeln!(out, "Frame Time: {:.8}", motion.frame_time_s);
@@ -47,7 +48,7 @@ pub fn bvh_text(motion: &RigMotion) -> (String, Vec<Vec<[f64; 3]>>) {
     (out, angles)
 }
 
-fn write_joint(out: &mut String, motion: &RigMotion, i: usize, depth: usize) {
+fn write_joint(out: &mut String, motion: &RigMotion, names: RigNames, i: usize, depth: usize) {
     let indent = "\t".repeat(depth);
     let r = &RIG[i];
     let o = motion.offsets[i] * BVH_UNITS_PER_METRE;
@@ -58,7 +59,7 @@ fn write_joint(out: &mut String, motion: &RigMotion, i: usize, depth: usize) {
         return;
     }
     let keyword = if r.parent.is_none() { "ROOT" } else { "JOINT" };
-    let _ = writeln!(out, "{indent}{keyword} {}\n{indent}{{", r.name);
+    let _ = writeln!(out, "{indent}{keyword} {}\n{indent}{{", names.name(i));
     let _ = writeln!(out, "{indent}\tOFFSET {offset}");
     if r.parent.is_none() {
         let _ = writeln!(
@@ -70,7 +71,7 @@ fn write_joint(out: &mut String, motion: &RigMotion, i: usize, depth: usize) {
     }
     for (c, child) in RIG.iter().enumerate() {
         if child.parent == Some(i) {
-            write_joint(out, motion, c, depth + 1);
+            write_joint(out, motion, names, c, depth + 1);
         }
     }
     let _ = writeln!(out, "{indent}}}");

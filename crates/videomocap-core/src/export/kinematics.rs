@@ -30,14 +30,26 @@ pub struct RigPose {
     /// World position of the root (the pelvis), metres.
     pub root: Point3<f64>,
     /// Rotation of each rig joint relative to its parent (the root's is global); identity for
-    /// End Sites.
+    /// End Sites and the untracked parts ([`XRule::Rigid`]).
     pub local: Vec<Rotation3<f64>>,
 }
 
 impl RigMotion {
     /// Forward kinematics: every rig joint's world position in frame `f`.
     pub fn positions(&self, f: usize) -> Vec<Point3<f64>> {
-        let pose = &self.frames[f];
+        self.forward(&self.frames[f])
+    }
+
+    /// Every rig joint's position in the rest pose (every rotation zero, the root at the
+    /// origin).
+    pub fn positions_at_rest(&self) -> Vec<Point3<f64>> {
+        self.forward(&RigPose {
+            root: Point3::origin(),
+            local: vec![Rotation3::identity(); RIG.len()],
+        })
+    }
+
+    fn forward(&self, pose: &RigPose) -> Vec<Point3<f64>> {
         let mut global: Vec<Rotation3<f64>> = Vec::with_capacity(RIG.len());
         let mut pos: Vec<Point3<f64>> = Vec::with_capacity(RIG.len());
         for (i, r) in RIG.iter().enumerate() {
@@ -112,7 +124,7 @@ pub fn solve(
                 .enumerate()
                 .map(|(i, r)| {
                     let m = match r.parent {
-                        _ if r.is_end() => Matrix3::identity(),
+                        _ if r.is_end() || r.x_rule == XRule::Rigid => Matrix3::identity(),
                         None => global[i],
                         Some(parent) => global[parent].transpose() * global[i],
                     };
@@ -166,7 +178,7 @@ fn body_frames(
                 }
             }
             XRule::Hinge(limb) => hinges[limb_index(limb)],
-            XRule::ParentX => parent_axis(0),
+            XRule::ParentX | XRule::Rigid => parent_axis(0),
         };
         let x = perpendicular(x_wanted, z)
             .or_else(|| perpendicular(parent_axis(0), z))
@@ -332,7 +344,21 @@ mod tests {
         for (f, p) in frames.iter().enumerate() {
             let fk = motion.positions(f);
             let want = rig_positions(p);
+            // The toes turn with the shank: they keep the rest pose's angle to it.
+            let rest_angle = {
+                let rest = motion.positions_at_rest();
+                let (shank, foot) = (rest[19] - rest[18], rest[20] - rest[19]);
+                shank.angle(&foot)
+            };
+            let angle = (fk[19] - fk[18]).angle(&(fk[20] - fk[19]));
+            assert!(
+                (angle - rest_angle).abs() < 1e-9,
+                "{angle} against {rest_angle}"
+            );
             for (i, (a, b)) in fk.iter().zip(&want).enumerate() {
+                if matches!(RIG[i].place, crate::export::rig::Place::Toe { .. }) {
+                    continue;
+                }
                 assert!(
                     (a - b).norm() < 1e-9,
                     "frame {f} {}: {a} vs {b}",

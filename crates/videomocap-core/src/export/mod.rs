@@ -14,6 +14,7 @@ pub mod world;
 
 pub use bvh_writer::{BVH_UNITS_PER_METRE, ROTATION_CHANNELS, bvh_text};
 pub use euler::zxy_degrees;
+pub use rig::RigNames;
 pub use tables::{skeleton_csv, tracks_csv, trc};
 pub use world::{UpSource, WorldFrame};
 
@@ -128,8 +129,9 @@ pub struct BvhExport {
     pub max_angle_step_deg: f64,
 }
 
-/// Builds the BVH of a world skeleton and checks it by reading it back.
-pub fn bvh(skeleton: &WorldSkeleton) -> Result<BvhExport, ExportError> {
+/// Builds the BVH of a world skeleton with the bone names of `names` and checks it by reading
+/// it back.
+pub fn bvh(skeleton: &WorldSkeleton, names: RigNames) -> Result<BvhExport, ExportError> {
     for w in skeleton.indices.windows(2) {
         if w[1] != w[0] + 1 {
             return Err(ExportError::Gap {
@@ -139,7 +141,7 @@ pub fn bvh(skeleton: &WorldSkeleton) -> Result<BvhExport, ExportError> {
         }
     }
     let motion = kinematics::solve(&skeleton.frames, 1.0 / skeleton.fps)?;
-    let (text, angles) = bvh_text(&motion);
+    let (text, angles) = bvh_text(&motion, names);
     let max_angle_step_deg = angles
         .windows(2)
         .flat_map(|w| {

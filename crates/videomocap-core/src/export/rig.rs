@@ -7,6 +7,7 @@
 //! the BVH gives back every joint exactly when the bone lengths are constant.
 
 use crate::skeleton::Joint;
+use Place::{At, Between, Toe};
 use nalgebra::{Point3, Vector3};
 
 /// Where a rig joint sits on the 16-joint skeleton.
@@ -14,8 +15,19 @@ use nalgebra::{Point3, Vector3};
 pub enum Place {
     /// At a joint of the model.
     At(Joint),
-    /// On the segment from the first joint to the second, at this fraction of the way.
+    /// On the line from the first joint to the second, at this fraction of the way (beyond
+    /// the second when above 1: the hand's end continues the forearm).
     Between(Joint, Joint, f64),
+    /// The toes of the leg whose knee and ankle these are: in front of the ankle, square to the
+    /// shank and towards the body's front, and down towards the floor ([`TOE_FORWARD_PER_SHANK`]
+    /// and [`TOE_DOWN_PER_SHANK`] of the shank's length), so a standing foot lies flat. It sets
+    /// the rest pose; in motion the foot turns with the shank ([`XRule::Rigid`]).
+    Toe {
+        /// The leg's knee.
+        knee: Joint,
+        /// The leg's ankle.
+        ankle: Joint,
+    },
 }
 
 impl Place {
@@ -24,9 +36,36 @@ impl Place {
         match self {
             Place::At(j) => joint(j),
             Place::Between(a, b, t) => joint(a) + t * (joint(b) - joint(a)),
+            Place::Toe { knee, ankle } => {
+                let shank = joint(ankle) - joint(knee);
+                let length = shank.norm();
+                let down = shank.try_normalize(1e-9).unwrap_or_else(Vector3::zeros);
+                // The body's front: (left − right) × up, the same in camera space and the
+                // world (both right-handed).
+                let front = (joint(Joint::LeftHip) - joint(Joint::RightHip))
+                    .cross(&(joint(Joint::Neck) - joint(Joint::Pelvis)));
+                let forward = (front - front.dot(&down) * down)
+                    .try_normalize(1e-9)
+                    .unwrap_or_else(Vector3::zeros);
+                joint(ankle)
+                    + length * (TOE_FORWARD_PER_SHANK * forward + TOE_DOWN_PER_SHANK * down)
+            }
         }
     }
 }
+
+/// How far the hand's end (the middle fingertip) lies beyond the wrist, as a share of the
+/// forearm: Winter's hand 0.108 H over his forearm 0.146 H.
+pub const HAND_PER_FOREARM: f64 = 0.108 / 0.146;
+
+/// How far the toes lie in front of the ankle, as a share of the shank: the foot reaches about
+/// 0.11 H in front of the ankle (Winter's foot 0.152 H less the heel behind the ankle), over the
+/// shank's 0.246 H (knee 0.285 H, ankle 0.039 H).
+pub const TOE_FORWARD_PER_SHANK: f64 = 0.11 / 0.246;
+
+/// How far the toes lie below the ankle, as a share of the shank: the ankle's 0.039 H over the
+/// floor (Winter), so a standing foot's toes touch the floor.
+pub const TOE_DOWN_PER_SHANK: f64 = 0.039 / 0.246;
 
 /// How a rig joint's local X axis is found (after Chu et al. §4: "the X axis of the torso is
 /// the cross product of the Z axis and the vector formed between the two shoulder points …
@@ -45,6 +84,11 @@ pub enum XRule {
     Hinge(Limb),
     /// The parent's X (the lower bone of a hinge turns about the same axis as the upper one).
     ParentX,
+    /// A part that is not tracked (a hand, a foot): at rest its X is its parent's, and in
+    /// motion it turns with its parent (its own rotation stays zero), keeping the rest pose's
+    /// angle to the parent's bone: a hand continues its forearm, a foot stays square to its
+    /// shank and turns with the knee's plane, so it never flips.
+    Rigid,
 }
 
 /// The four two-bone limbs.
@@ -119,35 +163,24 @@ const fn joint(
     }
 }
 
-const fn end(parent: usize, at: Joint) -> RigJoint {
-    joint(
-        "End Site",
-        Some(parent),
-        Place::At(at),
-        None,
-        XRule::ParentX,
-    )
+const fn end(parent: usize, place: Place) -> RigJoint {
+    joint("End Site", Some(parent), place, None, XRule::ParentX)
 }
 
 /// The exported rig, parents before children. Names follow the CMU/Mixamo conventions Blender
-/// users know; the spine's middle joint sits halfway from pelvis to chest.
-pub const RIG: [RigJoint; 22] = {
+/// users know (see [`RigNames`] for the Mixamo set); the spine's middle joint sits halfway from
+/// pelvis to chest; the hands continue the forearms and the feet point at the toes (neither is
+/// tracked: a hand turns with its forearm, a foot stays square to its shank).
+pub const RIG: [RigJoint; 26] = {
     use Joint::*;
     use XRule::*;
     [
-        /* 0 */
-        joint(
-            "Hips",
-            None,
-            Place::At(Pelvis),
-            Some(1),
-            Across(LeftHip, RightHip),
-        ),
+        /* 0 */ joint("Hips", None, At(Pelvis), Some(1), Across(LeftHip, RightHip)),
         /* 1 */
         joint(
             "Spine",
             Some(0),
-            Place::Between(Pelvis, Chest, 0.5),
+            Between(Pelvis, Chest, 0.5),
             Some(2),
             FromParent,
         ),
@@ -155,115 +188,129 @@ pub const RIG: [RigJoint; 22] = {
         joint(
             "Chest",
             Some(1),
-            Place::At(Chest),
+            At(Chest),
             Some(3),
             Across(LeftShoulder, RightShoulder),
         ),
-        /* 3 */ joint("Neck", Some(2), Place::At(Neck), Some(4), FromParent),
+        /* 3 */ joint("Neck", Some(2), At(Neck), Some(4), FromParent),
         /* 4 */
         joint(
             "Head",
             Some(3),
-            Place::Between(Neck, HeadTop, HEAD_JOINT_FRACTION),
+            Between(Neck, HeadTop, HEAD_JOINT_FRACTION),
             Some(5),
             FromParent,
         ),
-        /* 5 */ end(4, HeadTop),
-        /* 6 */
-        joint(
-            "LeftShoulder",
-            Some(2),
-            Place::At(Chest),
-            Some(7),
-            FromParent,
-        ),
+        /* 5 */ end(4, At(HeadTop)),
+        /* 6 */ joint("LeftShoulder", Some(2), At(Chest), Some(7), FromParent),
         /* 7 */
         joint(
             "LeftArm",
             Some(6),
-            Place::At(LeftShoulder),
+            At(LeftShoulder),
             Some(8),
             Hinge(Limb::LeftArm),
         ),
-        /* 8 */
-        joint(
-            "LeftForeArm",
-            Some(7),
-            Place::At(LeftElbow),
-            Some(9),
-            ParentX,
-        ),
-        /* 9 */ end(8, LeftWrist),
-        /* 10 */
-        joint(
-            "RightShoulder",
-            Some(2),
-            Place::At(Chest),
-            Some(11),
-            FromParent,
-        ),
-        /* 11 */
-        joint(
-            "RightArm",
-            Some(10),
-            Place::At(RightShoulder),
-            Some(12),
-            Hinge(Limb::RightArm),
-        ),
+        /* 8 */ joint("LeftForeArm", Some(7), At(LeftElbow), Some(9), ParentX),
+        /* 9 */ joint("LeftHand", Some(8), At(LeftWrist), Some(10), Rigid),
+        /* 10 */ end(9, Between(LeftElbow, LeftWrist, 1.0 + HAND_PER_FOREARM)),
+        /* 11 */ joint("RightShoulder", Some(2), At(Chest), Some(12), FromParent),
         /* 12 */
         joint(
-            "RightForeArm",
+            "RightArm",
             Some(11),
-            Place::At(RightElbow),
+            At(RightShoulder),
             Some(13),
-            ParentX,
+            Hinge(Limb::RightArm),
         ),
-        /* 13 */ end(12, RightWrist),
-        /* 14 */
-        joint(
-            "LHipJoint",
-            Some(0),
-            Place::At(Pelvis),
-            Some(15),
-            FromParent,
-        ),
-        /* 15 */
+        /* 13 */ joint("RightForeArm", Some(12), At(RightElbow), Some(14), ParentX),
+        /* 14 */ joint("RightHand", Some(13), At(RightWrist), Some(15), Rigid),
+        /* 15 */ end(14, Between(RightElbow, RightWrist, 1.0 + HAND_PER_FOREARM)),
+        /* 16 */ joint("LHipJoint", Some(0), At(Pelvis), Some(17), FromParent),
+        /* 17 */
         joint(
             "LeftUpLeg",
-            Some(14),
-            Place::At(LeftHip),
             Some(16),
+            At(LeftHip),
+            Some(18),
             Hinge(Limb::LeftLeg),
         ),
-        /* 16 */ joint("LeftLeg", Some(15), Place::At(LeftKnee), Some(17), ParentX),
-        /* 17 */ end(16, LeftAnkle),
-        /* 18 */
-        joint(
-            "RHipJoint",
-            Some(0),
-            Place::At(Pelvis),
-            Some(19),
-            FromParent,
+        /* 18 */ joint("LeftLeg", Some(17), At(LeftKnee), Some(19), ParentX),
+        /* 19 */ joint("LeftFoot", Some(18), At(LeftAnkle), Some(20), Rigid),
+        /* 20 */
+        end(
+            19,
+            Toe {
+                knee: LeftKnee,
+                ankle: LeftAnkle,
+            },
         ),
-        /* 19 */
+        /* 21 */ joint("RHipJoint", Some(0), At(Pelvis), Some(22), FromParent),
+        /* 22 */
         joint(
             "RightUpLeg",
-            Some(18),
-            Place::At(RightHip),
-            Some(20),
+            Some(21),
+            At(RightHip),
+            Some(23),
             Hinge(Limb::RightLeg),
         ),
-        /* 20 */
-        joint(
-            "RightLeg",
-            Some(19),
-            Place::At(RightKnee),
-            Some(21),
-            ParentX,
+        /* 23 */ joint("RightLeg", Some(22), At(RightKnee), Some(24), ParentX),
+        /* 24 */ joint("RightFoot", Some(23), At(RightAnkle), Some(25), Rigid),
+        /* 25 */
+        end(
+            24,
+            Toe {
+                knee: RightKnee,
+                ankle: RightAnkle,
+            },
         ),
-        /* 21 */ end(20, RightAnkle),
     ]
 };
+
+/// Which bone names the BVH carries; the joints, offsets and motion are the same.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RigNames {
+    /// The CMU motion-capture names (`Hips`, `LHipJoint`, `LeftUpLeg`, `LeftForeArm`, …), as
+    /// the CMU database's BVH conversions carry them.
+    #[default]
+    Cmu,
+    /// Mixamo's names (`mixamorig:Hips`, `mixamorig:Spine2`, `mixamorig:LeftUpLeg`, …), which
+    /// Blender's retargeting add-ons map onto Mixamo characters by name. The chest is
+    /// `Spine2` (Mixamo's top spine bone, that carries neck and shoulders); the hip joints,
+    /// which Mixamo does not have, are `LeftHipJoint`/`RightHipJoint`.
+    Mixamo,
+}
+
+impl RigNames {
+    /// Both sets, the default first.
+    pub const ALL: [RigNames; 2] = [RigNames::Cmu, RigNames::Mixamo];
+
+    /// The BVH name of rig joint `i` (End Sites have none).
+    pub fn name(self, i: usize) -> String {
+        let cmu = RIG[i].name;
+        match self {
+            RigNames::Cmu => cmu.to_owned(),
+            RigNames::Mixamo => {
+                let name = match cmu {
+                    "Chest" => "Spine2",
+                    "LHipJoint" => "LeftHipJoint",
+                    "RHipJoint" => "RightHipJoint",
+                    other => other,
+                };
+                format!("mixamorig:{name}")
+            }
+        }
+    }
+
+    /// The word a user types (`--rig cmu|mixamo`).
+    pub fn key(self) -> &'static str {
+        match self {
+            RigNames::Cmu => "cmu",
+            RigNames::Mixamo => "mixamo",
+        }
+    }
+}
 
 /// The rig joint (or End Site) that sits on each model joint, for reading positions back.
 pub fn rig_index_of(joint: Joint) -> usize {

@@ -2,6 +2,7 @@
 
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
+use videomocap_core::export::RigNames;
 
 const EXAMPLES: &str = "\
 Examples:
@@ -123,6 +124,11 @@ pub struct LiftOptions {
     /// file's `foot_lock`).
     #[arg(long)]
     pub no_foot_lock: bool,
+    /// Bone names in the BVH: `cmu` (Hips, LHipJoint, LeftUpLeg, …) or `mixamo`
+    /// (mixamorig:Hips, mixamorig:LeftUpLeg, …, for retargeting onto Mixamo characters);
+    /// the motion is the same (docs/formats.md).
+    #[arg(long, default_value = "cmu", value_parser = parse_rig)]
+    pub rig: RigNames,
 }
 
 /// `lift`.
@@ -158,6 +164,11 @@ pub struct ExportArgs {
     /// Frames per second, for skeleton3d files that do not record it (or to override it).
     #[arg(long)]
     pub fps: Option<f64>,
+    /// Bone names in the BVH: `cmu` (Hips, LHipJoint, LeftUpLeg, …) or `mixamo`
+    /// (mixamorig:Hips, mixamorig:LeftUpLeg, …, for retargeting onto Mixamo characters);
+    /// the motion is the same (docs/formats.md).
+    #[arg(long, default_value = "cmu", value_parser = parse_rig)]
+    pub rig: RigNames,
 }
 
 /// `run`.
@@ -209,6 +220,11 @@ pub struct BatchArgs {
     /// Track with VBA alone, without the pose network's evidence.
     #[arg(long)]
     pub no_network: bool,
+    /// Bone names in the BVH: `cmu` (Hips, LHipJoint, LeftUpLeg, …) or `mixamo`
+    /// (mixamorig:Hips, mixamorig:LeftUpLeg, …, for retargeting onto Mixamo characters);
+    /// the motion is the same (docs/formats.md).
+    #[arg(long, default_value = "cmu", value_parser = parse_rig)]
+    pub rig: RigNames,
 }
 
 /// `volume`.
@@ -223,6 +239,11 @@ pub struct VolumeArgs {
     /// Frames per second of the sequence.
     #[arg(long, default_value_t = 30.0)]
     pub fps: f64,
+    /// Bone names in the BVH: `cmu` (Hips, LHipJoint, LeftUpLeg, …) or `mixamo`
+    /// (mixamorig:Hips, mixamorig:LeftUpLeg, …, for retargeting onto Mixamo characters);
+    /// the motion is the same (docs/formats.md).
+    #[arg(long, default_value = "cmu", value_parser = parse_rig)]
+    pub rig: RigNames,
 }
 
 /// `carve`.
@@ -248,4 +269,15 @@ pub struct CarveArgs {
     /// carve is for (default: the largest blob). What is dropped is reported.
     #[arg(long)]
     pub person: Option<String>,
+}
+
+/// `--rig`: one of [`RigNames::ALL`]'s keys.
+fn parse_rig(s: &str) -> Result<RigNames, String> {
+    RigNames::ALL
+        .into_iter()
+        .find(|r| r.key().eq_ignore_ascii_case(s))
+        .ok_or_else(|| {
+            let keys: Vec<&str> = RigNames::ALL.iter().map(|r| r.key()).collect();
+            format!("unknown rig `{s}`: choose one of {}", keys.join(", "))
+        })
 }

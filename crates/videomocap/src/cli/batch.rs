@@ -218,6 +218,7 @@ fn run_row(a: &BatchArgs, row: &Row, threads: usize, quiet: &GlobalArgs) {
                 lift_settings: row.lift_settings.clone(),
                 lengths: row.lengths.clone(),
                 no_foot_lock: false,
+                rig: a.rig,
             };
             let (marks, keys) = match row.keys.as_deref() {
                 Some(k) if is_marks(k) => (Some(k), None),

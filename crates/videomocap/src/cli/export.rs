@@ -5,7 +5,7 @@ use super::args::{ExportArgs, GlobalArgs};
 use super::{ExitError, say};
 use anyhow::anyhow;
 use std::path::{Path, PathBuf};
-use videomocap_core::export::{self, BvhExport, WorldSkeleton};
+use videomocap_core::export::{self, BvhExport, RigNames, WorldSkeleton};
 use videomocap_core::formats::{self, Skeleton3d, Tracks2d};
 
 /// Which 3D files to write (any may be absent).
@@ -14,6 +14,8 @@ pub struct Outputs3d {
     pub bvh: Option<PathBuf>,
     pub csv: Option<PathBuf>,
     pub trc: Option<PathBuf>,
+    /// The BVH's bone names.
+    pub rig: RigNames,
 }
 
 /// What a 3D export wrote and measured.
@@ -36,7 +38,7 @@ pub fn write_3d(
     let mut bvh = None;
     let save = |path: &Path, text: &str| export::save_text(path, text).map_err(ExitError::failed);
     if let Some(path) = &outputs.bvh {
-        let out = export::bvh(&world).map_err(named)?;
+        let out = export::bvh(&world, outputs.rig).map_err(named)?;
         paths.push(save(path, &out.text)?);
         bvh = Some(out);
     }
@@ -91,6 +93,7 @@ pub fn run(a: &ExportArgs, global: &GlobalArgs) -> Result<(), ExitError> {
                 bvh: a.bvh.clone(),
                 csv: a.csv.clone(),
                 trc: a.trc.clone(),
+                rig: a.rig,
             };
             let written = write_3d(&skeleton, &a.input, a.fps, &outputs)?;
             report_3d(&written, global);

@@ -183,6 +183,7 @@ pub fn run(a: &LiftArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     if let Some(bvh) = &a.bvh {
         let outputs = super::export::Outputs3d {
             bvh: Some(bvh.clone()),
+            rig: a.options.rig,
             ..Default::default()
         };
         let written = super::export::write_3d(&out.skeleton, &a.output, None, &outputs)?;

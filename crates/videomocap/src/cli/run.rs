@@ -104,6 +104,7 @@ pub fn run_into(
         bvh: Some(out_dir.join(BVH)),
         csv: Some(out_dir.join(JOINTS_CSV)),
         trc: Some(out_dir.join(TRC)),
+        rig: input.options.rig,
     };
     let written = write_3d(&lifted.skeleton, &path, None, &outputs)?;
     report_3d(&written, global);

@@ -72,6 +72,7 @@ pub fn run(a: &VolumeArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         bvh: Some(a.out_dir.join("motion.bvh")),
         csv: Some(a.out_dir.join("joints3d.csv")),
         trc: Some(a.out_dir.join("motion.trc")),
+        rig: a.rig,
     };
     let written = write_3d(skeleton, &skeleton_path, None, &outputs)?;
     report_3d(&written, global);
