@@ -412,6 +412,74 @@ fn up_and_floor_of_a_captured_walk_are_found() {
     }
 }
 
+/// The floor rests on the feet the lift found planted: a clip with a jump (a third of it in
+/// the air) keeps its floor under the planted ankles, and the root leaves it and lands again;
+/// without any planted foot the floor is a guess from the lowest ankles, and says so.
+#[test]
+fn the_floor_rests_on_the_planted_feet_and_a_jump_leaves_it() {
+    use videomocap_core::export::{FloorSource, world::ANKLE_HEIGHT_FRACTION, world::stature_m};
+    let mut world = cmu_walk();
+    let n = world.len();
+    let jump = n / 3..2 * n / 3;
+    for p in &mut world[jump.clone()] {
+        for q in p.0.iter_mut() {
+            q.y += 0.3;
+        }
+    }
+    let lowest = world
+        .iter()
+        .map(|p| p[Joint::LeftAnkle].y.min(p[Joint::RightAnkle].y))
+        .fold(f64::INFINITY, f64::min);
+    let mut skeleton = to_camera(&world, 0.8, 0.2);
+    for (t, f) in skeleton.frames.iter_mut().enumerate() {
+        for (ankle, name) in [
+            (Joint::LeftAnkle, "left_ankle"),
+            (Joint::RightAnkle, "right_ankle"),
+        ] {
+            if !jump.contains(&t) && world[t][ankle].y < lowest + 0.03 {
+                f.flags.push(format!("{CONTACT_FLAG}{name}"));
+            }
+        }
+    }
+    let ws = WorldSkeleton::new(&skeleton, None).unwrap();
+    assert!(matches!(ws.world.floor_source, FloorSource::PlantedFeet { frames } if frames > 20));
+    let ankle_height = ANKLE_HEIGHT_FRACTION * stature_m(&ws.frames);
+    let mut planted = Vec::new();
+    for t in 0..n {
+        for a in [Joint::LeftAnkle, Joint::RightAnkle] {
+            if ws.contact[t][a] {
+                planted.push(ws.frames[t][a].y);
+            }
+        }
+    }
+    planted.sort_by(f64::total_cmp);
+    let median = planted[planted.len() / 2];
+    assert!(
+        (median - ankle_height).abs() < 0.01,
+        "{median} against {ankle_height}"
+    );
+    // The root leaves the floor by the jump's height and lands again.
+    let (before, top, after) = (jump.start - 1, jump.start + 1, jump.end);
+    let rise = |a: usize, b: usize, w: &[PerJoint<Point3<f64>>]| {
+        w[b][Joint::Pelvis].y - w[a][Joint::Pelvis].y
+    };
+    assert!((rise(before, top, &ws.frames) - rise(before, top, &world)).abs() < 0.01);
+    assert!((rise(before, after, &ws.frames) - rise(before, after, &world)).abs() < 0.01);
+    // No planted foot: the lowest ankles, said to be a guess.
+    for f in &mut skeleton.frames {
+        f.flags.clear();
+    }
+    let guessed = WorldSkeleton::new(&skeleton, None).unwrap();
+    assert_eq!(guessed.world.floor_source, FloorSource::LowestAnkles);
+    assert!(
+        guessed
+            .world
+            .floor_source
+            .to_string()
+            .contains("check the floor")
+    );
+}
+
 #[test]
 fn csv_and_trc_hold_every_joint_of_every_frame() {
     let m = Motion {
@@ -518,7 +586,7 @@ fn the_real_sample_round_trips_within_a_millimetre() {
     assert!(b.max_round_trip_m < 1e-3);
     // Up from the lifted skeleton against up from the reference's own 3D joints.
     let reference: Vec<PerJoint<Point3<f64>>> = gt.frames.iter().map(|f| f.points3d()).collect();
-    let reference_up = videomocap_core::export::WorldFrame::estimate(&reference).unwrap();
+    let reference_up = videomocap_core::export::WorldFrame::estimate(&reference, &[]).unwrap();
     let angle = ws
         .world
         .up_in_camera()

@@ -16,7 +16,7 @@ pub use bvh_writer::{BVH_UNITS_PER_METRE, ROTATION_CHANNELS, bvh_text};
 pub use euler::zxy_degrees;
 pub use rig::RigNames;
 pub use tables::{skeleton_csv, tracks_csv, trc};
-pub use world::{UpSource, WorldFrame};
+pub use world::{FloorSource, UpSource, WorldFrame};
 
 use crate::formats::{
     CONTACT_FLAG, FormatError, FrameIndex, LOST_FLAG, OFF_FRAME_FLAG, Skeleton3d, write_atomically,
@@ -80,7 +80,12 @@ impl WorldSkeleton {
             return Err(ExportError::BadFps(fps));
         }
         let camera: Vec<PerJoint<Point3<f64>>> = skeleton.frames.iter().map(|f| f.points).collect();
-        let world = WorldFrame::estimate(&camera)?;
+        let contact: Vec<PerJoint<bool>> = skeleton
+            .frames
+            .iter()
+            .map(|f| f.joint_flags(CONTACT_FLAG))
+            .collect();
+        let world = WorldFrame::estimate(&camera, &contact)?;
         let frames = camera
             .iter()
             .map(|p| p.map(|_, q| world.to_world(q)))
@@ -100,11 +105,7 @@ impl WorldSkeleton {
                 .iter()
                 .map(|f| f.joint_flags(LOST_FLAG))
                 .collect(),
-            contact: skeleton
-                .frames
-                .iter()
-                .map(|f| f.joint_flags(CONTACT_FLAG))
-                .collect(),
+            contact,
         })
     }
 

@@ -28,9 +28,42 @@ const PLANE_FLATNESS: f64 = 0.1;
 /// An estimate of "up" further than this from the trunk's mean direction is not trusted.
 const MAX_TILT_FROM_TRUNK_DEG: f64 = 30.0;
 
-/// Share of frames whose lowest ankle is taken to be on the floor (the lower quantile of the
-/// lowest ankle's height; jumps and noise lie above it).
+/// The share of the floor's frames whose lower ankle is taken to be on the floor (the lower
+/// quantile of the lower ankle's height: noise, and without planted feet jumps, lie above it).
 const FLOOR_QUANTILE: f64 = 0.2;
+
+/// Frames with a planted foot needed before the floor is taken from them alone (two short
+/// contacts).
+const MIN_PLANTED_FRAMES: usize = 6;
+
+/// Where the floor came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FloorSource {
+    /// The frames on which the lift found a foot planted (`contact:` flags): the floor lies
+    /// under their lower ankles, so the root's height over the floor is read from the contacts
+    /// over the whole clip, and a jump (no foot planted) leaves the floor and lands on it
+    /// again however long it lasts.
+    PlantedFeet {
+        /// Frames with a planted foot the floor rests on.
+        frames: usize,
+    },
+    /// No foot was found planted (or on too few frames): the floor lies under every frame's
+    /// lower ankle, a guess worth a look (a jump that fills most of the clip would lift it).
+    LowestAnkles,
+}
+
+impl std::fmt::Display for FloorSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FloorSource::PlantedFeet { frames } => {
+                write!(f, "under the planted feet ({frames} frames)")
+            }
+            FloorSource::LowestAnkles => f.write_str(
+                "under the lowest ankles (no foot found planted: a guess, check the floor)",
+            ),
+        }
+    }
+}
 
 /// How "up" was found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -65,6 +98,8 @@ pub struct WorldFrame {
     pub origin_in_camera: Point3<f64>,
     /// How up was found.
     pub up_source: UpSource,
+    /// Where the floor came from.
+    pub floor_source: FloorSource,
 }
 
 impl WorldFrame {
@@ -83,17 +118,22 @@ impl WorldFrame {
         self.rotation.matrix().row(1).transpose()
     }
 
-    /// Estimates up, the floor and the origin from a camera-space sequence:
+    /// Estimates up, the floor and the origin from a camera-space sequence and, per frame,
+    /// the ankles found planted on the floor (`contacts`, may be empty):
     /// 1. the trunk's mean direction (pelvis → neck, each frame's unit vector averaged) is a
     ///    first "up";
-    /// 2. each frame's lower ankle along it is a floor contact; if the contacts spread over the
-    ///    floor in two directions their best-fit plane's normal is up, if they spread along one
-    ///    line (a walk) that line is taken as horizontal and removed from the trunk direction,
-    ///    otherwise the trunk direction stays (a result tilted more than 30° from the trunk is
-    ///    not trusted);
+    /// 2. the floor's points are the lower ankle (along the trunk) of each frame with a
+    ///    planted foot, or of every frame when fewer than [`MIN_PLANTED_FRAMES`] have one
+    ///    ([`FloorSource`]); if they spread over the floor in two directions their best-fit
+    ///    plane's normal is up, if they spread along one line (a walk) that line is taken as
+    ///    horizontal and removed from the trunk direction, otherwise the trunk direction stays
+    ///    (a result tilted more than 30° from the trunk is not trusted);
     /// 3. the floor lies [`ANKLE_HEIGHT_FRACTION`] of the stature (from the bone lengths) under
-    ///    the lower 20 % quantile of the contacts' heights.
-    pub fn estimate(frames: &[PerJoint<Point3<f64>>]) -> Result<WorldFrame, ExportError> {
+    ///    the lower 20 % quantile of their heights.
+    pub fn estimate(
+        frames: &[PerJoint<Point3<f64>>],
+        contacts: &[PerJoint<bool>],
+    ) -> Result<WorldFrame, ExportError> {
         let first = frames.first().ok_or(ExportError::NoFrames)?;
         let mut trunk = Vector3::zeros();
         for f in frames {
@@ -102,20 +142,30 @@ impl WorldFrame {
             }
         }
         let trunk = trunk.try_normalize(1e-9).unwrap_or_else(|| -Vector3::y());
-        let contacts: Vec<Point3<f64>> = frames
+        let lowest_of = |f: &PerJoint<Point3<f64>>| {
+            let (l, r) = (f[Joint::LeftAnkle], f[Joint::RightAnkle]);
+            if l.coords.dot(&trunk) <= r.coords.dot(&trunk) {
+                l
+            } else {
+                r
+            }
+        };
+        let planted: Vec<Point3<f64>> = frames
             .iter()
-            .map(|f| {
-                let (l, r) = (f[Joint::LeftAnkle], f[Joint::RightAnkle]);
-                if l.coords.dot(&trunk) <= r.coords.dot(&trunk) {
-                    l
-                } else {
-                    r
-                }
-            })
+            .zip(contacts)
+            .filter(|(_, c)| c[Joint::LeftAnkle] || c[Joint::RightAnkle])
+            .map(|(f, _)| lowest_of(f))
             .collect();
-        let (up, up_source) = up_from_contacts(&contacts, trunk);
+        let (points, floor_source) = if planted.len() >= MIN_PLANTED_FRAMES {
+            let frames = planted.len();
+            (planted, FloorSource::PlantedFeet { frames })
+        } else {
+            let lowest = frames.iter().map(lowest_of).collect();
+            (lowest, FloorSource::LowestAnkles)
+        };
+        let (up, up_source) = up_from_contacts(&points, trunk);
         let stature = stature_m(frames);
-        let mut heights: Vec<f64> = contacts.iter().map(|c| c.coords.dot(&up)).collect();
+        let mut heights: Vec<f64> = points.iter().map(|c| c.coords.dot(&up)).collect();
         heights.sort_by(f64::total_cmp);
         let k = ((heights.len() - 1) as f64 * FLOOR_QUANTILE).round() as usize;
         let floor = heights[k] - ANKLE_HEIGHT_FRACTION * stature;
@@ -134,6 +184,7 @@ impl WorldFrame {
             rotation: Rotation3::from_matrix_unchecked(rows),
             origin_in_camera,
             up_source,
+            floor_source,
         })
     }
 }

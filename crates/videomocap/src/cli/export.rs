@@ -59,8 +59,9 @@ pub fn report_3d(w: &Written3d, global: &GlobalArgs) {
     say(
         global,
         &format!(
-            "world: up from the {}; {} frames at {} fps",
+            "world: up from the {}; the floor {}; {} frames at {} fps",
             w.world.world.up_source,
+            w.world.world.floor_source,
             w.world.frames.len(),
             w.world.fps
         ),
@@ -102,6 +103,7 @@ pub fn run(a: &ExportArgs, global: &GlobalArgs) -> Result<(), ExitError> {
                     "frames": written.world.frames.len(),
                     "fps": written.world.fps,
                     "up_source": written.world.world.up_source.to_string(),
+                    "floor_source": written.world.world.floor_source.to_string(),
                     "bvh_round_trip_mm": written.bvh.as_ref().map(|b| b.max_round_trip_m * 1000.0),
                     "bvh_max_euler_step_deg": written.bvh.as_ref().map(|b| b.max_angle_step_deg),
                     "written": written.paths,

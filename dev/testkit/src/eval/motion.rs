@@ -1,8 +1,9 @@
 //! Motion quality as an animator sees it, against the reference motion capture: jitter (the
 //! mean third difference of the joints, as WHAM reports it, beside the reference's own), foot
 //! sliding (the ankle's horizontal travel over each of the reference's contact phases, beside
-//! the reference's own), the root's path over the clip after aligning the first frame, and the
-//! acceleration error of the pelvis-aligned joints.
+//! the reference's own), the root's path over the clip after aligning the first frame, the
+//! root's height over the floor as each export finds its floor, and the acceleration error of
+//! the pelvis-aligned joints.
 //!
 //! "Horizontal" and "height" are the reference's: its floor is found by the exporter's own
 //! [`WorldFrame::estimate`] on the reference skeleton, and the estimate (in the same camera
@@ -11,7 +12,7 @@
 use crate::synth::GroundTruth;
 use nalgebra::{Point3, Vector3};
 use videomocap_core::export::WorldFrame;
-use videomocap_core::formats::Skeleton3d;
+use videomocap_core::formats::{CONTACT_FLAG, Skeleton3d};
 use videomocap_core::skeleton::{Joint, PerJoint};
 
 /// A reference ankle is in contact when it is within this height of its lowest (metres) ...
@@ -45,6 +46,12 @@ pub struct MotionScore {
     pub root_m: f64,
     /// Frames of the root path.
     pub root_n: usize,
+    /// |the pelvis's height over the floor − the reference's|, metres, summed over the root
+    /// path's frames: each in its own export world, the estimate's floor from its planted
+    /// feet (the `contact:` flags; the lowest ankles when it has none).
+    pub root_height_m: f64,
+    /// The same with the estimate's floor from its lowest ankles (as before contacts).
+    pub root_height_lowest_m: f64,
     /// |estimated − reference| acceleration of the pelvis-aligned joints, m/s², summed.
     pub accel: f64,
     /// Joint samples of the acceleration.
@@ -62,6 +69,8 @@ impl MotionScore {
         self.phases += o.phases;
         self.root_m += o.root_m;
         self.root_n += o.root_n;
+        self.root_height_m += o.root_height_m;
+        self.root_height_lowest_m += o.root_height_lowest_m;
         self.accel += o.accel;
         self.accel_n += o.accel_n;
     }
@@ -83,6 +92,16 @@ impl MotionScore {
         1000.0 * self.root_m / self.root_n.max(1) as f64
     }
 
+    /// Mean root height error, millimetres: the floor from the planted feet, and from the
+    /// lowest ankles.
+    pub fn root_height_mm(&self) -> (f64, f64) {
+        let n = self.root_n.max(1) as f64;
+        (
+            1000.0 * self.root_height_m / n,
+            1000.0 * self.root_height_lowest_m / n,
+        )
+    }
+
     /// Mean acceleration error, m/s².
     pub fn accel(&self) -> f64 {
         self.accel / self.accel_n.max(1) as f64
@@ -102,12 +121,13 @@ fn scored(gt: &GroundTruth) -> Vec<Joint> {
 /// hold; `None` when the reference's floor cannot be found or no run is four frames long.
 pub fn score_motion(gt: &GroundTruth, skeleton: &Skeleton3d) -> Option<MotionScore> {
     // The frames both have, in order, in runs of consecutive indices.
-    let pairs: Vec<(usize, Pose, Pose)> = skeleton
+    let pairs: Vec<(usize, Pose, Pose, PerJoint<bool>)> = skeleton
         .frames
         .iter()
         .filter_map(|f| {
             let t = f.index.get();
-            Some((t, f.points, gt.frames.get(t)?.points3d()))
+            let contact = f.joint_flags(CONTACT_FLAG);
+            Some((t, f.points, gt.frames.get(t)?.points3d(), contact))
         })
         .collect();
     let start = (0..pairs.len())
@@ -124,7 +144,10 @@ pub fn score_motion(gt: &GroundTruth, skeleton: &Skeleton3d) -> Option<MotionSco
     }
     let est: Vec<_> = pairs.iter().map(|p| p.1).collect();
     let truth: Vec<_> = pairs.iter().map(|p| p.2).collect();
-    let world = WorldFrame::estimate(&truth).ok()?;
+    let contacts: Vec<_> = pairs.iter().map(|p| p.3).collect();
+    let world = WorldFrame::estimate(&truth, &[]).ok()?;
+    let est_world = WorldFrame::estimate(&est, &contacts).ok()?;
+    let est_lowest = WorldFrame::estimate(&est, &[]).ok()?;
     let fps = gt.fps;
     let joints = scored(gt);
     let mut s = MotionScore::default();
@@ -159,6 +182,11 @@ pub fn score_motion(gt: &GroundTruth, skeleton: &Skeleton3d) -> Option<MotionSco
         let r = truth[t][Joint::Pelvis] - truth[0][Joint::Pelvis];
         s.root_m += (e - r).norm();
         s.root_n += 1;
+        let height = |w: &WorldFrame, p: &Point3<f64>| w.to_world(p).y;
+        let truth_height = height(&world, &truth[t][Joint::Pelvis]);
+        s.root_height_m += (height(&est_world, &est[t][Joint::Pelvis]) - truth_height).abs();
+        s.root_height_lowest_m +=
+            (height(&est_lowest, &est[t][Joint::Pelvis]) - truth_height).abs();
     }
     // Foot sliding over the reference's contact phases.
     let up = |v: Vector3<f64>| (world.rotation * v).y;
@@ -243,6 +271,11 @@ mod tests {
         let same = score_motion(&gt, &skeleton_of(&gt, |_, p| p)).unwrap();
         assert!(same.phases > 0, "a walk has contact phases");
         assert!(same.root_mm() < 1e-9 && same.accel() < 1e-9);
+        assert!(
+            same.root_height_mm().0 < 1e-6,
+            "{:?}",
+            same.root_height_mm()
+        );
         let (j, rj) = same.jitter();
         assert!((j - rj).abs() < 1e-9);
         let (sl, rsl) = same.slide_cm();
