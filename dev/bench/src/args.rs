@@ -208,9 +208,11 @@ pub struct BenchArgs {
     /// doubt, swap cost, motion, key fade frames, jump cap (torso lengths).
     #[arg(long)]
     pub evidence: Option<String>,
-    /// `learned` only: keep each clip's VBA tracks and network output in its folder
-    /// (`learned-vba.json`, `learned-net.json`) and read them back when there, for sweeps of the weighing alone.
-    /// Stale after any change to the tracker or the network: delete the files then.
+    /// Keep what is slow to make in each clip's folder and read it back when there, for sweeps
+    /// of what comes after: `learned`'s VBA tracks and network output (`learned-vba.json`,
+    /// `learned-net.json`); `lift --network` and `motion`'s network frames on the true 2D
+    /// (`lift-net.json`) and tracker output (`tracked-net.json`). Stale after any change to
+    /// the tracker or the network: delete the files then.
     #[arg(long)]
     pub reuse: bool,
     /// `correct`: track as the product does, with the pose network's evidence (without it,

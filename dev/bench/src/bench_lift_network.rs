@@ -218,8 +218,15 @@ pub(crate) fn inputs_with_network(
     for (f, seen) in exact.frames.iter_mut().zip(&net) {
         f.body3d = seen.body().map(Box::new);
     }
+    // With `--reuse`, the tracker's output is kept beside the clip (stale after any change
+    // to the tracker or the network: delete the file then).
+    let cache = clip.dir.join("tracked-net.json");
     let tracked = if a.no_tracker {
         None
+    } else if a.reuse
+        && let Ok(t) = Tracks2d::load(&cache)
+    {
+        Some(t)
     } else {
         let job = TrackJob::from_marks(&opened.marks, TrackerParams::default(), threads)
             .with_network(Some(network.clone()));
@@ -230,6 +237,9 @@ pub(crate) fn inputs_with_network(
             &AtomicBool::new(false),
         )
         .map_err(ExitError::failed)?;
+        if a.reuse {
+            out.tracks.save(&cache).map_err(ExitError::failed)?;
+        }
         Some(out.tracks)
     };
     Ok((exact, tracked))

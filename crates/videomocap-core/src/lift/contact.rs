@@ -1,5 +1,5 @@
-//! The lift's last stage: feet on the floor. A foot is in contact while its ankle is slow in the
-//! image and no higher than the other ankle (with hysteresis); over each contact the body is
+//! The lift's last stage: feet on the floor. A foot is in contact while its ankle is seen, slow
+//! in the image and no higher than the other ankle (with hysteresis); over each contact the body is
 //! moved as one rigid piece along the planted ankle's viewing ray, so that the ankle keeps one
 //! depth and stays on its 2D track, and the moves are blended across the swings between. A single camera sees
 //! depth worst: a body that wanders a few centimetres towards and away from the camera per
@@ -33,14 +33,17 @@ const MIN_CONTACT_FRAMES: usize = 3;
 const BLEND_FRAMES: f64 = 1.0;
 
 /// Finds each foot's contacts (see the module's note); `images` are the tracks the lift was
-/// solved on, `points` the skeleton in camera space.
+/// solved on, `points` the skeleton in camera space, `seen` per frame whether each ankle's
+/// track was seen (not lost, not off the frame): a foot is never planted where it was not seen,
+/// and a contact broken by such a span is two contacts.
 pub fn foot_contacts(
     cam: &PinholeCamera,
     images: &[PerJoint<Point2<f64>>],
     points: &[PerJoint<Point3<f64>>],
+    seen: &[[bool; 2]],
     fps: f64,
 ) -> FootContacts {
-    let n = points.len().min(images.len());
+    let n = points.len().min(images.len()).min(seen.len());
     let up = points
         .iter()
         .map(|p| (p[Joint::Neck] - p[Joint::Pelvis]).normalize())
@@ -57,7 +60,8 @@ pub fn foot_contacts(
             let pixels = (images[b][ankle] - images[a][ankle]).norm() / (b - a).max(1) as f64;
             let speed = pixels * points[t][ankle].z.max(0.1) / cam.focal_px * fps;
             let higher = (points[t][ankle] - points[t][other]).dot(&up);
-            planted = higher < HIGHER_M
+            planted = seen[t][k]
+                && higher < HIGHER_M
                 && if planted {
                     speed < LEAVE_SPEED_M_S
                 } else {
@@ -200,7 +204,7 @@ mod tests {
     #[test]
     fn a_still_foot_is_planted_and_the_swinging_one_is_not() {
         let (cam, images, lifted) = wandering(20);
-        let c = foot_contacts(&cam, &images, &lifted, 30.0);
+        let c = foot_contacts(&cam, &images, &lifted, &[[true; 2]; 20], 30.0);
         assert!(c.iter().all(|f| f[0]), "the left foot stands");
         assert!(
             c.iter().filter(|f| f[1]).count() < 5,
@@ -208,11 +212,28 @@ mod tests {
         );
     }
 
+    /// A foot lost for a span is not planted there, and the span splits its contact.
+    #[test]
+    fn a_foot_lost_for_a_span_is_not_planted_there() {
+        let (cam, images, lifted) = wandering(20);
+        let mut seen = [[true; 2]; 20];
+        (8..12).for_each(|t| seen[t][0] = false);
+        let c = foot_contacts(&cam, &images, &lifted, &seen, 30.0);
+        assert!((8..12).all(|t| !c[t][0]), "not planted while lost");
+        assert!((0..8).chain(12..20).all(|t| c[t][0]), "planted either side");
+        // Lost on every frame: no contact at all, and planting moves nothing.
+        let c = foot_contacts(&cam, &images, &lifted, &[[false; 2]; 20], 30.0);
+        assert!(c.iter().all(|f| !f[0] && !f[1]));
+        let mut moved = lifted.clone();
+        plant_feet(&mut moved, &c);
+        assert_eq!(moved, lifted);
+    }
+
     #[test]
     fn planting_holds_the_foots_depth_and_keeps_the_body_rigid() {
         let (cam, images, mut lifted) = wandering(20);
         let before = lifted.clone();
-        let c = foot_contacts(&cam, &images, &lifted, 30.0);
+        let c = foot_contacts(&cam, &images, &lifted, &[[true; 2]; 20], 30.0);
         plant_feet(&mut lifted, &c);
         let depth = |p: &[PerJoint<Point3<f64>>]| {
             let z: Vec<f64> = p.iter().map(|q| q[Joint::LeftAnkle].z).collect();

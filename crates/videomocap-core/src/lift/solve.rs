@@ -890,7 +890,21 @@ fn plant(
     }
     let mut points: Vec<PerJoint<Point3<f64>>> = skeleton.frames.iter().map(|f| f.points).collect();
     let fps = skeleton.fps.unwrap_or(30.0);
-    let contacts = super::contact::foot_contacts(&job.camera, images, &points, fps);
+    // A foot lost or off the frame is never planted.
+    let seen: Vec<[bool; 2]> = job
+        .tracks
+        .frames
+        .iter()
+        .map(|f| {
+            super::contact::FEET.map(|a| {
+                !matches!(
+                    f.points[a].source,
+                    PointSource::Lost | PointSource::OffFrame
+                )
+            })
+        })
+        .collect();
+    let contacts = super::contact::foot_contacts(&job.camera, images, &points, &seen, fps);
     super::contact::plant_feet(&mut points, &contacts);
     for ((f, p), c) in skeleton.frames.iter_mut().zip(points).zip(&contacts) {
         f.points = p;
