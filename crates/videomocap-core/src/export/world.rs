@@ -123,7 +123,7 @@ impl WorldFrame {
     /// 1. the trunk's mean direction (pelvis → neck, each frame's unit vector averaged) is a
     ///    first "up";
     /// 2. the floor's points are the lower ankle (along the trunk) of each frame with a
-    ///    planted foot, or of every frame when fewer than [`MIN_PLANTED_FRAMES`] have one
+    ///    planted foot, or of every frame when fewer than 6 have one
     ///    ([`FloorSource`]); if they spread over the floor in two directions their best-fit
     ///    plane's normal is up, if they spread along one line (a walk) that line is taken as
     ///    horizontal and removed from the trunk direction, otherwise the trunk direction stays

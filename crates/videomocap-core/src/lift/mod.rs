@@ -24,10 +24,13 @@ mod backproject;
 mod calibrate;
 mod contact;
 mod error;
+mod facing;
 mod focal;
+mod key_candidates;
 mod key_path;
 mod least_squares;
 mod newton;
+mod params;
 mod pipeline;
 mod propagate;
 mod refine;
@@ -43,10 +46,11 @@ pub use calibrate::{KEY_JOINTS, KeyTriangle};
 pub use contact::{FEET, FootContacts};
 pub use error::LiftError;
 pub use focal::{DEFAULT_FOV_LONG_SIDE_DEG, default_focal};
+pub use params::LiftParams;
 pub use pipeline::{
     CameraChoice, FocalSource, LiftStage, Reconstruction, SubjectChoice, reconstruct,
 };
 pub use refine::RefineParams;
 pub use report::{BoneDepth, FrameFlag, FrameReport, UNSURE_MARGIN};
-pub use solve::{LiftJob, LiftOutput, LiftParams, LiftProgress, PerFrame, lift, lift_per_frame};
+pub use solve::{LiftJob, LiftOutput, LiftProgress, PerFrame, lift, lift_per_frame};
 pub use subject_fit::{SubjectFit, subject_from_height};

@@ -4,7 +4,8 @@
 
 use super::error::LiftError;
 use super::focal::{default_focal, estimate_focal};
-use super::solve::{LiftJob, LiftOutput, LiftParams, lift};
+use super::params::LiftParams;
+use super::solve::{LiftJob, LiftOutput, lift};
 use super::subject_fit::{SubjectFit, subject_from_height};
 use super::{DepthOverrides, LiftProgress};
 use crate::camera::PinholeCamera;

@@ -2,8 +2,9 @@
 //! and running each arm repeats the other's swing half a stride later, mirrored left to right.
 //! The lag is read from the thighs (solved before the arms), whose forward swing alternates.
 
+use super::priors::TrunkFrame;
 use super::{Group, LeftElbow, LeftShoulder, LeftWrist, RightElbow, RightShoulder, RightWrist};
-use super::{Joint, LeftHip, LeftKnee, RightHip, RightKnee, TrunkFrame};
+use super::{Joint, LeftHip, LeftKnee, RightHip, RightKnee};
 use crate::skeleton::PerJoint;
 use nalgebra::{Point3, Vector3};
 

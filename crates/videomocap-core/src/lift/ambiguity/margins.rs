@@ -3,7 +3,8 @@
 //! candidate (the forward pass of [`super::viterbi`] met by the same pass run backwards), so a
 //! bone's margin on a frame is what taking its other root there would cost the clip at best.
 
-use super::{Candidate, acceleration, first_pair, forward_step};
+use super::Candidate;
+use super::viterbi::{acceleration, first_pair, forward_step};
 
 /// Per frame and candidate, the least total of the sequence with that frame at that candidate
 /// (the same costs as [`super::viterbi`]: unaries, the first two frames' velocity, squared
@@ -58,7 +59,7 @@ pub(super) fn min_marginals(candidates: &[Vec<Candidate>]) -> Vec<Vec<f64>> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{VELOCITY_WEIGHT, test_candidate as cand, viterbi};
+    use super::super::viterbi::{VELOCITY_WEIGHT, test_candidate as cand, viterbi};
     use super::*;
 
     /// Brute force over every path: each frame's min-marginal is the best path through it, and

@@ -1,8 +1,9 @@
 //! Tests of the parent module.
 
+use super::priors::*;
+use super::viterbi::test_candidate as cand;
+use super::weights::*;
 use super::*;
-
-use super::test_candidate as cand;
 
 #[test]
 fn viterbi_prefers_a_smooth_crossing_to_a_bounce() {

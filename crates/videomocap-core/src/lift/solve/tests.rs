@@ -1,5 +1,9 @@
 //! Tests of the parent module.
 
+use super::super::calibrate::{Residuals, calibrate_from};
+use super::super::facing::*;
+use super::super::key_candidates::*;
+use super::super::key_path::{centroid, tilt_m};
 use super::*;
 use nalgebra::Vector3;
 
