@@ -412,9 +412,9 @@ fn up_and_floor_of_a_captured_walk_are_found() {
     }
 }
 
-/// The floor rests on the feet the lift found planted: a clip with a jump (a third of it in
-/// the air) keeps its floor under the planted ankles, and the root leaves it and lands again;
-/// without any planted foot the floor is a guess from the lowest ankles, and says so.
+/// A clip with a jump (a third of it in the air) keeps its floor under the ankles the lift
+/// found planted, and the root leaves it and lands again; without any planted foot the floor
+/// is said to be a guess.
 #[test]
 fn the_floor_rests_on_the_planted_feet_and_a_jump_leaves_it() {
     use videomocap_core::export::{FloorSource, world::ANKLE_HEIGHT_FRACTION, world::stature_m};
@@ -442,7 +442,7 @@ fn the_floor_rests_on_the_planted_feet_and_a_jump_leaves_it() {
         }
     }
     let ws = WorldSkeleton::new(&skeleton, None).unwrap();
-    assert!(matches!(ws.world.floor_source, FloorSource::PlantedFeet { frames } if frames > 20));
+    assert!(matches!(ws.world.floor_source, FloorSource::FeetPlanted { frames } if frames > 20));
     let ankle_height = ANKLE_HEIGHT_FRACTION * stature_m(&ws.frames);
     let mut planted = Vec::new();
     for t in 0..n {
@@ -470,7 +470,7 @@ fn the_floor_rests_on_the_planted_feet_and_a_jump_leaves_it() {
         f.flags.clear();
     }
     let guessed = WorldSkeleton::new(&skeleton, None).unwrap();
-    assert_eq!(guessed.world.floor_source, FloorSource::LowestAnkles);
+    assert_eq!(guessed.world.floor_source, FloorSource::NoFootPlanted);
     assert!(
         guessed
             .world

@@ -269,11 +269,32 @@ fn lift_writes_a_skeleton_and_refuses_a_bad_focal_length() {
     assert!(!out.exists());
     // A settings file with a weight out of its range is named with the setting.
     let settings = dir.path().join("settings.json");
-    std::fs::write(&settings, r#"{"ambiguity": {"elbow": -5}}"#).unwrap();
+    std::fs::write(&settings, r#"{"arm_swing": -5}"#).unwrap();
     let ss = settings.to_str().unwrap();
     assert_bad(
         &["lift", tp, "-o", outs, "--lift-settings", ss],
-        &[ss, "ambiguity.elbow", "0 or more"],
+        &[ss, "arm_swing", "0 or more"],
+    );
+    assert!(!out.exists());
+    // An older file: its retired settings are named and ignored, a renamed one carries over.
+    std::fs::write(
+        &settings,
+        r#"{"ambiguity": {"elbow": -5, "contact": 3}, "calibration_tolerance_px": 2}"#,
+    )
+    .unwrap();
+    let (code, stderr) = run(&["lift", tp, "-o", outs, "--lift-settings", ss]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stderr.contains("retired") && stderr.contains("ambiguity.elbow, calibration_tolerance_px"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("ambiguity.contact"), "{stderr}");
+    std::fs::remove_file(&out).unwrap();
+    // A name that never was a setting is refused.
+    std::fs::write(&settings, r#"{"elbow_weight": 1}"#).unwrap();
+    assert_bad(
+        &["lift", tp, "-o", outs, "--lift-settings", ss],
+        &[ss, "elbow_weight"],
     );
     assert!(!out.exists());
     let (code, stderr) = run(&[

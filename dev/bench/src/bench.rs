@@ -27,9 +27,7 @@ pub fn run(what: &str, a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitErr
         return crate::bench_correct::run(a, global);
     }
     if what == "lift" && a.network {
-        let default = videomocap_core::lift::LiftParams::default()
-            .ambiguity
-            .image_depth;
+        let default = videomocap_core::lift::LiftParams::default().image_depth;
         return crate::bench_lift_network::run(
             a,
             global,

@@ -191,7 +191,7 @@ fn score_input(
     ];
     for &w in weights {
         let mut p = *params;
-        p.ambiguity.image_depth = w;
+        p.image_depth = w;
         out.push(column(&lift(tracks, &p)?)?);
     }
     Ok(out)

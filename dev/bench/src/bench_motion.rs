@@ -1,7 +1,7 @@
 //! `videomocap bench motion`: what an animator sees in the motion (issue 82): jitter beside the
 //! reference motion capture's own, foot sliding over the reference's contact phases beside the
 //! reference's own, the root's path after aligning the first frame, the root's height over the
-//! floor (the floor from the lowest ankles and from the planted feet), and acceleration error
+//! floor (each in its export world), and acceleration error
 //! ([`videomocap_testkit::eval::motion`]), for the lift and the flat cut-out on the same input.
 //!
 //! Inputs: (a) the true 2D with the pose network's 3D body (run from the clicked marks, as
@@ -128,7 +128,7 @@ fn score_clip(
     Ok(scores)
 }
 
-const WIDTH: usize = 65;
+const WIDTH: usize = 60;
 
 fn cell(s: &([MotionScore; 3], LockShift)) -> String {
     let [free, locked, flat] = &s.0;
@@ -138,7 +138,7 @@ fn cell(s: &([MotionScore; 3], LockShift)) -> String {
     let (_, rj) = free.jitter();
     let (_, rsl) = free.slide_cm();
     format!(
-        "{:>4.0}/{:<4.0} {:>4.1}>{:<4.1}/{:<3.1} {:>4.1} {:>4.0}>{:<4.0} {:>4.0}>{:<4.0} {:>5.1} {:>3.1}/{:<4.1}",
+        "{:>4.0}/{:<4.0} {:>4.1}>{:<4.1}/{:<3.1} {:>4.1} {:>4.0}>{:<4.0} {:>5.0} {:>5.1} {:>3.1}/{:<4.1}",
         locked.jitter().0,
         rj,
         free.slide_cm().0,
@@ -147,8 +147,7 @@ fn cell(s: &([MotionScore; 3], LockShift)) -> String {
         flat.slide_cm().0,
         free.root_mm(),
         locked.root_mm(),
-        locked.root_height_mm().1,
-        locked.root_height_mm().0,
+        locked.root_height_mm(),
         locked.accel(),
         s.1.sum_px / s.1.n.max(1) as f64,
         s.1.max_px
@@ -167,11 +166,11 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         tally.add(clip, &s);
     }
     let columns = format!(
-        "{:>9} {:>14} {:>4} {:>9} {:>9} {:>5} {:>8}",
-        "jitter/ref", "slide>lock/ref", "cut", "root>lock", "floor>feet", "accel", "px m/max"
+        "{:>9} {:>14} {:>4} {:>9} {:>5} {:>5} {:>8}",
+        "jitter/ref", "slide>lock/ref", "cut", "root>lock", "height", "accel", "px m/max"
     );
     let mut out = vec![
-        "motion of the lift (stated height, default camera): jitter m/s³ with the foot lock (the reference's own after /); foot sliding, cm per reference contact phase, without > with the lock (the reference's own after /), the cut-out's; root path error mm (first frame aligned) without > with; the root's height over the floor, error mm, with the lock, the floor under the lowest ankles > under the planted feet; acceleration error m/s²; how far the lock moved a held ankle in the image, px mean / max".to_owned(),
+        "motion of the lift (stated height, default camera): jitter m/s³ with the foot lock (the reference's own after /); foot sliding, cm per reference contact phase, without > with the lock (the reference's own after /), the cut-out's; root path error mm (first frame aligned) without > with; the root's height over the floor, error mm, with the lock; acceleration error m/s²; how far the lock moved a held ankle in the image, px mean / max".to_owned(),
     ];
     for (i, input) in INPUTS.iter().enumerate() {
         out.push(String::new());

@@ -535,12 +535,6 @@ impl State {
         }
     }
 
-    /// The project, for tests that set one up directly.
-    #[cfg(test)]
-    pub fn project_mut(&mut self) -> Option<&mut Project> {
-        self.project.as_mut()
-    }
-
     /// Puts a project in place without a video (tests of the panels).
     #[cfg(test)]
     pub fn set_project_for_test(&mut self, p: Project) {

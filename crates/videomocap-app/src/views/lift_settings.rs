@@ -17,28 +17,25 @@ pub fn lift_settings_ui(ui: &mut egui::Ui, l: &mut LiftParams) {
          accurate; default {}",
         on_off(d.refine)
     ));
-    // The fixed smoothing replaces the adaptive one: greyed out while it is set.
-    let adaptive = egui::Checkbox::new(
-        &mut l.adaptive_smoothing,
-        "smooth each joint by its own noise",
-    );
-    ui.add_enabled(l.smoothing_s == 0.0, adaptive)
+    ui.checkbox(&mut l.smooth_tracks, "smooth the tracks")
         .on_hover_text(format!(
-            "Before the lift, each joint's track is smoothed by as much as its own jitter calls \
-             for (used when the fixed smoothing below is 0); default {}",
-            on_off(d.adaptive_smoothing)
+            "Before the lift, the tracks are smoothed over time (off for tracks that are \
+             already clean); default {}",
+            on_off(d.smooth_tracks)
         ));
-    ui.add(egui::Slider::new(&mut l.smoothing_s, 0.0..=0.3).text("fixed smoothing (s)"))
+    let width = egui::Slider::new(&mut l.smoothing_s, 0.0..=0.3).text("smoothing (s)");
+    ui.add_enabled(l.smooth_tracks, width)
         .on_hover_text(format!(
-            "Above 0: every joint's track is smoothed by a Gaussian this many seconds wide \
-             instead; default {}",
+            "0: each joint's track is smoothed by as much as its own jitter calls for (nothing \
+             for clean tracks); above 0: every joint by a Gaussian this many seconds wide; \
+             default {}",
             d.smoothing_s
         ));
-    ui.checkbox(&mut l.key_path_smoothing, "refit the trunk's path")
+    ui.checkbox(&mut l.steady_trunk, "keep the trunk's path steady")
         .on_hover_text(format!(
             "The shoulders' and chest's 3D path is refitted over the whole clip (steadier depth \
              and turn); default {}",
-            on_off(d.key_path_smoothing)
+            on_off(d.steady_trunk)
         ));
     ui.checkbox(&mut l.foot_lock, "keep planted feet still")
         .on_hover_text(format!(
@@ -47,18 +44,25 @@ pub fn lift_settings_ui(ui: &mut egui::Ui, l: &mut LiftParams) {
              slide; default {}",
             on_off(d.foot_lock)
         ));
-    let a = &mut l.ambiguity;
-    ui.add(egui::Slider::new(&mut a.arm_swing, 0.0..=3.0).text("arm swing vs. legs"))
+    ui.add(egui::Slider::new(&mut l.arm_swing, 0.0..=3.0).text("arm swing vs. legs"))
         .on_hover_text(format!(
             "When walking or running, how strongly each arm is taken to swing against its own leg \
              when its depth is in doubt (0 = off); default {}",
-            d.ambiguity.arm_swing
+            d.arm_swing
         ));
-    ui.add(egui::Slider::new(&mut a.contact, 0.0..=30.0).text("hands outside the body"))
+    ui.add(
+        egui::Slider::new(&mut l.hands_outside_body, 0.0..=30.0).text("hands outside the body"),
+    )
+    .on_hover_text(format!(
+        "How strongly a hand is kept out of the trunk and the thighs when its depth is in doubt \
+         (0 = off); default {}",
+        d.hands_outside_body
+    ));
+    ui.add(egui::Slider::new(&mut l.image_depth, 0.0..=3.0).text("image depth evidence"))
         .on_hover_text(format!(
-            "How strongly a hand is kept out of the trunk and the thighs when its depth is in \
-             doubt (0 = off); default {}",
-            d.ambiguity.contact
+            "How much the pose network's 3D body counts for which way each bone points in depth \
+             and which way the body faces (0 = geometry alone; your flips always win); default {}",
+            d.image_depth
         ));
     if ui.button("Defaults").clicked() {
         *l = d;

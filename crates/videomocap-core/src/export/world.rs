@@ -28,38 +28,39 @@ const PLANE_FLATNESS: f64 = 0.1;
 /// An estimate of "up" further than this from the trunk's mean direction is not trusted.
 const MAX_TILT_FROM_TRUNK_DEG: f64 = 30.0;
 
-/// The share of the floor's frames whose lower ankle is taken to be on the floor (the lower
-/// quantile of the lower ankle's height: noise, and without planted feet jumps, lie above it).
+/// Share of frames whose lowest ankle is taken to be on the floor (the lower quantile of the
+/// lowest ankle's height; jumps and noise lie above it).
 const FLOOR_QUANTILE: f64 = 0.2;
 
-/// Frames with a planted foot needed before the floor is taken from them alone (two short
+/// Frames with a planted foot needed before the floor is said to stand on them (two short
 /// contacts).
 const MIN_PLANTED_FRAMES: usize = 6;
 
-/// Where the floor came from.
+/// What the floor stands on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FloorSource {
-    /// The frames on which the lift found a foot planted (`contact:` flags): the floor lies
-    /// under their lower ankles, so the root's height over the floor is read from the contacts
-    /// over the whole clip, and a jump (no foot planted) leaves the floor and lands on it
-    /// again however long it lasts.
-    PlantedFeet {
-        /// Frames with a planted foot the floor rests on.
+    /// The lift found a foot planted on this many frames: the floor under the lowest ankles is
+    /// where the feet stood.
+    FeetPlanted {
+        /// Frames with a planted foot.
         frames: usize,
     },
-    /// No foot was found planted (or on too few frames): the floor lies under every frame's
-    /// lower ankle, a guess worth a look (a jump that fills most of the clip would lift it).
-    LowestAnkles,
+    /// No foot was found planted (feet never still on the floor, a jump, or the foot lock off):
+    /// the floor under the lowest ankles is a guess worth a look.
+    NoFootPlanted,
 }
 
 impl std::fmt::Display for FloorSource {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            FloorSource::PlantedFeet { frames } => {
-                write!(f, "under the planted feet ({frames} frames)")
+            FloorSource::FeetPlanted { frames } => {
+                write!(
+                    f,
+                    "under the lowest ankles (a foot planted on {frames} frames)"
+                )
             }
-            FloorSource::LowestAnkles => f.write_str(
-                "under the lowest ankles (no foot found planted: a guess, check the floor)",
+            FloorSource::NoFootPlanted => f.write_str(
+                "under the lowest ankles, but no foot was found planted: a guess, check the floor",
             ),
         }
     }
@@ -98,7 +99,7 @@ pub struct WorldFrame {
     pub origin_in_camera: Point3<f64>,
     /// How up was found.
     pub up_source: UpSource,
-    /// Where the floor came from.
+    /// What the floor stands on.
     pub floor_source: FloorSource,
 }
 
@@ -118,18 +119,21 @@ impl WorldFrame {
         self.rotation.matrix().row(1).transpose()
     }
 
-    /// Estimates up, the floor and the origin from a camera-space sequence and, per frame,
-    /// the ankles found planted on the floor (`contacts`, may be empty):
+    /// Estimates up, the floor and the origin from a camera-space sequence; `contacts` (per
+    /// frame, the ankles the lift found planted; may be empty) only say whether the floor
+    /// stands on anything ([`FloorSource`]):
     /// 1. the trunk's mean direction (pelvis → neck, each frame's unit vector averaged) is a
     ///    first "up";
-    /// 2. the floor's points are the lower ankle (along the trunk) of each frame with a
-    ///    planted foot, or of every frame when fewer than 6 have one
-    ///    ([`FloorSource`]); if they spread over the floor in two directions their best-fit
-    ///    plane's normal is up, if they spread along one line (a walk) that line is taken as
-    ///    horizontal and removed from the trunk direction, otherwise the trunk direction stays
-    ///    (a result tilted more than 30° from the trunk is not trusted);
+    /// 2. each frame's lower ankle along it is a floor contact; if the contacts spread over the
+    ///    floor in two directions their best-fit plane's normal is up, if they spread along one
+    ///    line (a walk) that line is taken as horizontal and removed from the trunk direction,
+    ///    otherwise the trunk direction stays (a result tilted more than 30° from the trunk is
+    ///    not trusted);
     /// 3. the floor lies [`ANKLE_HEIGHT_FRACTION`] of the stature (from the bone lengths) under
-    ///    the lower 20 % quantile of their heights.
+    ///    the lower 20 % quantile of the contacts' heights (a jump shorter than four fifths of
+    ///    the clip leaves the floor and lands on it again). Taking the contacts only from the
+    ///    frames with a planted foot was tried: worse from the tracker's output on the test
+    ///    split (`docs/method.md`, "The floor").
     pub fn estimate(
         frames: &[PerJoint<Point3<f64>>],
         contacts: &[PerJoint<bool>],
@@ -150,19 +154,17 @@ impl WorldFrame {
                 r
             }
         };
-        let planted: Vec<Point3<f64>> = frames
+        let planted = frames
             .iter()
             .zip(contacts)
             .filter(|(_, c)| c[Joint::LeftAnkle] || c[Joint::RightAnkle])
-            .map(|(f, _)| lowest_of(f))
-            .collect();
-        let (points, floor_source) = if planted.len() >= MIN_PLANTED_FRAMES {
-            let frames = planted.len();
-            (planted, FloorSource::PlantedFeet { frames })
+            .count();
+        let floor_source = if planted >= MIN_PLANTED_FRAMES {
+            FloorSource::FeetPlanted { frames: planted }
         } else {
-            let lowest = frames.iter().map(lowest_of).collect();
-            (lowest, FloorSource::LowestAnkles)
+            FloorSource::NoFootPlanted
         };
+        let points: Vec<Point3<f64>> = frames.iter().map(lowest_of).collect();
         let (up, up_source) = up_from_contacts(&points, trunk);
         let stature = stature_m(frames);
         let mut heights: Vec<f64> = points.iter().map(|c| c.coords.dot(&up)).collect();

@@ -15,6 +15,10 @@ use crate::camera::PinholeCamera;
 use crate::skeleton::{Bone, Joint, SubjectModel};
 use nalgebra::{Matrix2, Matrix2x3, Point2, Point3, Rotation3, SMatrix, SVector, Vector2, Vector3};
 
+/// A key-triangle calibration fits when its residual is below this RMS, pixels: a pixel is
+/// what a careful click or a good track gives.
+pub(super) const CALIBRATION_TOLERANCE_PX: f64 = 1.0;
+
 /// The key joints in the order used by every array of this module.
 pub const KEY_JOINTS: [Joint; 3] = [Joint::LeftShoulder, Joint::RightShoulder, Joint::Chest];
 

@@ -1,9 +1,11 @@
 //! The key triangle's candidate poses on every frame (eqs. 6–11 solved on each frame's three
 //! points, up to four poses each) and the smoothest path through them over the clip.
 
-use super::calibrate::{KeyTriangle, Residuals, calibrate_all, calibrate_from, starting_poses};
+use super::calibrate::{
+    CALIBRATION_TOLERANCE_PX, KeyTriangle, Residuals, calibrate_all, calibrate_from, starting_poses,
+};
 use super::key_path::{centroid, tilt_m};
-use super::propagate::key_depths;
+use super::propagate::{PROPAGATION_TOLERANCE_M, key_depths};
 use super::solve::LiftJob;
 use crate::camera::PinholeCamera;
 use crate::skeleton::{Joint, PerJoint, SubjectModel};
@@ -56,7 +58,7 @@ pub(super) fn key_candidates(
     max_depth: f64,
 ) -> (Vec<[Point3<f64>; 3]>, bool) {
     let cam = &job.camera;
-    let fits = calibrate_all(cam, triangle, image, job.params.calibration_tolerance_px);
+    let fits = calibrate_all(cam, triangle, image, CALIBRATION_TOLERANCE_PX);
     let closest_point_fit = || {
         starting_poses(cam, triangle, image)
             .into_iter()
@@ -75,7 +77,7 @@ pub(super) fn key_candidates(
     for pose in poses {
         let k = triangle.points.map(|p| pose.apply(&p));
         let snapped = key_depths(cam, image, sides, k.map(|p| p.z));
-        let k = if snapped.rms_m < job.params.propagation_tolerance_m {
+        let k = if snapped.rms_m < PROPAGATION_TOLERANCE_M {
             snapped.points
         } else {
             k

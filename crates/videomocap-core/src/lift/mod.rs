@@ -46,7 +46,7 @@ pub use calibrate::{KEY_JOINTS, KeyTriangle};
 pub use contact::{FEET, FootContacts};
 pub use error::LiftError;
 pub use focal::{DEFAULT_FOV_LONG_SIDE_DEG, default_focal};
-pub use params::LiftParams;
+pub use params::{LiftParams, retired_lift_settings};
 pub use pipeline::{
     CameraChoice, FocalSource, LiftStage, Reconstruction, SubjectChoice, reconstruct,
 };

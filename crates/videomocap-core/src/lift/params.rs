@@ -1,95 +1,208 @@
-//! The lift's settings: what can be given as JSON (`--lift-settings`, the app's Lift
-//! settings, a batch row), each with its documented default, and their checks.
+//! The lift's settings: the few a user may change (`--lift-settings`, the app's Lift settings,
+//! a batch row), each named for what it does to the result and with its documented default,
+//! and their checks. Everything else the lift weighs is a fitted constant beside the code that
+//! uses it (measurements in `docs/method.md`). Files written before 2026-11-29 held 30 settings:
+//! they still load, the ones kept renamed and the retired ones dropped
+//! ([`retired_lift_settings`] names them).
 
 use super::ambiguity::AmbiguityWeights;
 use super::error::{LiftError, check_setting};
-use super::refine::RefineParams;
 use serde::{Deserialize, Serialize};
 
 /// Settings of the lift; every field has a documented default and can be given as JSON.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[serde(from = "StoredLiftParams")]
 pub struct LiftParams {
-    /// Run the global refinement after the per-frame solve (default true), then set every bone
-    /// back to exactly its refined length (`super::refine::snap_to_lengths`), so the BVH's
-    /// fixed offsets give the skeleton back exactly. `bench lift` reports both; on the synthetic
-    /// suite with true lengths it lowers the error 49.2 → 47.7 mm with 2 px white noise (four
-    /// draws), 94.2 → 93.9 mm with the tracker's output, exact tracks 11.5 → 11.3 mm; on the
-    /// real sample 68.1 → 66.7 mm with its reference 2D and 174.0 → 172.3 mm with the
-    /// tracker's output. It lowers every overall row but one: the real sample from the
-    /// tracker's output and the height (162.0 → 162.2 mm).
+    /// Polish the whole clip after the per-frame solve (default true): one least-squares pass
+    /// over every frame (reprojection, bone lengths, smooth motion), then every bone set back
+    /// to its length, so the BVH's fixed offsets give the skeleton back exactly.
     pub refine: bool,
-    /// A key-triangle calibration fits when its residual is below this RMS, pixels (default 1).
-    pub calibration_tolerance_px: f64,
-    /// A calibrated key-triangle pose is made exact by eqs. 10–11 when they then hold within this
-    /// RMS residual, metres (default 0.005).
-    pub propagation_tolerance_m: f64,
-    /// When above 0, the per-frame solve works on tracks smoothed over time by a Gaussian of
-    /// this many seconds, the same for every joint (default 0: see `adaptive_smoothing`).
-    /// Measured on the synthetic suite, 0.066 s (two frames at 30 fps) halved the error with
-    /// 2 px white noise (150 → 80 mm) but raised it with exact tracks (31 → 51 mm: a grazing
-    /// key triangle turns a pixel of lag into centimetres of depth).
+    /// Smooth the tracks over time before the lift (default true); off for tracks that are
+    /// already clean.
+    pub smooth_tracks: bool,
+    /// With `smooth_tracks`: every joint's track by a Gaussian this many seconds wide; 0 (the
+    /// default) each joint by as much as its own jitter calls for.
     pub smoothing_s: f64,
-    /// When `smoothing_s` is 0, smooth each joint's track by the width its own noise calls for
-    /// (`super::smoothing`; default true). On the synthetic suite with true lengths: 2 px
-    /// white noise 162 → 77.5 mm, exact tracks 31.1 → 31.1 mm, the tracker's output
-    /// 151.5 → 157.7 mm (its errors are drift and jumps more than white noise).
-    pub adaptive_smoothing: bool,
-    /// Refit the key triangle's path over the whole clip after it is chosen frame by frame
-    /// (`super::key_path`: reprojection, rigid sides, acceleration and the trunk's pitch
-    /// towards the camera by least squares, as firm as the tracks are noisy; default true).
-    /// With the calibration frame chosen by size as well, on the synthetic suite with true
-    /// lengths: 2 px noise (four draws) 71.0 → 53.3 mm, exact tracks 20.4 → 20.6 mm, the
-    /// tracker's output 111.3 → 112.0 mm; the real sample with noise 73.1 → 70.5 mm, with its
-    /// reference 2D 69.2 → 69.3 mm.
-    pub key_path_smoothing: bool,
-    /// Weights of the depth-ambiguity priors.
-    pub ambiguity: AmbiguityWeights,
-    /// Weights of the global refinement.
-    pub refinement: RefineParams,
-    /// Hold a planted foot in place (default true): each foot's contacts with the floor are
-    /// found and the body is moved along the planted ankle's viewing ray so the ankle keeps one
-    /// depth over each (it stays on its 2D track).
+    /// Keep the trunk's path steady (default true): the shoulders' and chest's 3D path is
+    /// refitted over the whole clip (reprojection, rigid sides, acceleration, as firm as their
+    /// tracks are noisy).
+    pub steady_trunk: bool,
+    /// Keep planted feet still (default true): each foot's contacts with the floor are found
+    /// and the body is moved along the planted ankle's viewing ray so the ankle keeps one depth
+    /// over each (it stays on its 2D track).
     pub foot_lock: bool,
+    /// In a walk or run, how strongly an arm whose depth is in doubt is taken to swing against
+    /// its own leg (default 1; 0 = off).
+    pub arm_swing: f64,
+    /// How strongly a hand whose depth is in doubt is kept out of the trunk and the thighs
+    /// (default 10; 0 = off).
+    pub hands_outside_body: f64,
+    /// How much the pose network's 3D body counts for each bone's depth and the body's facing
+    /// where the tracks carry it (default 1; 0 = geometry alone).
+    pub image_depth: f64,
 }
 
 impl Default for LiftParams {
     fn default() -> Self {
+        let fitted = AmbiguityWeights::default();
         LiftParams {
             refine: true,
-            calibration_tolerance_px: 1.0,
-            propagation_tolerance_m: 0.005,
+            smooth_tracks: true,
             smoothing_s: 0.0,
-            adaptive_smoothing: true,
-            key_path_smoothing: true,
-            ambiguity: AmbiguityWeights::default(),
-            refinement: RefineParams::default(),
+            steady_trunk: true,
             foot_lock: true,
+            arm_swing: fitted.arm_swing,
+            hands_outside_body: fitted.contact,
+            image_depth: fitted.image_depth,
         }
     }
 }
 
 impl LiftParams {
     /// Checks every setting is in the range it means something in (a settings file can hold
-    /// anything): tolerances positive, the smoothing width not negative, and the ambiguity
-    /// weights and refinement deviations as their own `validate` says.
+    /// anything): the smoothing width and the weights finite and not negative.
     pub fn validate(&self) -> Result<(), LiftError> {
         // Destructured so that a new setting cannot be left unchecked.
         let LiftParams {
             refine: _,
-            calibration_tolerance_px,
-            propagation_tolerance_m,
+            smooth_tracks: _,
             smoothing_s,
-            adaptive_smoothing: _,
-            key_path_smoothing: _,
+            steady_trunk: _,
             foot_lock: _,
-            ambiguity,
-            refinement,
+            arm_swing,
+            hands_outside_body,
+            image_depth,
         } = *self;
-        check_setting("calibration_tolerance_px", calibration_tolerance_px, true)?;
-        check_setting("propagation_tolerance_m", propagation_tolerance_m, true)?;
         check_setting("smoothing_s", smoothing_s, false)?;
-        ambiguity.validate()?;
-        refinement.validate()
+        check_setting("arm_swing", arm_swing, false)?;
+        check_setting("hands_outside_body", hands_outside_body, false)?;
+        check_setting("image_depth", image_depth, false)
+    }
+
+    /// The depth-ambiguity weights: the fitted ones with the user's three.
+    pub(super) fn ambiguity(&self) -> AmbiguityWeights {
+        AmbiguityWeights {
+            arm_swing: self.arm_swing,
+            contact: self.hands_outside_body,
+            image_depth: self.image_depth,
+            // The facing's evidence comes from the same network body: off with it.
+            image_facing: if self.image_depth > 0.0 {
+                AmbiguityWeights::default().image_facing
+            } else {
+                0.0
+            },
+            ..AmbiguityWeights::default()
+        }
+    }
+}
+
+/// The settings of an older file that no longer exist (each now a fitted constant), as
+/// `name` or `group.name`; empty for a current file. A front end shows them, then the file's
+/// next save drops them.
+pub fn retired_lift_settings(json: &serde_json::Value) -> Vec<String> {
+    let Some(map) = json.as_object() else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for (key, value) in map {
+        match key.as_str() {
+            "calibration_tolerance_px" | "propagation_tolerance_m" => {
+                out.push(key.clone());
+            }
+            "ambiguity" | "refinement" => {
+                for inner in value.as_object().into_iter().flat_map(|m| m.keys()) {
+                    let kept = key == "ambiguity"
+                        && matches!(inner.as_str(), "arm_swing" | "contact" | "image_depth");
+                    if !kept {
+                        out.push(format!("{key}.{inner}"));
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+/// What a settings file may hold: today's settings and, from older files, the ones renamed
+/// (`key_path_smoothing`, `adaptive_smoothing`, `ambiguity.arm_swing`, `ambiguity.contact`,
+/// `ambiguity.image_depth`) and the ones retired (read and dropped). Unknown names are refused.
+#[derive(Deserialize)]
+#[serde(default, deny_unknown_fields)]
+struct StoredLiftParams {
+    refine: bool,
+    smooth_tracks: Option<bool>,
+    smoothing_s: f64,
+    steady_trunk: Option<bool>,
+    foot_lock: bool,
+    arm_swing: Option<f64>,
+    hands_outside_body: Option<f64>,
+    image_depth: Option<f64>,
+    // Renamed.
+    key_path_smoothing: Option<bool>,
+    ambiguity: Option<OldAmbiguity>,
+    adaptive_smoothing: Option<bool>,
+    // Retired.
+    #[allow(dead_code)]
+    calibration_tolerance_px: Option<serde_json::Value>,
+    #[allow(dead_code)]
+    propagation_tolerance_m: Option<serde_json::Value>,
+    #[allow(dead_code)]
+    refinement: Option<serde_json::Value>,
+}
+
+/// The old `ambiguity` group: three of its weights live on under new names.
+#[derive(Deserialize, Default)]
+#[serde(default)]
+struct OldAmbiguity {
+    arm_swing: Option<f64>,
+    contact: Option<f64>,
+    image_depth: Option<f64>,
+}
+
+impl Default for StoredLiftParams {
+    fn default() -> Self {
+        let d = LiftParams::default();
+        StoredLiftParams {
+            refine: d.refine,
+            smooth_tracks: None,
+            smoothing_s: d.smoothing_s,
+            steady_trunk: None,
+            foot_lock: d.foot_lock,
+            arm_swing: None,
+            hands_outside_body: None,
+            image_depth: None,
+            key_path_smoothing: None,
+            ambiguity: None,
+            calibration_tolerance_px: None,
+            propagation_tolerance_m: None,
+            adaptive_smoothing: None,
+            refinement: None,
+        }
+    }
+}
+
+impl From<StoredLiftParams> for LiftParams {
+    fn from(s: StoredLiftParams) -> Self {
+        let d = LiftParams::default();
+        let old = s.ambiguity.unwrap_or_default();
+        // The old switch turned off only the automatic smoothing (a fixed width still smoothed).
+        let old_smoothing = s.adaptive_smoothing.map(|a| a || s.smoothing_s > 0.0);
+        LiftParams {
+            refine: s.refine,
+            smooth_tracks: s.smooth_tracks.or(old_smoothing).unwrap_or(d.smooth_tracks),
+            smoothing_s: s.smoothing_s,
+            steady_trunk: s
+                .steady_trunk
+                .or(s.key_path_smoothing)
+                .unwrap_or(d.steady_trunk),
+            foot_lock: s.foot_lock,
+            arm_swing: s.arm_swing.or(old.arm_swing).unwrap_or(d.arm_swing),
+            hands_outside_body: s
+                .hands_outside_body
+                .or(old.contact)
+                .unwrap_or(d.hands_outside_body),
+            image_depth: s.image_depth.or(old.image_depth).unwrap_or(d.image_depth),
+        }
     }
 }

@@ -8,6 +8,10 @@ use super::newton::levenberg_marquardt;
 use crate::camera::PinholeCamera;
 use nalgebra::{Matrix3, Point2, Point3, Vector3};
 
+/// A calibrated key-triangle pose is made exact by eqs. 10–11 when they then hold within this
+/// RMS residual, metres: half a centimetre, under the sides' own doubt.
+pub(super) const PROPAGATION_TOLERANCE_M: f64 = 0.005;
+
 /// The key joints' depths found for one frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct KeyDepths {

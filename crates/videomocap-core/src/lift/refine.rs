@@ -17,37 +17,21 @@
 //! Solved by Levenberg–Marquardt; the normal equations are sparse (banded over frames plus
 //! the length columns) and factored with `nalgebra-sparse`'s Cholesky.
 
-use super::error::{LiftError, check_setting};
+use super::error::LiftError;
 use super::least_squares::{Residuals, Row, frame_interval_s, minimise};
 use crate::camera::PinholeCamera;
 use crate::formats::{PointSource, TrackedPoint};
 use crate::skeleton::{BONE_COUNT, Bone, JOINT_COUNT, Joint, PerJoint, SubjectModel};
 use nalgebra::{DVector, Point2, Point3, Vector3};
-use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// Weights of the refinement.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+/// Weights of the refinement: fitted constants (`docs/method.md`).
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RefineParams {
     /// Expected 2D error of a fully trusted track point, pixels (default 20: the tracker's
     /// errors are drift and jumps of several to tens of pixels, and the per-frame solve already
     /// lies on the smoothed tracks' rays, so the pass mostly smooths and evens the lengths).
-    /// Swept with `bench lift` before the calibration pose was chosen by `fit_score`
-    /// (per-frame → refined, mm; suite with true lengths (b) four draws of 2 px noise, (c) the
-    /// tracker's output; real sample (a) its reference 2D, (c) the tracker's output from the
-    /// height):
-    ///
-    /// | σ px | suite (b) | suite (c) | real (a) | real (c), height |
-    /// |---|---|---|---|---|
-    /// | per frame | 49.5 | 117.7 | 69.3 | 165.5 |
-    /// | 2 | 48.5 | 118.3 | 72.9 | 170.3 |
-    /// | 5 | 48.1 | 117.6 | 70.2 | 167.3 |
-    /// | 10 | 48.0 | 117.5 | 68.6 | 166.0 |
-    /// | 20 | 48.0 | 117.5 | 67.9 | 165.5 |
-    /// | 40 | 48.0 | 117.5 | 67.7 | 165.4 |
-    ///
-    /// Exact 2D stays at 20.3 mm throughout.
+    /// Measured in `docs/method.md` ("Fitted constants of the lift").
     pub reprojection_sigma_px: f64,
     /// Allowed deviation of a bone from its length, metres (default 0.005).
     pub length_sigma_m: f64,
@@ -62,16 +46,13 @@ pub struct RefineParams {
     /// Levenberg–Marquardt iterations at most (default 20).
     pub max_iterations: usize,
     /// How far (metres, standard deviation per axis) a joint may move from the per-frame solve
-    /// (default 0.03; 0 turns the anchor off). Without it, on the synthetic suite with the
-    /// tracker's 2D and true lengths, a forearm the tracker made too long pulled whole trunks
-    /// 5 cm off (jumping jacks: shoulders 7 → 57 mm) and the refinement raised the error,
-    /// 111.2 → 117.0 mm; with it 111.2 → 110.8 mm, and exact tracks stay at 20.4 mm (21.6
-    /// without). 2 px noise: 63.5 → 62.2 mm (61.5 without).
+    /// (default 0.03; 0 turns the anchor off). Measured in `docs/method.md` ("Fitted constants
+    /// of the lift").
     pub anchor_sigma_m: f64,
     /// Set the acceleration deviation from the tracks' own noise (default true): it is
     /// `ACCELERATION_TIMES_NOISE` over the median white-noise deviation of the joints' tracks
-    /// (`super::smoothing::median_noise_px`), so noisy tracks are smoothed firmly and exact ones
-    /// barely. Off, `acceleration_sigma_mps2` is used as it is.
+    /// (`super::smoothing::median_noise_px`), so noisy tracks are smoothed firmly and exact
+    /// ones barely. Measured in `docs/method.md` ("Fitted constants of the lift").
     pub adaptive: bool,
 }
 
@@ -86,36 +67,6 @@ impl Default for RefineParams {
             anchor_sigma_m: 0.03,
             adaptive: true,
         }
-    }
-}
-
-impl RefineParams {
-    /// Checks every deviation is finite and above 0 (each divides its residual), the anchor's
-    /// at least 0 (0 turns it off).
-    pub fn validate(&self) -> Result<(), LiftError> {
-        // Destructured so that a new setting cannot be left unchecked.
-        let RefineParams {
-            reprojection_sigma_px,
-            length_sigma_m,
-            acceleration_sigma_mps2,
-            length_prior,
-            max_iterations: _,
-            anchor_sigma_m,
-            adaptive: _,
-        } = *self;
-        check_setting(
-            "refinement.reprojection_sigma_px",
-            reprojection_sigma_px,
-            true,
-        )?;
-        check_setting("refinement.length_sigma_m", length_sigma_m, true)?;
-        check_setting(
-            "refinement.acceleration_sigma_mps2",
-            acceleration_sigma_mps2,
-            true,
-        )?;
-        check_setting("refinement.length_prior", length_prior, true)?;
-        check_setting("refinement.anchor_sigma_m", anchor_sigma_m, false)
     }
 }
 

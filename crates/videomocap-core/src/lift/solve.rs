@@ -8,11 +8,13 @@ use super::facing::facing_by_segments;
 use super::key_candidates::{deepest_trunk, key_candidates, plausible_key, smoothest_key_path};
 use super::params::LiftParams;
 
-use super::calibrate::{KEY_JOINTS, KeyTriangle, calibrate_all, longest_side, shape};
+use super::calibrate::{
+    CALIBRATION_TOLERANCE_PX, KEY_JOINTS, KeyTriangle, calibrate_all, longest_side, shape,
+};
 use super::error::LiftError;
 use super::key_path::{chain_pitch_prior, smooth_key_path};
 use super::pipeline::LiftStage;
-use super::refine::{RefineSummary, refine, track_weight};
+use super::refine::{RefineParams, RefineSummary, refine, track_weight};
 use super::report::{BoneDepth, FrameFlag, FrameReport, flag_too_long};
 use super::smoothing::{adaptive_sigmas, median_noise_px, smoothed_images};
 use crate::camera::PinholeCamera;
@@ -155,12 +157,12 @@ fn per_frame_solve(
     } else {
         30.0
     };
-    let sigma = if job.params.smoothing_s > 0.0 {
-        PerJoint([job.params.smoothing_s * fps; crate::skeleton::JOINT_COUNT])
-    } else if job.params.adaptive_smoothing {
-        adaptive_sigmas(tracks)
-    } else {
+    let sigma = if !job.params.smooth_tracks {
         PerJoint([0.0; crate::skeleton::JOINT_COUNT])
+    } else if job.params.smoothing_s > 0.0 {
+        PerJoint([job.params.smoothing_s * fps; crate::skeleton::JOINT_COUNT])
+    } else {
+        adaptive_sigmas(tracks)
     };
     let images = smoothed_images(tracks, &sigma);
     let rays: Vec<_> = images.iter().map(|im| im.map(|_, p| cam.ray(p))).collect();
@@ -194,7 +196,7 @@ fn per_frame_solve(
         cam,
         &triangle,
         &key_image(&images, calibration_frame),
-        job.params.calibration_tolerance_px,
+        CALIBRATION_TOLERANCE_PX,
     );
     // Poses too deep for the trunk's image length are dropped, unless every pose is.
     let max_depth = deepest_trunk(cam, &job.subject, &images[calibration_frame]);
@@ -222,6 +224,7 @@ fn per_frame_solve(
         .collect();
     let noise_px = median_noise_px(tracks, &KEY_JOINTS);
     let mut best: Option<(f64, Vec<FrameReport>, Resolved)> = None;
+    let weights = job.params.ambiguity();
     // Every frame's candidate poses, computed once.
     let per_frame: Vec<(Vec<[Point3<f64>; 3]>, bool)> = (0..n)
         .map(|t| {
@@ -240,11 +243,11 @@ fn per_frame_solve(
         // gave 53.0–53.9; the real sample with noise and the tracker's output unchanged).
         let pitch = job
             .params
-            .key_path_smoothing
+            .steady_trunk
             .then(|| chain_pitch_prior(noise_px, fps, &key_of(&c.pose)))
             .flatten();
         let mut key = smoothest_key_path(&candidates, pitch);
-        if job.params.key_path_smoothing {
+        if job.params.steady_trunk {
             key = smooth_key_path(
                 cam,
                 &key,
@@ -263,14 +266,14 @@ fn per_frame_solve(
                 &frame_index,
                 &bodies,
                 &job.subject,
-                &job.params.ambiguity,
+                &weights,
                 &job.overrides,
             );
             let miss: f64 = (0..n)
                 .map(|t| miss_m(cam, &resolved.points[t], &images[t]))
                 .sum();
             let mut score = fit_score(miss, &resolved.group_costs);
-            let facing_weight = job.params.ambiguity.image_facing;
+            let facing_weight = weights.image_facing;
             if facing_weight > 0.0
                 && let Some(cost) = super::ambiguity::image_facing_cost(key, &bodies)
             {
@@ -474,7 +477,7 @@ fn lift_leaning(
             &job.subject,
             job.tracks.source.fps,
             median_noise_px(job.tracks, &Joint::ALL),
-            &job.params.refinement,
+            &RefineParams::default(),
             &mut |done, total| {
                 progress(&LiftProgress {
                     stage: LiftStage::Refine,

@@ -265,11 +265,60 @@ mod tests {
         p.settings.height_m = 1.82;
         p.settings.focal_px = Some(900.0);
         p.settings.lift.refine = false;
-        p.settings.lift.ambiguity.contact = 3.0;
+        p.settings.lift.hands_outside_body = 3.0;
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("p.json");
         p.save(&path).unwrap();
         assert_eq!(Project::load(&path).unwrap(), p);
+    }
+
+    /// A project saved before the lift's settings were cut to eight opens: the kept ones
+    /// carried over under their new names, the retired ones dropped.
+    #[test]
+    fn a_project_with_the_old_lift_settings_opens() {
+        let mut p = Project::new(PathBuf::from("clip.mp4"));
+        p.settings.lift.hands_outside_body = 3.0;
+        p.settings.lift.steady_trunk = false;
+        let new = p.to_json();
+        let lift = new.index_of_lift();
+        let old = format!(
+            "{}{}{}",
+            &new[..lift.0],
+            r#""lift": {"refine": true, "calibration_tolerance_px": 1.0, "key_path_smoothing": false,
+               "adaptive_smoothing": true, "ambiguity": {"elbow": 5.0, "contact": 3.0},
+               "refinement": {"max_iterations": 20}}"#,
+            &new[lift.1..]
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("old.json");
+        std::fs::write(&path, old).unwrap();
+        assert_eq!(Project::load(&path).unwrap(), p);
+    }
+
+    /// Where the `"lift": {…}` entry lies in a project's text.
+    trait LiftEntry {
+        fn index_of_lift(&self) -> (usize, usize);
+    }
+
+    impl LiftEntry for String {
+        fn index_of_lift(&self) -> (usize, usize) {
+            let start = self.find("\"lift\":").unwrap();
+            let open = start + self[start..].find('{').unwrap();
+            let mut depth = 0;
+            for (k, c) in self[open..].char_indices() {
+                match c {
+                    '{' => depth += 1,
+                    '}' => {
+                        depth -= 1;
+                        if depth == 0 {
+                            return (start, open + k + 1);
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            panic!("unclosed lift entry");
+        }
     }
 
     #[test]
@@ -292,8 +341,11 @@ mod tests {
             ("{".to_owned(), "bad.videomocap"),
             // A weight below 0 would reward the posture its prior forbids.
             (
-                base.replace("\"contact\": 10.0", "\"contact\": -1.0"),
-                "ambiguity.contact",
+                base.replace(
+                    "\"hands_outside_body\": 10.0",
+                    "\"hands_outside_body\": -1.0",
+                ),
+                "hands_outside_body",
             ),
             // The tracker's settings are checked too (a length range of 1 or more would let a
             // limb's block shrink to nothing).

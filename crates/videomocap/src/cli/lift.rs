@@ -50,12 +50,24 @@ pub fn check_options(o: &LiftOptions) -> Result<(LiftParams, KnownLengths), Exit
     Ok((params, known))
 }
 
-/// Reads lift settings from a JSON file.
+/// Reads lift settings from a JSON file; an older file's retired settings are named on stderr
+/// (they no longer change anything).
 pub fn load_settings(path: &Path) -> Result<LiftParams, ExitError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| ExitError::bad_input(anyhow!("{}: cannot read: {e}", path.display())))?;
-    let params: LiftParams = serde_json::from_str(&text)
-        .map_err(|e| ExitError::bad_input(anyhow!("{}: bad lift settings: {e}", path.display())))?;
+    let bad = |e: serde_json::Error| {
+        ExitError::bad_input(anyhow!("{}: bad lift settings: {e}", path.display()))
+    };
+    let json: serde_json::Value = serde_json::from_str(&text).map_err(bad)?;
+    let retired = videomocap_core::lift::retired_lift_settings(&json);
+    if !retired.is_empty() {
+        eprintln!(
+            "note: {}: settings retired in 2026-11 are ignored (now fixed in the lift): {}",
+            path.display(),
+            retired.join(", ")
+        );
+    }
+    let params: LiftParams = serde_json::from_value(json).map_err(bad)?;
     params
         .validate()
         .map_err(|e| ExitError::bad_input(anyhow!("{}: {e}", path.display())))?;

@@ -47,11 +47,8 @@ pub struct MotionScore {
     /// Frames of the root path.
     pub root_n: usize,
     /// |the pelvis's height over the floor − the reference's|, metres, summed over the root
-    /// path's frames: each in its own export world, the estimate's floor from its planted
-    /// feet (the `contact:` flags; the lowest ankles when it has none).
+    /// path's frames, each in its own export world.
     pub root_height_m: f64,
-    /// The same with the estimate's floor from its lowest ankles (as before contacts).
-    pub root_height_lowest_m: f64,
     /// |estimated − reference| acceleration of the pelvis-aligned joints, m/s², summed.
     pub accel: f64,
     /// Joint samples of the acceleration.
@@ -70,7 +67,6 @@ impl MotionScore {
         self.root_m += o.root_m;
         self.root_n += o.root_n;
         self.root_height_m += o.root_height_m;
-        self.root_height_lowest_m += o.root_height_lowest_m;
         self.accel += o.accel;
         self.accel_n += o.accel_n;
     }
@@ -92,14 +88,9 @@ impl MotionScore {
         1000.0 * self.root_m / self.root_n.max(1) as f64
     }
 
-    /// Mean root height error, millimetres: the floor from the planted feet, and from the
-    /// lowest ankles.
-    pub fn root_height_mm(&self) -> (f64, f64) {
-        let n = self.root_n.max(1) as f64;
-        (
-            1000.0 * self.root_height_m / n,
-            1000.0 * self.root_height_lowest_m / n,
-        )
+    /// Mean root height error, millimetres.
+    pub fn root_height_mm(&self) -> f64 {
+        1000.0 * self.root_height_m / self.root_n.max(1) as f64
     }
 
     /// Mean acceleration error, m/s².
@@ -147,7 +138,6 @@ pub fn score_motion(gt: &GroundTruth, skeleton: &Skeleton3d) -> Option<MotionSco
     let contacts: Vec<_> = pairs.iter().map(|p| p.3).collect();
     let world = WorldFrame::estimate(&truth, &[]).ok()?;
     let est_world = WorldFrame::estimate(&est, &contacts).ok()?;
-    let est_lowest = WorldFrame::estimate(&est, &[]).ok()?;
     let fps = gt.fps;
     let joints = scored(gt);
     let mut s = MotionScore::default();
@@ -185,8 +175,6 @@ pub fn score_motion(gt: &GroundTruth, skeleton: &Skeleton3d) -> Option<MotionSco
         let height = |w: &WorldFrame, p: &Point3<f64>| w.to_world(p).y;
         let truth_height = height(&world, &truth[t][Joint::Pelvis]);
         s.root_height_m += (height(&est_world, &est[t][Joint::Pelvis]) - truth_height).abs();
-        s.root_height_lowest_m +=
-            (height(&est_lowest, &est[t][Joint::Pelvis]) - truth_height).abs();
     }
     // Foot sliding over the reference's contact phases.
     let up = |v: Vector3<f64>| (world.rotation * v).y;
@@ -271,11 +259,7 @@ mod tests {
         let same = score_motion(&gt, &skeleton_of(&gt, |_, p| p)).unwrap();
         assert!(same.phases > 0, "a walk has contact phases");
         assert!(same.root_mm() < 1e-9 && same.accel() < 1e-9);
-        assert!(
-            same.root_height_mm().0 < 1e-6,
-            "{:?}",
-            same.root_height_mm()
-        );
+        assert!(same.root_height_mm() < 1e-6, "{}", same.root_height_mm());
         let (j, rj) = same.jitter();
         assert!((j - rj).abs() < 1e-9);
         let (sl, rsl) = same.slide_cm();
