@@ -282,7 +282,7 @@ fn per_frame_solve(
             (resolved, score)
         };
         // The facing decided stretch by stretch over the whole clip (see `facing_by_segments`).
-        key = facing_by_segments(key, &per_frame, |k| build(k).1);
+        key = facing_by_segments(key, &per_frame, &bodies, |k| build(k).1);
         let mut reports: Vec<FrameReport> = tracks
             .frames
             .iter()

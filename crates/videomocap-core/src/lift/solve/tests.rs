@@ -88,12 +88,12 @@ fn each_stretch_takes_the_facing_that_explains_the_clip_better() {
             .map(|(t, k)| (facing_m(k) / 2.0 - truth(t)).abs())
             .sum::<f64>()
     };
-    let out = facing_by_segments(chain.clone(), &candidates, score);
+    let out = facing_by_segments(chain.clone(), &candidates, &[], score);
     for (t, k) in out.iter().enumerate() {
         assert!((facing_m(k) / 2.0 - truth(t)).abs() < 1e-12, "frame {t}");
     }
     // A score that prefers the chain leaves it alone.
-    let keep = facing_by_segments(chain.clone(), &candidates, |k| {
+    let keep = facing_by_segments(chain.clone(), &candidates, &[], |k| {
         k.iter().map(|k| -facing_m(k)).sum::<f64>()
     });
     assert_eq!(keep, chain);
