@@ -152,13 +152,14 @@ pub(crate) fn network_on_truth(
     Ok(net)
 }
 
-/// Scores one input of one clip: cut-out, lift alone, network alone, together per weight.
+/// Scores one input of one clip: cut-out, lift alone, network alone, together per weight; and
+/// the seconds the first together lift took (one thread: the lift runs on the caller's).
 fn score_input(
     gt: &GroundTruth,
     tracks: &Tracks2d,
     params: &LiftParams,
     weights: &[f64],
-) -> Result<Vec<Column>, ExitError> {
+) -> Result<(Vec<Column>, f64), ExitError> {
     let camera = gt.camera();
     let subject = SubjectChoice::Height {
         height_m: gt.stated_height_m.unwrap_or(DEFAULT_HEIGHT_M),
@@ -189,12 +190,16 @@ fn score_input(
         column(&lift(&without_bodies(tracks), params)?)?,
         column(&network_alone(gt, tracks, &flat))?,
     ];
+    let mut seconds = None;
     for &w in weights {
         let mut p = *params;
         p.image_depth = w;
-        out.push(column(&lift(tracks, &p)?)?);
+        let t0 = std::time::Instant::now();
+        let together = lift(tracks, &p)?;
+        seconds.get_or_insert(t0.elapsed().as_secs_f64());
+        out.push(column(&together)?);
     }
-    Ok(out)
+    Ok((out, seconds.unwrap_or(0.0)))
 }
 
 /// The clip's true 2D carrying the network's body (run from the clicked marks as the tracker
@@ -252,16 +257,17 @@ fn score_clip(
     weights: &[f64],
     a: &BenchArgs,
     threads: usize,
-) -> Result<Scores, ExitError> {
+) -> Result<(Scores, f64, usize), ExitError> {
     let mut opened = clip.open()?;
     let (exact, tracked) = inputs_with_network(clip, &mut opened, network, a, threads)?;
     let gt = &opened.gt;
     let mut scores: Scores = Default::default();
-    scores[0] = score_input(gt, &exact, params, weights)?;
+    let (columns, seconds) = score_input(gt, &exact, params, weights)?;
+    scores[0] = columns;
     if let Some(tracked) = tracked {
-        scores[1] = score_input(gt, &tracked, params, weights)?;
+        scores[1] = score_input(gt, &tracked, params, weights)?.0;
     }
-    Ok(scores)
+    Ok((scores, seconds, exact.frames.len()))
 }
 
 fn cell(c: Option<&Column>) -> String {
@@ -293,9 +299,12 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs, weights: &[f64]) -> Result<(), Ex
     ];
     names.extend(weights.iter().map(|w| format!("together ({w})")));
     let mut per_clip = Vec::new();
+    let (mut seconds, mut frames) = (0.0, 0);
     for clip in &clips {
         say(global, &format!("lifting {} with the network …", clip.name));
-        let s = score_clip(clip, &network, &params, weights, a, threads)?;
+        let (s, t, n) = score_clip(clip, &network, &params, weights, a, threads)?;
+        seconds += t;
+        frames += n;
         per_clip.push(format!(
             "{:<26} {:<5} {}",
             clip.name,
@@ -322,6 +331,11 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs, weights: &[f64]) -> Result<(), Ex
     out.push(String::new());
     out.push(format!("per clip, (a) MPJPE mm: {}", names.join(" | ")));
     out.extend(per_clip);
+    out.push(String::new());
+    out.push(format!(
+        "speed: the whole lift together with the network's body (reading the lengths, the per-frame solve with the facing steps, the refinement, the feet) on (a), one thread: {:.2} s per 1000 frames",
+        1000.0 * seconds / frames.max(1) as f64
+    ));
     for l in out {
         println!("{l}");
     }
