@@ -7,7 +7,7 @@ use std::path::Path;
 use videomocap_core::bvh::{Bvh, map_to_model};
 use videomocap_core::camera::PinholeCamera;
 use videomocap_core::export::rig::{RIG, rig_index_of};
-use videomocap_core::export::{RigNames, WorldSkeleton, bvh, skeleton_csv, trc};
+use videomocap_core::export::{BvhExport, RigNames, WorldSkeleton, bvh, skeleton_csv, trc};
 use videomocap_core::formats::FrameIndex;
 use videomocap_core::formats::{CONTACT_FLAG, Frame3d, Skeleton3d};
 use videomocap_core::skeleton::{Bone, Joint, PerJoint, SubjectModel};
@@ -197,16 +197,7 @@ proptest! {
 
 #[test]
 fn the_written_hierarchy_is_the_rig_in_order() {
-    let m = Motion {
-        base: vec![[0.1, 0.0, 0.0]; 15],
-        swing: vec![[0.0, 0.2, 0.0]; 15],
-        phase: vec![0.0; 15],
-        turn: 0.0,
-        height: 1.7,
-    };
-    let ws = WorldSkeleton::new(&to_camera(&frames_of(&m, 3), 0.0, 0.0), None).unwrap();
-    let out = bvh(&ws, RigNames::Cmu).unwrap();
-    let read = Bvh::parse(&out.text, Path::new("t.bvh")).unwrap();
+    let (_, out, read) = written([0.1, 0.0, 0.0], [0.0, 0.2, 0.0], 0.0, 0.0);
     assert_eq!(read.joints.len(), RIG.len());
     for (r, j) in RIG.iter().zip(&read.joints) {
         assert_eq!(r.is_end(), j.end_site);
@@ -228,21 +219,10 @@ fn the_written_hierarchy_is_the_rig_in_order() {
 /// through the reader's name table like any other rig.
 #[test]
 fn the_mixamo_rig_is_the_same_motion_under_mixamo_names() {
-    let m = Motion {
-        base: vec![[0.1, 0.0, 0.0]; 15],
-        swing: vec![[0.0, 0.2, 0.0]; 15],
-        phase: vec![0.0; 15],
-        turn: 0.0,
-        height: 1.7,
-    };
-    let ws = WorldSkeleton::new(&to_camera(&frames_of(&m, 3), 0.0, 0.0), None).unwrap();
-    let cmu = bvh(&ws, RigNames::Cmu).unwrap();
+    let (ws, _, a) = written([0.1, 0.0, 0.0], [0.0, 0.2, 0.0], 0.0, 0.0);
     let mixamo = bvh(&ws, RigNames::Mixamo).unwrap();
     assert!(mixamo.max_round_trip_m < 1e-3);
-    let (a, b) = (
-        Bvh::parse(&cmu.text, Path::new("cmu.bvh")).unwrap(),
-        Bvh::parse(&mixamo.text, Path::new("mixamo.bvh")).unwrap(),
-    );
+    let b = Bvh::parse(&mixamo.text, Path::new("mixamo.bvh")).unwrap();
     assert_eq!(a.joints.len(), b.joints.len());
     for k in 0..3 {
         assert_eq!(a.frame(k), b.frame(k), "same motion");
@@ -288,31 +268,43 @@ fn the_mixamo_rig_is_the_same_motion_under_mixamo_names() {
     }
 }
 
-/// The hands continue the forearms by a hand's length; the feet point to the body's front with
-/// the toes at the floor at rest, and turn with the shanks.
-#[test]
-fn hands_continue_the_forearms_and_feet_point_forward_to_the_floor() {
+/// The End Site under the joint called `name`.
+fn end_site_of(read: &Bvh, name: &str) -> usize {
+    let i = read.find(name).unwrap();
+    (0..read.joints.len())
+        .find(|&k| read.joints[k].end_site && read.joints[k].parent == Some(i))
+        .unwrap()
+}
+
+/// A three-frame motion: every bone turned by `base`, swinging by `swing`, seen from
+/// `yaw`/`pitch`; its world skeleton and the CMU BVH written of it, read back.
+fn written(
+    base: [f64; 3],
+    swing: [f64; 3],
+    yaw: f64,
+    pitch: f64,
+) -> (WorldSkeleton, BvhExport, Bvh) {
     let m = Motion {
-        base: vec![[0.0, 0.0, 0.0]; 15],
-        swing: vec![[0.0, 0.0, 0.0]; 15],
+        base: vec![base; 15],
+        swing: vec![swing; 15],
         phase: vec![0.0; 15],
         turn: 0.0,
         height: 1.7,
     };
-    let ws = WorldSkeleton::new(&to_camera(&frames_of(&m, 3), 0.7, 0.1), None).unwrap();
+    let ws = WorldSkeleton::new(&to_camera(&frames_of(&m, 3), yaw, pitch), None).unwrap();
     let out = bvh(&ws, RigNames::Cmu).unwrap();
     let read = Bvh::parse(&out.text, Path::new("t.bvh")).unwrap();
-    let p = read.positions(0);
+    (ws, out, read)
+}
+
+/// The hands continue the forearms by a hand's length; the feet point to the body's front with
+/// the toes at the floor at rest, and turn with the shanks.
+#[test]
+fn hands_continue_the_forearms_and_feet_point_forward_to_the_floor() {
+    let (ws, _, read) = written([0.0; 3], [0.0; 3], 0.7, 0.1);
     let f = &ws.frames[0];
-    let end_of = |name: &str| {
-        let i = read.find(name).unwrap();
-        let e = (0..read.joints.len())
-            .find(|&k| read.joints[k].end_site && read.joints[k].parent == Some(i))
-            .unwrap();
-        p[e] / 100.0
-    };
     // Hand: along elbow → wrist, 0.74 of the forearm beyond the wrist.
-    let hand = end_of("LeftHand");
+    let hand = read.positions(0)[end_site_of(&read, "LeftHand")] / 100.0;
     let forearm = f[Joint::LeftWrist] - f[Joint::LeftElbow];
     let beyond = hand - f[Joint::LeftWrist];
     assert!(beyond.normalize().dot(&forearm.normalize()) > 0.999);
@@ -321,13 +313,7 @@ fn hands_continue_the_forearms_and_feet_point_forward_to_the_floor() {
     // height over the floor (0.039 of the stature), square-ish to the shank.
     let rest = read.rest_positions();
     let at = |name: &str| rest[read.find(name).unwrap()];
-    let toe_rest = {
-        let i = read.find("RightFoot").unwrap();
-        let e = (0..read.joints.len())
-            .find(|&k| read.joints[k].end_site && read.joints[k].parent == Some(i))
-            .unwrap();
-        rest[e]
-    };
+    let toe_rest = rest[end_site_of(&read, "RightFoot")];
     let foot_rest = (toe_rest - at("RightFoot")) / 100.0;
     let shank_rest = (at("RightFoot") - at("RightLeg")) / 100.0;
     assert!(foot_rest.z > 0.0 && foot_rest.x.abs() < 1e-9, "{foot_rest}");
@@ -340,10 +326,10 @@ fn hands_continue_the_forearms_and_feet_point_forward_to_the_floor() {
     let rest_angle = shank_rest.angle(&foot_rest);
     for k in 0..3 {
         let p = read.positions(k);
-        let i = read.find("RightFoot").unwrap();
-        let e = (0..read.joints.len())
-            .find(|&q| read.joints[q].end_site && read.joints[q].parent == Some(i))
-            .unwrap();
+        let (i, e) = (
+            read.find("RightFoot").unwrap(),
+            end_site_of(&read, "RightFoot"),
+        );
         let angle = (p[i] - p[read.find("RightLeg").unwrap()]).angle(&(p[e] - p[i]));
         assert!(
             (angle - rest_angle).abs() < 1e-3,

@@ -407,12 +407,16 @@ fn mark_drag_undo_track_scrub_orbit_export_and_recover() {
     );
 
     // Export a BVH through the menu (the dialog answers with a path).
-    let bvh = dir.path().join("out.bvh");
-    dialogs.answers.borrow_mut().push_back(bvh.clone());
-    h.get_by_label("Export").click();
-    h.run_steps(3);
-    h.get_by_label(ExportKind::Bvh.label()).click();
-    h.run_steps(3);
+    let export = |h: &mut Harness<'_, App>, kind: ExportKind, name: &str| {
+        let path = dir.path().join(name);
+        dialogs.answers.borrow_mut().push_back(path.clone());
+        h.get_by_label("Export").click();
+        h.run_steps(3);
+        h.get_by_label(kind.label()).click();
+        h.run_steps(3);
+        path
+    };
+    let bvh = export(&mut h, ExportKind::Bvh, "out.bvh");
     assert!(
         h.state().state().status().contains("Wrote"),
         "{}",
@@ -421,12 +425,7 @@ fn mark_drag_undo_track_scrub_orbit_export_and_recover() {
     let read = videomocap_core::bvh::Bvh::load(&bvh).unwrap();
     assert_eq!(read.frame_count(), 60);
     // And with Mixamo's bone names, for retargeting: the same motion.
-    let mixamo = dir.path().join("out.mixamo.bvh");
-    dialogs.answers.borrow_mut().push_back(mixamo.clone());
-    h.get_by_label("Export").click();
-    h.run_steps(3);
-    h.get_by_label(ExportKind::BvhMixamo.label()).click();
-    h.run_steps(3);
+    let mixamo = export(&mut h, ExportKind::BvhMixamo, "out.mixamo.bvh");
     let text = std::fs::read_to_string(&mixamo).unwrap();
     assert!(text.contains("ROOT mixamorig:Hips"), "{}", &text[..60]);
     let read_mixamo = videomocap_core::bvh::Bvh::load(&mixamo).unwrap();
