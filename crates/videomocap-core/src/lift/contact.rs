@@ -16,11 +16,11 @@ pub const FEET: [Joint; 2] = [Joint::LeftAnkle, Joint::RightAnkle];
 pub type FootContacts = Vec<[bool; 2]>;
 
 /// A foot comes into contact below this speed of its ankle (metres per second, its image speed
-/// at its depth) ...
-const ENTER_SPEED_M_S: f64 = 0.3;
+/// at its depth): loose enough for a tracked ankle's jitter (`docs/method.md`, "Planted feet") ...
+const ENTER_SPEED_M_S: f64 = 0.48;
 
 /// ... and leaves it above this one.
-const LEAVE_SPEED_M_S: f64 = 0.5;
+const LEAVE_SPEED_M_S: f64 = 0.8;
 
 /// An ankle higher than the other by more than this (metres, along the trunk's mean up
 /// direction) is not planted.
