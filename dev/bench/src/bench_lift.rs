@@ -64,9 +64,23 @@ impl LengthErrors {
     }
 }
 
+/// The doubt table's heading.
+pub(crate) fn doubt_columns() -> String {
+    format!(
+        "{:>8} {:>13} {}",
+        "flagged",
+        "wrong f/unf",
+        UNSURE_SWEEP
+            .iter()
+            .map(|m| format!("{:>17}", format!("<{m}: u% wu/ws")))
+            .collect::<Vec<_>>()
+            .join(" ")
+    )
+}
+
 /// The doubt table's columns: frames flagged, wrong rates flagged / not, and per margin the
 /// unsure share with the wrong rates unsure / sure (percent).
-fn doubt_cell(d: &DoubtTally) -> String {
+pub(crate) fn doubt_cell(d: &DoubtTally) -> String {
     let (wf, wu) = d.flagged_rates();
     let mut s = format!(
         "{:>7.1}% {:>6.1}/{:<6.1}",
@@ -302,16 +316,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         "stated height, true focal: the depth choices that matter (roots apart, no coin flip): frames with a bone flagged too long; how often a flagged bone's choice is wrong against an unflagged one's; per margin, the share shown unsure and how often an unsure / a sure choice is wrong"
             .to_owned(),
     );
-    let doubt_columns = format!(
-        "{:>8} {:>13} {}",
-        "flagged",
-        "wrong f/unf",
-        UNSURE_SWEEP
-            .iter()
-            .map(|m| format!("{:>17}", format!("<{m}: u% wu/ws")))
-            .collect::<Vec<_>>()
-            .join(" ")
-    );
+    let doubt_columns = doubt_columns();
     let doubt_width = doubt_columns.chars().count();
     for (i, input) in INPUTS.iter().enumerate() {
         out.push((*input).to_owned());

@@ -19,6 +19,7 @@ use videomocap_core::network::PoseNetwork;
 use videomocap_core::skeleton::{Bone, DEFAULT_HEIGHT_M, Joint, PerJoint};
 use videomocap_core::track::{NetworkFrames, TrackJob, TrackerParams, run_network, track_video};
 use videomocap_core::video::Video;
+use videomocap_testkit::eval::doubt::{DoubtTally, tally_doubt};
 use videomocap_testkit::eval::pose3d::{Pose3dScore, cutout, score_skeleton, tracks_from_truth};
 use videomocap_testkit::synth::GroundTruth;
 
@@ -63,7 +64,8 @@ type Column = (Pose3dScore, Agreement);
 
 /// A clip's columns per input: cut-out, lift alone, network alone, then the lift together with
 /// the network at each weight; `None` where the input was not run.
-type Scores = [Vec<Column>; 2];
+/// And per input, whether the together lift's doubts point at its mistakes.
+type Scores = ([Vec<Column>; 2], [DoubtTally; 2]);
 
 const INPUT_NAMES: [&str; 2] = [
     "(a) true 2D, network run from the clicked marks",
@@ -152,14 +154,15 @@ pub(crate) fn network_on_truth(
     Ok(net)
 }
 
-/// Scores one input of one clip: cut-out, lift alone, network alone, together per weight; and
-/// the seconds the first together lift took (one thread: the lift runs on the caller's).
+/// Scores one input of one clip: cut-out, lift alone, network alone, together per weight; the
+/// first together lift's doubts against its mistakes; and the seconds it took (one thread: the
+/// lift runs on the caller's).
 fn score_input(
     gt: &GroundTruth,
     tracks: &Tracks2d,
     params: &LiftParams,
     weights: &[f64],
-) -> Result<(Vec<Column>, f64), ExitError> {
+) -> Result<(Vec<Column>, DoubtTally, f64), ExitError> {
     let camera = gt.camera();
     let subject = SubjectChoice::Height {
         height_m: gt.stated_height_m.unwrap_or(DEFAULT_HEIGHT_M),
@@ -175,7 +178,7 @@ fn score_input(
             &mut |_| {},
             &AtomicBool::new(false),
         )
-        .map(|r| r.output.skeleton)
+        .map(|r| r.output)
         .map_err(ExitError::failed)
     };
     let column = |s: &Skeleton3d| -> Result<Column, ExitError> {
@@ -187,19 +190,25 @@ fn score_input(
     let flat = cutout(gt, tracks, camera);
     let mut out = vec![
         column(&flat)?,
-        column(&lift(&without_bodies(tracks), params)?)?,
+        column(&lift(&without_bodies(tracks), params)?.skeleton)?,
         column(&network_alone(gt, tracks, &flat))?,
     ];
-    let mut seconds = None;
+    let mut first: Option<(DoubtTally, f64)> = None;
     for &w in weights {
         let mut p = *params;
         p.image_depth = w;
         let t0 = std::time::Instant::now();
         let together = lift(tracks, &p)?;
-        seconds.get_or_insert(t0.elapsed().as_secs_f64());
-        out.push(column(&together)?);
+        let seconds = t0.elapsed().as_secs_f64();
+        if first.is_none() {
+            let doubt =
+                tally_doubt(gt, &together.skeleton, &together.bones).map_err(ExitError::failed)?;
+            first = Some((doubt, seconds));
+        }
+        out.push(column(&together.skeleton)?);
     }
-    Ok((out, seconds.unwrap_or(0.0)))
+    let (doubt, seconds) = first.unwrap_or_default();
+    Ok((out, doubt, seconds))
 }
 
 /// The clip's true 2D carrying the network's body (run from the clicked marks as the tracker
@@ -262,10 +271,11 @@ fn score_clip(
     let (exact, tracked) = inputs_with_network(clip, &mut opened, network, a, threads)?;
     let gt = &opened.gt;
     let mut scores: Scores = Default::default();
-    let (columns, seconds) = score_input(gt, &exact, params, weights)?;
-    scores[0] = columns;
+    let (columns, doubt, seconds) = score_input(gt, &exact, params, weights)?;
+    (scores.0[0], scores.1[0]) = (columns, doubt);
     if let Some(tracked) = tracked {
-        scores[1] = score_input(gt, &tracked, params, weights)?.0;
+        let (columns, doubt, _) = score_input(gt, &tracked, params, weights)?;
+        (scores.0[1], scores.1[1]) = (columns, doubt);
     }
     Ok((scores, seconds, exact.frames.len()))
 }
@@ -309,7 +319,8 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs, weights: &[f64]) -> Result<(), Ex
             "{:<26} {:<5} {}",
             clip.name,
             clip.split.name(),
-            s[0].iter()
+            s.0[0]
+                .iter()
                 .map(|c| format!("{:>7.1}", c.0.mpjpe_mm()))
                 .collect::<Vec<_>>()
                 .join(" ")
@@ -325,8 +336,22 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs, weights: &[f64]) -> Result<(), Ex
             out.push(format!("{input}: {name}"));
             let columns = format!("{:>6} {:>5} {:>5} {:>4}", "mm", "PA", "mirr", "ord");
             out.extend(Tally::<Scores>::heading(21, &columns));
-            out.extend(tally.lines(21, |s: &Scores| cell(s[i].get(c))));
+            out.extend(tally.lines(21, |s: &Scores| cell(s.0[i].get(c))));
         }
+    }
+    out.push(String::new());
+    out.push(
+        "together: frames with a bone flagged too long; how often a flagged bone's depth choice is wrong against an unflagged one's; per margin, the share shown unsure and how often an unsure / a sure choice is wrong (the product's margin is 0.01)"
+            .to_owned(),
+    );
+    let doubt_columns = crate::bench_lift::doubt_columns();
+    let doubt_width = doubt_columns.chars().count();
+    for (i, input) in INPUT_NAMES.iter().enumerate() {
+        out.push((*input).to_owned());
+        out.extend(Tally::<Scores>::heading(doubt_width, &doubt_columns));
+        out.extend(tally.lines(doubt_width, |s: &Scores| {
+            crate::bench_lift::doubt_cell(&s.1[i])
+        }));
     }
     out.push(String::new());
     out.push(format!("per clip, (a) MPJPE mm: {}", names.join(" | ")));
