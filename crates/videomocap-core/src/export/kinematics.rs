@@ -42,7 +42,8 @@ impl RigMotion {
 
     /// Every rig joint's position in the rest pose (every rotation zero, the root at the
     /// origin).
-    pub fn positions_at_rest(&self) -> Vec<Point3<f64>> {
+    #[cfg(test)]
+    fn positions_at_rest(&self) -> Vec<Point3<f64>> {
         self.forward(&RigPose {
             root: Point3::origin(),
             local: vec![Rotation3::identity(); RIG.len()],
@@ -318,6 +319,7 @@ pub fn hinge_axes(frames: &[PerJoint<Point3<f64>>]) -> Vec<[Vector3<f64>; 4]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::export::rig::rig_index_of;
     use crate::skeleton::SubjectModel;
 
     /// A pose with every bone turned a different way.
@@ -345,12 +347,17 @@ mod tests {
             let fk = motion.positions(f);
             let want = rig_positions(p);
             // The toes turn with the shank: they keep the rest pose's angle to it.
-            let rest_angle = {
-                let rest = motion.positions_at_rest();
-                let (shank, foot) = (rest[19] - rest[18], rest[20] - rest[19]);
-                shank.angle(&foot)
-            };
-            let angle = (fk[19] - fk[18]).angle(&(fk[20] - fk[19]));
+            let (knee, ankle) = (
+                rig_index_of(Joint::LeftKnee),
+                rig_index_of(Joint::LeftAnkle),
+            );
+            let toe = RIG
+                .iter()
+                .position(|r| r.parent == Some(ankle))
+                .expect("the foot's End Site");
+            let angle_at = |q: &[Point3<f64>]| (q[ankle] - q[knee]).angle(&(q[toe] - q[ankle]));
+            let rest_angle = angle_at(&motion.positions_at_rest());
+            let angle = angle_at(&fk);
             assert!(
                 (angle - rest_angle).abs() < 1e-9,
                 "{angle} against {rest_angle}"
