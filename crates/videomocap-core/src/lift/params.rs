@@ -128,7 +128,11 @@ pub fn retired_lift_settings(json: &serde_json::Value) -> Vec<String> {
 /// (`key_path_smoothing`, `adaptive_smoothing`, `ambiguity.arm_swing`, `ambiguity.contact`,
 /// `ambiguity.image_depth`) and the ones retired (read and dropped). Unknown names are refused.
 #[derive(Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[serde(
+    default,
+    deny_unknown_fields,
+    expecting = "lift settings (a JSON object)"
+)]
 struct StoredLiftParams {
     refine: bool,
     smooth_tracks: Option<bool>,
@@ -153,7 +157,10 @@ struct StoredLiftParams {
 
 /// The old `ambiguity` group: three of its weights live on under new names.
 #[derive(Deserialize, Default)]
-#[serde(default)]
+#[serde(
+    default,
+    expecting = "the older files' ambiguity weights (a JSON object)"
+)]
 struct OldAmbiguity {
     arm_swing: Option<f64>,
     contact: Option<f64>,
