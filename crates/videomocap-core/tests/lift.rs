@@ -1,164 +1,25 @@
 //! The 3D reconstruction on sequences built from the skeleton model itself (rigid key triangle,
 //! constant bone lengths), where the answer is known exactly.
 
-use nalgebra::{Point3, Rotation3, Vector3};
+mod lift_support;
+
+use lift_support::{FRAMES, camera, job_for, run, truth, truth_of};
+use nalgebra::Point3;
 use std::sync::atomic::AtomicBool;
-use videomocap_core::camera::PinholeCamera;
 use videomocap_core::formats::FrameIndex;
-use videomocap_core::formats::{KnownLengths, Tracks2d};
+use videomocap_core::formats::KnownLengths;
 use videomocap_core::lift::AmbiguityWeights;
-use videomocap_core::lift::KeyTriangle;
 use videomocap_core::lift::bone_roots;
 use videomocap_core::lift::lift_order;
 use videomocap_core::lift::subject_from_height;
 use videomocap_core::lift::{
-    CameraChoice, DepthOverrides, FocalSource, LiftError, LiftJob, LiftOutput, LiftParams,
-    LiftStage, Root, SubjectChoice, lift, lift_per_frame, reconstruct,
+    CameraChoice, DepthOverrides, FocalSource, LiftError, LiftJob, LiftParams, LiftStage, Root,
+    SubjectChoice, lift, lift_per_frame, reconstruct,
 };
-use videomocap_core::skeleton::{Bone, Joint, PerJoint, SubjectModel};
+use videomocap_core::skeleton::{Bone, Joint, SubjectModel};
 use videomocap_testkit::eval::pose3d::{
     key_triangle_flex_m, lift_on_reference_key, score_skeleton, tracks_from_truth,
 };
-use videomocap_testkit::synth::{GroundTruth, GroundTruthFrame};
-
-const FRAMES: usize = 60;
-
-fn camera() -> PinholeCamera {
-    PinholeCamera::centred(700.0, 640, 480)
-}
-
-/// A lift of `tracks` through [`camera`], with no forced roots.
-fn job_for<'a>(tracks: &'a Tracks2d, subject: &SubjectModel, params: LiftParams) -> LiftJob<'a> {
-    LiftJob {
-        tracks,
-        camera: camera(),
-        subject: subject.clone(),
-        params,
-        overrides: DepthOverrides::new(),
-    }
-}
-
-/// A walking-like sequence of the default subject, turning slowly in front of the camera.
-fn truth() -> (GroundTruth, SubjectModel) {
-    truth_of(SubjectModel::default())
-}
-
-/// The walking-like sequence of subject `s`.
-fn truth_of(s: SubjectModel) -> (GroundTruth, SubjectModel) {
-    use Joint::*;
-    let tri = KeyTriangle::from_subject(&s).unwrap();
-    // The bone joining two joints, whichever way the model's tree runs.
-    let len = |a: Joint, b: Joint| {
-        let bone = if Bone::ALL.contains(&Bone::new(a, b)) {
-            Bone::new(a, b)
-        } else {
-            Bone::new(b, a)
-        };
-        s.bone_length(bone)
-    };
-    let cam = camera();
-    let mut frames = Vec::new();
-    for t in 0..FRAMES {
-        let phase = t as f64 / 30.0 * std::f64::consts::TAU;
-        let r = Rotation3::from_axis_angle(&Vector3::y_axis(), 0.5 * (phase / 2.0).sin() + 0.4)
-            * Rotation3::from_axis_angle(&Vector3::x_axis(), 0.1);
-        let d = Vector3::new(0.4 * t as f64 / FRAMES as f64 - 0.2, -0.35, 4.0);
-        let mut p = PerJoint::from_fn(|_| Point3::origin());
-        p.0[LeftShoulder.index()] = r * tri.points[0] + d;
-        p.0[RightShoulder.index()] = r * tri.points[1] + d;
-        p.0[Chest.index()] = r * tri.points[2] + d;
-        let left = r * Vector3::x();
-        let up = r * -Vector3::y();
-        let fwd = left.cross(&up);
-        let mut put = |a: Joint, b: Joint, dir: Vector3<f64>| {
-            p.0[b.index()] = p[a] + dir.normalize() * len(a, b);
-        };
-        put(Chest, Neck, up + fwd * 0.1);
-        put(Neck, HeadTop, up);
-        put(Chest, Pelvis, -up + fwd * 0.05);
-        put(Pelvis, LeftHip, left);
-        put(Pelvis, RightHip, -left);
-        for (side, sign, shoulder, elbow, wrist, hip, knee, ankle) in [
-            (
-                0.0,
-                1.0,
-                LeftShoulder,
-                LeftElbow,
-                LeftWrist,
-                LeftHip,
-                LeftKnee,
-                LeftAnkle,
-            ),
-            (
-                std::f64::consts::PI,
-                -1.0,
-                RightShoulder,
-                RightElbow,
-                RightWrist,
-                RightHip,
-                RightKnee,
-                RightAnkle,
-            ),
-        ] {
-            let swing = (phase + side).sin();
-            put(
-                shoulder,
-                elbow,
-                -up - fwd * (0.5 * swing) + left * (0.15 * sign),
-            );
-            // The forearm leads the upper arm forwards by 0.2–0.6 (an elbow does not bend
-            // backwards; before 2026-11-23 it trailed by up to 0.4 here, 21° of overextension).
-            put(elbow, wrist, -up + fwd * (0.4 - 0.3 * swing));
-            put(hip, knee, -up + fwd * (0.45 * swing));
-            put(
-                knee,
-                ankle,
-                -up - fwd * (0.25 * (1.0 + (phase + side + 1.0).sin())),
-            );
-        }
-        frames.push(GroundTruthFrame {
-            index: t,
-            points2d: p
-                .0
-                .iter()
-                .map(|q| {
-                    let u = cam.project(q).unwrap();
-                    [u.x, u.y]
-                })
-                .collect(),
-            points3d: p.0.iter().map(|q| [q.x, q.y, q.z]).collect(),
-            visible: vec![true; 16],
-        });
-    }
-    let gt = GroundTruth {
-        source: "tests/lift.rs".into(),
-        fps: 30.0,
-        width: cam.width,
-        height: cam.height,
-        focal_px: cam.focal_px,
-        cx: cam.cx,
-        cy: cam.cy,
-        joints: Joint::ALL.iter().map(|j| j.name().to_owned()).collect(),
-        stated_height_m: None,
-        derived_joints: vec![],
-        bone_lengths_m: Default::default(),
-        frames,
-    };
-    (gt, s)
-}
-
-fn run(gt: &GroundTruth, subject: &SubjectModel, noise: f64, refine: bool) -> LiftOutput {
-    let tracks = tracks_from_truth(gt, noise, 3);
-    let params = LiftParams {
-        refine,
-        // Exact tracks: no temporal smoothing, so the geometry must be exact; noisy ones get
-        // the adaptive smoothing of the default settings.
-        smooth_tracks: noise > 0.0,
-        ..LiftParams::default()
-    };
-    let job = job_for(&tracks, subject, params);
-    lift(&job, &mut |_| {}, &AtomicBool::new(false)).unwrap()
-}
 
 #[test]
 fn exact_tracks_give_back_the_skeleton() {
@@ -254,73 +115,6 @@ fn with_the_true_roots_exact_tracks_give_back_every_joint() {
     }
 }
 
-/// The (frame, bone) pairs flagged too long in `reports`.
-fn too_long_flags(reports: &[videomocap_core::lift::FrameReport]) -> Vec<(FrameIndex, Bone)> {
-    reports
-        .iter()
-        .flat_map(|r| {
-            r.flags.iter().filter_map(move |f| match f {
-                videomocap_core::lift::FrameFlag::TooLong(b) => Some((r.index, *b)),
-                _ => None,
-            })
-        })
-        .collect()
-}
-
-#[test]
-fn a_bone_is_flagged_too_long_only_where_its_image_is_beyond_noise_and_length_doubt() {
-    // Limbs 3 % short of the truth: every frame where one lies square to the camera has its
-    // image a little too long, which says nothing about the tracks.
-    let (gt, truth) = truth();
-    let mut short = truth.clone();
-    for b in Bone::ALL {
-        if ![Joint::Pelvis, Joint::Chest].contains(&b.parent) {
-            short.bone_length_m[b.index()] *= 0.97;
-        }
-    }
-    let mut tracks = tracks_from_truth(&gt, 0.0, 3);
-    let too_long = |tracks: &Tracks2d| {
-        let job = job_for(tracks, &short, LiftParams::default());
-        too_long_flags(&lift_per_frame(&job).unwrap().reports)
-    };
-    let quiet = too_long(&tracks);
-    assert!(quiet.is_empty(), "{quiet:?}");
-    // A wrist the tracker threw 40 px off its forearm on one frame: named there.
-    let forearm = Bone::new(Joint::LeftElbow, Joint::LeftWrist);
-    let p = &mut tracks.frames[30].points[Joint::LeftWrist].pos;
-    let away =
-        (*p - nalgebra::Point2::from(gt.frames[30].points2d[Joint::LeftElbow.index()])).normalize();
-    *p += away * 40.0;
-    let flagged = too_long(&tracks);
-    assert!(flagged.contains(&(FrameIndex(30), forearm)), "{flagged:?}");
-    // Lengths read with a doubt are solved that much shorter (leaning square to their rays):
-    // the miss that leaning makes is not flagged, the thrown wrist still is.
-    let mut doubtful = truth.clone();
-    for b in Bone::ALL {
-        if ![Joint::Pelvis, Joint::Chest].contains(&b.parent) {
-            doubtful.length_doubt[b.index()] = 0.05;
-        }
-    }
-    let flags_of = |tracks: &Tracks2d| {
-        let job = job_for(tracks, &doubtful, LiftParams::default());
-        too_long_flags(
-            &lift(&job, &mut |_| {}, &AtomicBool::new(false))
-                .unwrap()
-                .reports,
-        )
-    };
-    let exact = tracks_from_truth(&gt, 0.0, 3);
-    let quiet = flags_of(&exact);
-    assert!(quiet.is_empty(), "{quiet:?}");
-    // After the refinement a forearm can turn to follow a throw it can reach; one thrown
-    // farther than it could ever reach from its elbow is still named.
-    let elbow = nalgebra::Point2::from(gt.frames[30].points2d[Joint::LeftElbow.index()]);
-    let reach = (tracks.frames[30].points[Joint::LeftWrist].pos - elbow).norm();
-    tracks.frames[30].points[Joint::LeftWrist].pos += away * reach;
-    let flagged = flags_of(&tracks);
-    assert!(flagged.contains(&(FrameIndex(30), forearm)), "{flagged:?}");
-}
-
 #[test]
 fn a_flipped_limb_stays_flipped_and_the_rest_is_resolved_again() {
     let (gt, subject) = truth();
@@ -350,92 +144,6 @@ fn a_flipped_limb_stays_flipped_and_the_rest_is_resolved_again() {
         after.resolved.choices[t][arm.index()],
         before.resolved.choices[t][arm.index()]
     );
-}
-
-#[test]
-fn bad_tracks_are_refused_with_a_reason() {
-    let (gt, subject) = truth();
-    let tracks = tracks_from_truth(&gt, 0.0, 3);
-    let job = |tracks, focal| LiftJob {
-        tracks,
-        camera: PinholeCamera::centred(focal, 640, 480),
-        subject: subject.clone(),
-        params: LiftParams::default(),
-        overrides: DepthOverrides::new(),
-    };
-    assert!(matches!(
-        lift_per_frame(&job(&tracks, 0.0)),
-        Err(LiftError::BadFocal(_))
-    ));
-    assert!(matches!(
-        lift_per_frame(&job(&tracks, f64::NAN)),
-        Err(LiftError::BadFocal(_))
-    ));
-    // One frame lifts.
-    let mut one = tracks.clone();
-    one.frames.truncate(1);
-    let out = lift(&job(&one, 700.0), &mut |_| {}, &AtomicBool::new(false)).unwrap();
-    assert_eq!(out.skeleton.frames.len(), 1);
-    // No frames.
-    let mut none = tracks.clone();
-    none.frames.clear();
-    assert!(matches!(
-        lift_per_frame(&job(&none, 700.0)),
-        Err(LiftError::NoFrames)
-    ));
-    // Shoulders on top of each other in every frame.
-    let mut flat = tracks.clone();
-    for f in &mut flat.frames {
-        f.points.0[Joint::RightShoulder.index()] = f.points[Joint::LeftShoulder];
-    }
-    let e = lift_per_frame(&job(&flat, 700.0)).unwrap_err();
-    assert!(matches!(e, LiftError::DegenerateKeyTriangle), "{e}");
-    assert!(e.to_string().contains("shoulders"));
-    // A NaN is named with its frame and joint.
-    let mut broken = tracks.clone();
-    broken.frames[7].points.0[Joint::LeftKnee.index()].pos.x = f64::NAN;
-    let e = lift_per_frame(&job(&broken, 700.0))
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("frame 7") && e.contains("left_knee"), "{e}");
-    // Settings out of their range are named (a negative weight would reward what its prior
-    // forbids, a zero deviation divides by zero); a zero weight or anchor turns a term off.
-    let with = |params: LiftParams| LiftJob {
-        params,
-        ..job(&tracks, 700.0)
-    };
-    let params = LiftParams {
-        arm_swing: -5.0,
-        ..LiftParams::default()
-    };
-    let e = lift_per_frame(&with(params)).unwrap_err().to_string();
-    assert!(e.contains("arm_swing") && e.contains("-5"), "{e}");
-    let params = LiftParams {
-        image_depth: f64::INFINITY,
-        ..LiftParams::default()
-    };
-    let e = lift(&with(params), &mut |_| {}, &AtomicBool::new(false)).unwrap_err();
-    assert!(
-        matches!(
-            e,
-            LiftError::BadSetting {
-                name: "image_depth",
-                ..
-            }
-        ),
-        "{e}"
-    );
-    let params = LiftParams {
-        smoothing_s: f64::NAN,
-        ..LiftParams::default()
-    };
-    assert!(lift_per_frame(&with(params)).is_err());
-    let params = LiftParams {
-        hands_outside_body: 0.0,
-        image_depth: 0.0,
-        ..LiftParams::default()
-    };
-    assert!(params.validate().is_ok());
 }
 
 #[test]

@@ -113,6 +113,8 @@ fn plain_flag(flag: &str) -> String {
         format!("{j} off the frame")
     } else if let Some(j) = flag.strip_prefix(videomocap_core::formats::LOST_FLAG) {
         format!("{j} lost: a guess")
+    } else if flag == videomocap_core::formats::NO_IMAGE_DEPTH_FLAG {
+        "the pose network saw no body here: depth from the geometry alone".to_owned()
     } else {
         flag.to_owned()
     }

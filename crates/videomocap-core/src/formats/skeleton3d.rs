@@ -19,6 +19,10 @@ pub const SKELETON3D_FORMAT: &str = "videomocap.skeleton3d";
 /// (`off_frame:left_wrist`): its 3D position rests on the tracker's estimate.
 pub const OFF_FRAME_FLAG: &str = "off_frame:";
 
+/// The frame flag for a frame where the pose network saw no body while it did on others (the
+/// depth choices there rest on the geometry alone).
+pub const NO_IMAGE_DEPTH_FLAG: &str = "no_image_depth";
+
 /// The prefix of the frame flag that marks a joint whose 2D track was lost (in a weak run too
 /// long to interpolate, `lost:left_wrist`): its 3D position rests on the tracker's guess.
 pub const LOST_FLAG: &str = "lost:";

@@ -22,6 +22,9 @@ pub enum FrameFlag {
     OffFrame(Joint),
     /// The joint's 2D track was lost (a weak run too long to fill): it rests on a guess.
     Lost(Joint),
+    /// The pose network saw no body on this frame while it did on others: the depth choices
+    /// here rest on the geometry alone.
+    NoImageDepth,
 }
 
 impl fmt::Display for FrameFlag {
@@ -31,6 +34,7 @@ impl fmt::Display for FrameFlag {
             FrameFlag::TooLong(b) => write!(f, "too_long:{}", b.key()),
             FrameFlag::OffFrame(j) => write!(f, "{}{}", crate::formats::OFF_FRAME_FLAG, j.name()),
             FrameFlag::Lost(j) => write!(f, "{}{}", crate::formats::LOST_FLAG, j.name()),
+            FrameFlag::NoImageDepth => f.write_str(crate::formats::NO_IMAGE_DEPTH_FLAG),
         }
     }
 }

@@ -172,6 +172,10 @@ fn per_frame_solve(
         .iter()
         .map(|f| f.body3d.as_deref().cloned())
         .collect();
+    // Frames without the network's body while others have one (and its evidence is weighed).
+    let no_image_depth = |t: usize| {
+        job.params.image_depth > 0.0 && bodies[t].is_none() && bodies.iter().any(Option::is_some)
+    };
 
     // The calibration frame: the best-shaped key triangle, weighted by the trust in its points
     // and by its size in the image (a pixel of noise turns a small triangle further: with one
@@ -288,7 +292,8 @@ fn per_frame_solve(
             .iter()
             .zip(&per_frame)
             .zip(&key)
-            .map(|((f, (_, converged)), k)| FrameReport {
+            .enumerate()
+            .map(|(t, ((f, (_, converged)), k))| FrameReport {
                 index: f.index,
                 key_rms_m: super::calibrate::KEY_LINES
                     .iter()
@@ -309,6 +314,7 @@ fn per_frame_solve(
                                 PointSource::Tracked | PointSource::Interpolated => None,
                             }),
                     )
+                    .chain(no_image_depth(t).then_some(FrameFlag::NoImageDepth))
                     .collect(),
             })
             .collect();

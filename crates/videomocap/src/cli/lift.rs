@@ -152,6 +152,15 @@ pub fn report(out: &LiftOutput, foot_lock: bool, global: &GlobalArgs) {
             count(&|f| matches!(f, FrameFlag::KeyTriangleNotConverged)),
         ),
     );
+    let blind = count(&|f| matches!(f, FrameFlag::NoImageDepth));
+    if blind > 0 {
+        say(
+            global,
+            &format!(
+                "frames where the pose network saw no body (depth from the geometry alone): {blind}"
+            ),
+        );
+    }
     if let Some(r) = &out.refinement {
         say(
             global,
