@@ -71,6 +71,102 @@ pub(crate) struct Minimum {
     pub cost_after: f64,
 }
 
+/// The normal equations' matrix JᵀJ in compressed columns, its sparsity pattern (with every
+/// diagonal entry) kept from one step to the next: the rows' derivatives touch the same
+/// unknowns at every step, so after the first step each product is added in place and the
+/// Cholesky factor's structure is reused.
+struct NormalMatrix {
+    /// JᵀJ (both triangles: the factorization wants a symmetric pattern).
+    matrix: CscMatrix<f64>,
+    /// Where each column's diagonal entry sits in the values.
+    diagonal_at: Vec<usize>,
+    /// The factor of the last damped matrix, for its structure.
+    factor: Option<CscCholesky<f64>>,
+}
+
+impl NormalMatrix {
+    /// JᵀJ and Jᵀr at `x` by way of coordinates (the first step, or when a row touched a pair
+    /// of unknowns the pattern lacks).
+    fn build(problem: &dyn Residuals, x: &DVector<f64>) -> (NormalMatrix, DVector<f64>) {
+        let m = x.len();
+        let mut jtj = CooMatrix::new(m, m);
+        let mut jtr = DVector::<f64>::zeros(m);
+        for i in 0..m {
+            jtj.push(i, i, 0.0);
+        }
+        problem.rows(x, &mut |row| {
+            let e = &row.entries[..row.len];
+            for &(i, di) in e {
+                jtr[i] += di * row.value;
+                for &(k, dk) in e {
+                    jtj.push(i, k, di * dk);
+                }
+            }
+        });
+        let matrix = CscMatrix::from(&jtj);
+        // Every diagonal entry was pushed, so each column has one (an invariant of the build).
+        let diagonal_at = (0..m)
+            .map(|k| {
+                let (offsets, rows) = (matrix.col_offsets(), matrix.row_indices());
+                offsets[k] + rows[offsets[k]..offsets[k + 1]].partition_point(|&r| r < k)
+            })
+            .collect();
+        let normal = NormalMatrix {
+            matrix,
+            diagonal_at,
+            factor: None,
+        };
+        (normal, jtr)
+    }
+
+    /// JᵀJ and Jᵀr at `x` added into the kept pattern; false (the matrix then undefined) when a
+    /// row touched a pair of unknowns outside it.
+    fn refill(
+        &mut self,
+        problem: &dyn Residuals,
+        x: &DVector<f64>,
+        jtr: &mut DVector<f64>,
+    ) -> bool {
+        jtr.fill(0.0);
+        let (offsets, rows, values) = self.matrix.csc_data_mut();
+        values.fill(0.0);
+        let mut inside = true;
+        problem.rows(x, &mut |row| {
+            let e = &row.entries[..row.len];
+            for &(i, di) in e {
+                jtr[i] += di * row.value;
+                for &(k, dk) in e {
+                    let column = &rows[offsets[k]..offsets[k + 1]];
+                    match column.binary_search(&i) {
+                        Ok(at) => values[offsets[k] + at] += di * dk,
+                        Err(_) => inside = false,
+                    }
+                }
+            }
+        });
+        inside
+    }
+
+    /// Solves (JᵀJ + λ·diag(JᵀJ)) step = Jᵀr; `None` when the damped matrix is not positive
+    /// definite.
+    fn solve_damped(&mut self, lambda: f64, jtr: &DVector<f64>) -> Option<DMatrix<f64>> {
+        let mut damped = self.matrix.values().to_vec();
+        for &at in &self.diagonal_at {
+            damped[at] += lambda * self.matrix.values()[at].max(1e-9) + 1e-12;
+        }
+        match &mut self.factor {
+            Some(factor) => factor.refactor(&damped).ok()?,
+            None => {
+                let matrix =
+                    CscMatrix::try_from_pattern_and_values(self.matrix.pattern().clone(), damped)
+                        .ok()?;
+                self.factor = Some(CscCholesky::factor(&matrix).ok()?);
+            }
+        }
+        self.factor.as_ref().map(|f| f.solve(jtr))
+    }
+}
+
 /// Levenberg–Marquardt from `x`, at most `max_iterations` steps, stopping when a step gains
 /// less than a millionth of the cost. `before_step(i)` runs before step `i` and stops the
 /// minimisation (`None`) when it returns false (a cancel).
@@ -80,46 +176,37 @@ pub(crate) fn minimise(
     max_iterations: usize,
     before_step: &mut dyn FnMut(usize) -> bool,
 ) -> Option<Minimum> {
-    let m = x.len();
     let cost_before = problem.cost(&x);
     let mut cost = cost_before;
     let mut lambda = 1e-3;
     let mut iterations = 0;
+    let mut normal: Option<NormalMatrix> = None;
+    let mut jtr = DVector::<f64>::zeros(x.len());
     while iterations < max_iterations {
         if !before_step(iterations) {
             return None;
         }
         iterations += 1;
         // Normal equations JᵀJ and Jᵀr, accumulated row by row.
-        let mut jtj = CooMatrix::new(m, m);
-        let mut jtr = DVector::<f64>::zeros(m);
-        problem.rows(&x, &mut |row| {
-            let e = &row.entries[..row.len];
-            for &(i, di) in e {
-                jtr[i] += di * row.value;
-                for &(k, dk) in e {
-                    jtj.push(i, k, di * dk);
-                }
+        let refilled = normal
+            .as_mut()
+            .is_some_and(|n| n.refill(problem, &x, &mut jtr));
+        let normal = match (refilled, &mut normal) {
+            (true, Some(n)) => n,
+            _ => {
+                let (n, r) = NormalMatrix::build(problem, &x);
+                jtr = r;
+                normal.insert(n)
             }
-        });
-        let jtj = CscMatrix::from(&jtj);
-        let diagonal: Vec<f64> = (0..m)
-            .map(|i| jtj.get_entry(i, i).map_or(0.0, |e| e.into_value()))
-            .collect();
+        };
         let mut improved = false;
         while lambda < 1e8 {
-            let mut damped = CooMatrix::new(m, m);
-            for (i, k, v) in jtj.triplet_iter() {
-                damped.push(i, k, *v);
-            }
-            for (i, d) in diagonal.iter().enumerate() {
-                damped.push(i, i, lambda * d.max(1e-9) + 1e-12);
-            }
-            let Ok(chol) = CscCholesky::factor(&CscMatrix::from(&damped)) else {
+            let Some(step) = normal.solve_damped(lambda, &jtr) else {
+                // Not positive definite: the next try starts the factor afresh.
+                normal.factor = None;
                 lambda *= 10.0;
                 continue;
             };
-            let step: DMatrix<f64> = chol.solve(&jtr);
             let candidate = &x - step.column(0);
             let c = problem.cost(&candidate);
             if c.is_finite() && c < cost {
@@ -217,5 +304,44 @@ mod tests {
             assert!((m.x[i] - 0.5 * i as f64).abs() < 0.1, "{i}: {}", m.x[i]);
         }
         assert!(minimise(&line, start, 20, &mut |i| i < 1).is_none());
+    }
+
+    /// The line, with a row tying its ends together only where the first point is above 1.
+    struct Tied(Line);
+
+    impl Residuals for Tied {
+        fn rows(&self, x: &DVector<f64>, emit: &mut dyn FnMut(Row)) {
+            self.0.rows(x, emit);
+            let n = self.0.samples.len() - 1;
+            if x[0] > 1.0 {
+                emit(Row::new(x[0] - x[n]).with(0, 1.0).with(n, -1.0));
+            }
+        }
+    }
+
+    #[test]
+    fn the_kept_pattern_is_refilled_in_place_and_rebuilt_when_a_row_leaves_it() {
+        let samples: Vec<f64> = (0..10).map(|i| (i as f64).sin()).collect();
+        let tied = Tied(Line { samples });
+        let (low, high) = (DVector::zeros(10), DVector::from_element(10, 2.0));
+        // Refilled at another point with the same pattern: exactly what a fresh build gives.
+        let (mut kept, _) = NormalMatrix::build(&tied, &low);
+        let mut jtr = DVector::zeros(10);
+        let shifted = DVector::from_element(10, 0.5);
+        assert!(kept.refill(&tied, &shifted, &mut jtr));
+        let (fresh, fresh_jtr) = NormalMatrix::build(&tied, &shifted);
+        assert_eq!(kept.matrix, fresh.matrix);
+        assert_eq!(jtr, fresh_jtr);
+        // Where the tie appears, its pair of ends is outside the pattern: refused.
+        assert!(!kept.refill(&tied, &high, &mut jtr));
+        // And the minimisation from there (the pattern changing as the first point crosses 1)
+        // still lowers the cost.
+        let m = minimise(&tied, high, 20, &mut |_| true).unwrap();
+        assert!(
+            m.cost_after < 0.2 * m.cost_before,
+            "{} {}",
+            m.cost_before,
+            m.cost_after
+        );
     }
 }
