@@ -251,3 +251,19 @@ fn sphere(centre: Point3<f64>, r: f64, push: &mut impl FnMut(Point3<f64>, Point3
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::plain_flag;
+
+    #[test]
+    fn lift_flags_read_in_words_and_unknown_ones_pass_through() {
+        assert!(plain_flag("no_image_depth").contains("pose network saw no body"));
+        assert_eq!(plain_flag("lost:left_knee"), "left_knee lost: a guess");
+        assert_eq!(
+            plain_flag("off_frame:right_wrist"),
+            "right_wrist off the frame"
+        );
+        assert_eq!(plain_flag("a_later_flag"), "a_later_flag");
+    }
+}

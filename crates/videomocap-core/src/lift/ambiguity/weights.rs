@@ -38,7 +38,8 @@ pub struct AmbiguityWeights {
     /// In a walking or running stride (the thighs split forwards and backwards), each arm
     /// swings against its own thigh (the left arm forward with the right leg): the arm whose
     /// forward tilt has the same sign as its thigh's pays, in proportion to how far the thighs
-    /// split (fully from 0.2 …. Measured in `docs/method.md` ("Fitted constants of the lift").
+    /// split (fully from 0.2 forwards and backwards), tilt times tilt. Measured in
+    /// `docs/method.md` ("Fitted constants of the lift").
     pub arm_swing: f64,
     /// A wrist inside the body: nearer the spine (chest to pelvis) than 0.35 of the trunk's
     /// breadth, or a thigh than 0.45 of the thigh's, pays the squared depth it went in.
@@ -53,7 +54,8 @@ pub struct AmbiguityWeights {
     /// In a gait (the thighs swinging alternately, repeating each other half a stride apart),
     /// each arm's upper arm and forearm pay their squared distance (times the bone's length
     /// squared) from the other arm's, mirrored left to right in the key triangle's frame, half
-    /// a stride before and …. Measured in `docs/method.md` ("Fitted constants of the lift").
+    /// a stride before and after. Measured in `docs/method.md` ("Fitted constants of the
+    /// lift").
     pub gait_symmetry: f64,
     /// The image's depth evidence: where the pose network saw the body (the tracks' `body3d`),
     /// each bone pays the squared difference between its depth step (child minus parent, along
@@ -63,7 +65,8 @@ pub struct AmbiguityWeights {
     /// The image's evidence for which way the body faces: how strongly the shoulders' depth
     /// order against the network's (each frame's squared difference of the two depth steps,
     /// times the network's confidence, summed over the clip) counts in the choice of the key
-    /// triangle's pose and …. Measured in `docs/method.md` ("Fitted constants of the lift").
+    /// triangle's pose and facing, as one more part of the fit's sum of logarithms. Measured in
+    /// `docs/method.md` ("Fitted constants of the lift").
     pub image_facing: f64,
 }
 
