@@ -38,7 +38,8 @@ pub struct LiftParams {
     /// (default 10; 0 = off).
     pub hands_outside_body: f64,
     /// How much the pose network's 3D body counts for each bone's depth and the body's facing
-    /// where the tracks carry it (default 1; 0 = geometry alone).
+    /// where the tracks carry it (default 1; 0 = geometry alone, which also turns off the
+    /// refinement's pull towards the network's bone directions).
     pub image_depth: f64,
 }
 

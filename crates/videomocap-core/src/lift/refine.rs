@@ -20,9 +20,9 @@
 use super::error::LiftError;
 use super::least_squares::{Residuals, Row, frame_interval_s, minimise};
 use crate::camera::PinholeCamera;
-use crate::formats::{PointSource, TrackedPoint};
+use crate::formats::{NetworkBody, PointSource, TrackedPoint};
 use crate::skeleton::{BONE_COUNT, Bone, JOINT_COUNT, Joint, PerJoint, SubjectModel};
-use nalgebra::{DVector, Point2, Point3, Vector3};
+use nalgebra::{DVector, Point2, Point3, Rotation3, Vector3};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Weights of the refinement: fitted constants (`docs/method.md`).
@@ -43,7 +43,8 @@ pub struct RefineParams {
     /// cannot tell a longer bone from a bone turned towards it, and at 0.1 the refinement traded
     /// lengths for depth and tilted whole poses on the suite).
     pub length_prior: f64,
-    /// Levenberg–Marquardt iterations at most (default 20).
+    /// Levenberg–Marquardt iterations at most (default 6: on the dev split 6, 10 and 20 gave the
+    /// same figures to 0.1 mm, and each step costs a factorisation).
     pub max_iterations: usize,
     /// How far (metres, standard deviation per axis) a joint may move from the per-frame solve
     /// (default 0.03; 0 turns the anchor off). Measured in `docs/method.md` ("Fitted constants
@@ -54,6 +55,12 @@ pub struct RefineParams {
     /// (`super::smoothing::median_noise_px`), so noisy tracks are smoothed firmly and exact
     /// ones barely. Measured in `docs/method.md` ("Fitted constants of the lift").
     pub adaptive: bool,
+    /// How far (metres along the child's viewing ray, at full confidence) a bone's child may sit
+    /// from where the pose network's direction for the bone puts it at the bone's length
+    /// (default 0.025; 0 turns the pull off): the network sees the limbs' depth better than the
+    /// rays and the priors alone, and the image places the bone across the ray. Measured in
+    /// `docs/method.md` ("The network's bone directions in the refinement").
+    pub network_direction_sigma_m: f64,
 }
 
 impl Default for RefineParams {
@@ -63,9 +70,10 @@ impl Default for RefineParams {
             length_sigma_m: 0.005,
             acceleration_sigma_mps2: 100.0,
             length_prior: 0.01,
-            max_iterations: 20,
+            max_iterations: 6,
             anchor_sigma_m: 0.03,
             adaptive: true,
+            network_direction_sigma_m: 0.025,
         }
     }
 }
@@ -152,6 +160,9 @@ struct Problem<'a> {
     params: RefineParams,
     /// Acceleration deviation, metres per frame² ([`acceleration_sigma_m`]).
     accel_sigma_m: f64,
+    /// Per frame, the bones the pose network saw: index, direction in camera axes, how sure it
+    /// is of both ends.
+    directions: Vec<Vec<(usize, Vector3<f64>, f64)>>,
 }
 
 /// The subject's lengths in refinement order: the 15 bones, then the shoulder width.
@@ -270,6 +281,29 @@ impl Residuals for Problem<'_> {
                         .with(cp + axis, -2.0 * s),
                 );
             }
+            if p.network_direction_sigma_m > 0.0 {
+                for &(k, u, sure) in &self.directions[t] {
+                    let (a, b) = pairs[k];
+                    let s = sure.sqrt() / p.network_direction_sigma_m;
+                    let d = Self::point(x, t, b) - Self::point(x, t, a);
+                    let target = u * self.start_lengths[k];
+                    let (ca, cb) = (Self::col(t, a), Self::col(t, b));
+                    // Along the child's ray only: the image places the bone across it.
+                    let e = self.start[t][b]
+                        .coords
+                        .try_normalize(1e-9)
+                        .unwrap_or_else(Vector3::z);
+                    emit(
+                        Row::new(s * (d - target).dot(&e))
+                            .with(cb, s * e.x)
+                            .with(cb + 1, s * e.y)
+                            .with(cb + 2, s * e.z)
+                            .with(ca, -s * e.x)
+                            .with(ca + 1, -s * e.y)
+                            .with(ca + 2, -s * e.z),
+                    );
+                }
+            }
             if t >= 1 && t + 1 < n {
                 let s = 1.0 / self.accel_sigma_m;
                 for j in Joint::ALL {
@@ -342,15 +376,78 @@ fn acceleration_sigma_m(track_noise_px: f64, params: &RefineParams, dt: f64) -> 
     accel * dt * dt
 }
 
-/// Refines a sequence; `start` is the per-frame solve, `fps` sets Δt, and `track_noise_px` is
-/// the tracks' white noise ([`super::smoothing::median_noise_px`]) for the adaptive
-/// acceleration term.
+/// The network's directions are averaged over this many frames either side (weighted by its
+/// confidence): frame by frame they jitter. On the dev split the averaging took the motion's
+/// jitter from exact 2D 1146 → 804 m/s³ (from the tracker's output 599 → 558) and left MPJPE
+/// as it was (`docs/method.md`, "The network's bone directions in the refinement").
+const NETWORK_DIRECTION_FRAMES: usize = 2;
+
+/// One bone as the network saw it on one frame: its direction in the camera's axes and the
+/// network's confidence in both ends.
+type Seen = (Vector3<f64>, f64);
+
+/// The least confidence (both ends) at which the network's direction of a bone is used.
+const MIN_NETWORK_CONFIDENCE: f32 = 0.5;
+
+/// Per frame, the bones the pose network saw surely enough ([`MIN_NETWORK_CONFIDENCE`]): each
+/// bone's index, its direction in the camera's axes (averaged over
+/// [`NETWORK_DIRECTION_FRAMES`] either side) and the network's confidence in both ends.
+/// The network's axes are the view's (x right, y down, z away), a view centred on the body:
+/// each frame's directions are turned from the optical axis onto the ray through the pelvis.
+fn network_directions(
+    start: &[PerJoint<Point3<f64>>],
+    bodies: &[Option<NetworkBody>],
+) -> Vec<Vec<(usize, Vector3<f64>, f64)>> {
+    // Each frame's bone directions in the camera's axes, where the network was sure.
+    let seen: Vec<[Option<Seen>; BONE_COUNT]> = start
+        .iter()
+        .enumerate()
+        .map(|(t, points)| {
+            let Some(Some(body)) = bodies.get(t) else {
+                return [None; BONE_COUNT];
+            };
+            let turn = points[Joint::Pelvis]
+                .coords
+                .try_normalize(1e-9)
+                .and_then(|ray| Rotation3::rotation_between(&Vector3::z(), &ray))
+                .unwrap_or_else(Rotation3::identity);
+            std::array::from_fn(|k| {
+                let bone = Bone::ALL[k];
+                let sure = body.confidence[bone.parent].min(body.confidence[bone.child]);
+                let d = body.points[bone.child] - body.points[bone.parent];
+                let u = d.try_normalize(1e-6)?;
+                (sure >= MIN_NETWORK_CONFIDENCE).then(|| (turn * u, f64::from(sure)))
+            })
+        })
+        .collect();
+    let radius = NETWORK_DIRECTION_FRAMES;
+    (0..seen.len())
+        .map(|t| {
+            (0..BONE_COUNT)
+                .filter_map(|k| {
+                    let (_, sure) = seen[t][k]?;
+                    let lo = t.saturating_sub(radius);
+                    let hi = (t + radius).min(seen.len() - 1);
+                    let sum: Vector3<f64> = (lo..=hi)
+                        .filter_map(|s| seen[s][k].map(|(u, c)| u * c))
+                        .sum();
+                    Some((k, sum.try_normalize(1e-9)?, sure))
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Refines a sequence; `start` is the per-frame solve, `bodies` the pose network's per frame
+/// (empty: none), `fps` sets Δt, and `track_noise_px` is the tracks' white noise
+/// ([`super::smoothing::median_noise_px`]) for the adaptive acceleration term.
 #[allow(clippy::too_many_arguments)]
 pub fn refine(
     cam: &PinholeCamera,
     images: &[PerJoint<Point2<f64>>],
     weights: &[PerJoint<f64>],
     start: &[PerJoint<Point3<f64>>],
+    bodies: &[Option<NetworkBody>],
     subject: &SubjectModel,
     fps: f64,
     track_noise_px: f64,
@@ -361,6 +458,7 @@ pub fn refine(
     let n = start.len();
     let start_lengths = subject_lengths(subject);
     let dt = frame_interval_s(fps);
+    let directions = network_directions(start, bodies);
     let problem = Problem {
         cam,
         images,
@@ -369,6 +467,7 @@ pub fn refine(
         start_lengths,
         params: *params,
         accel_sigma_m: acceleration_sigma_m(track_noise_px, params, dt),
+        directions,
     };
     let x = Problem::pack(start, &start_lengths);
     let reprojection_px_before = problem.reprojection_rms(&x);
@@ -480,6 +579,17 @@ mod tests {
             .map(|f| f.map(|_, p| cam.project(p).unwrap() + nalgebra::Vector2::new(1.5, -0.5)))
             .collect();
         let weights = vec![PerJoint::from_fn(|j| 0.3 + 0.04 * j.index() as f64); n];
+        // The network's body, turned a little from the start, on every frame but the second.
+        let bodies: Vec<Option<NetworkBody>> = (0..n)
+            .map(|t| {
+                (t != 1).then(|| NetworkBody {
+                    points: start[t].map(|j, p| {
+                        p.coords + Vector3::new(0.0, 0.0, 0.03 * (j.index() % 3) as f64)
+                    }),
+                    confidence: PerJoint::from_fn(|j| 0.4 + 0.05 * j.index() as f32),
+                })
+            })
+            .collect();
         let start_lengths = subject_lengths(&subject);
         let problem = Problem {
             cam: &cam,
@@ -489,6 +599,7 @@ mod tests {
             start_lengths,
             params: RefineParams::default(),
             accel_sigma_m: 20.0 / 900.0,
+            directions: network_directions(&start, &bodies),
         };
         let x = Problem::pack(&start, &start_lengths.map(|l| l * 1.05));
         assert_rows_match_finite_differences(&problem, &x);

@@ -473,6 +473,16 @@ fn lift_leaning(
             .iter()
             .map(|f| f.points.map(|_, p| track_weight(p)))
             .collect();
+        // The network's bodies pull the limbs' directions; off with the image's evidence.
+        let bodies: Vec<_> = if job.params.image_depth > 0.0 {
+            job.tracks
+                .frames
+                .iter()
+                .map(|f| f.body3d.as_deref().cloned())
+                .collect()
+        } else {
+            Vec::new()
+        };
         // The refinement sees the same smoothed points: fitted to the raw ones it brought the
         // noise back (2 px noise on the suite: 80 → 108 mm).
         let refined = refine(
@@ -480,6 +490,7 @@ fn lift_leaning(
             &per.images,
             &weights,
             &per.resolved.points,
+            &bodies,
             &job.subject,
             job.tracks.source.fps,
             median_noise_px(job.tracks, &Joint::ALL),
@@ -497,6 +508,12 @@ fn lift_leaning(
         let mut reports = per.reports.clone();
         let solved = (&refined.points[..], &per.images[..], &refined.bone_lengths);
         flag_too_long(job, &mut reports, solved, doubt, true);
+        // Only where the image is longer than the bone could be already on its rays: a miss the
+        // refinement made itself (smoothing, the network's depth) is not a slip of the image.
+        for (r, p) in reports.iter_mut().zip(&per.reports) {
+            r.flags
+                .retain(|f| !matches!(f, FrameFlag::TooLong(_)) || p.flags.contains(f));
+        }
         (
             skeleton(job, &refined.points, &refined.bone_lengths, &reports),
             Some(refined.summary),
