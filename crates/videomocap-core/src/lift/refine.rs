@@ -160,9 +160,8 @@ struct Problem<'a> {
     params: RefineParams,
     /// Acceleration deviation, metres per frame² ([`acceleration_sigma_m`]).
     accel_sigma_m: f64,
-    /// Per frame, the bones the pose network saw: index, direction in camera axes, how sure it
-    /// is of both ends.
-    directions: Vec<Vec<(usize, Vector3<f64>, f64)>>,
+    /// Per frame, the bones the pose network saw ([`network_directions`]).
+    directions: Vec<Vec<SeenBone>>,
 }
 
 /// The subject's lengths in refinement order: the 15 bones, then the shoulder width.
@@ -386,6 +385,9 @@ const NETWORK_DIRECTION_FRAMES: usize = 2;
 /// network's confidence in both ends.
 type Seen = (Vector3<f64>, f64);
 
+/// A bone's index (in [`Bone::ALL`]) with how the network saw it, averaged over frames.
+type SeenBone = (usize, Vector3<f64>, f64);
+
 /// The least confidence (both ends) at which the network's direction of a bone is used.
 const MIN_NETWORK_CONFIDENCE: f32 = 0.5;
 
@@ -397,7 +399,7 @@ const MIN_NETWORK_CONFIDENCE: f32 = 0.5;
 fn network_directions(
     start: &[PerJoint<Point3<f64>>],
     bodies: &[Option<NetworkBody>],
-) -> Vec<Vec<(usize, Vector3<f64>, f64)>> {
+) -> Vec<Vec<SeenBone>> {
     // Each frame's bone directions in the camera's axes, where the network was sure.
     let seen: Vec<[Option<Seen>; BONE_COUNT]> = start
         .iter()

@@ -18,7 +18,7 @@ use super::refine::{RefineParams, RefineSummary, refine, track_weight};
 use super::report::{BoneDepth, FrameFlag, FrameReport, flag_too_long};
 use super::smoothing::{adaptive_sigmas, median_noise_px, smoothed_images};
 use crate::camera::PinholeCamera;
-use crate::formats::{Frame3d, FrameIndex, PointSource, Skeleton3d, Tracks2d};
+use crate::formats::{Frame3d, FrameIndex, NetworkBody, PointSource, Skeleton3d, Tracks2d};
 use crate::skeleton::{BONE_COUNT, Bone, Joint, PerJoint, SubjectModel};
 use nalgebra::{Point2, Point3};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -167,11 +167,7 @@ fn per_frame_solve(
     let images = smoothed_images(tracks, &sigma);
     let rays: Vec<_> = images.iter().map(|im| im.map(|_, p| cam.ray(p))).collect();
     let frame_index: Vec<FrameIndex> = tracks.frames.iter().map(|f| f.index).collect();
-    let bodies: Vec<_> = tracks
-        .frames
-        .iter()
-        .map(|f| f.body3d.as_deref().cloned())
-        .collect();
+    let bodies = network_bodies(tracks);
     // Frames without the network's body while others have one (and its evidence is weighed).
     let no_image_depth = |t: usize| {
         job.params.image_depth > 0.0 && bodies[t].is_none() && bodies.iter().any(Option::is_some)
@@ -362,6 +358,15 @@ pub fn fit_score(miss_m: f64, group_costs: &[f64]) -> f64 {
         .sum()
 }
 
+/// Each frame's 3D body from the pose network, where the tracks carry one.
+fn network_bodies(tracks: &Tracks2d) -> Vec<Option<NetworkBody>> {
+    tracks
+        .frames
+        .iter()
+        .map(|f| f.body3d.as_deref().cloned())
+        .collect()
+}
+
 /// A skeleton3d from per-frame joints.
 fn skeleton(
     job: &LiftJob<'_>,
@@ -474,12 +479,8 @@ fn lift_leaning(
             .map(|f| f.points.map(|_, p| track_weight(p)))
             .collect();
         // The network's bodies pull the limbs' directions; off with the image's evidence.
-        let bodies: Vec<_> = if job.params.image_depth > 0.0 {
-            job.tracks
-                .frames
-                .iter()
-                .map(|f| f.body3d.as_deref().cloned())
-                .collect()
+        let bodies = if job.params.image_depth > 0.0 {
+            network_bodies(job.tracks)
         } else {
             Vec::new()
         };
