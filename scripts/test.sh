@@ -5,9 +5,9 @@ cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 export PATH="$HOME/.cargo/bin:$PATH"
 cargo fmt --check
-cargo clippy --workspace --all-targets --quiet -- -D warnings
+cargo clippy --locked --workspace --all-targets --quiet -- -D warnings
 # The stages build without FFmpeg (image sequences only) and never pull in the GUI.
-cargo check -p videomocap-core --no-default-features --quiet
-cargo check -p videomocap --no-default-features --quiet
-RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
-cargo test --workspace
+cargo check --locked -p videomocap-core --no-default-features --quiet
+cargo check --locked -p videomocap --no-default-features --quiet
+RUSTDOCFLAGS="-D warnings" cargo doc --locked --workspace --no-deps --quiet
+cargo test --locked --workspace
