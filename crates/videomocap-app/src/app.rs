@@ -4,10 +4,11 @@
 //! to the screen (the frame view's zoom, the 3D view's orbit, the guide's rendering).
 
 use super::intent::Intent;
+use super::state::layout::{DEFAULT_SIDE_PX, DEFAULT_VIEW3D_PX, Layout};
 use super::state::{Config, State};
 use super::views::frame_view::{FrameView, Overlay, ViewEvent};
 use super::views::keys::SpaceKey;
-use super::views::view3d::Orbit;
+use super::views::view3d::{self, Orbit};
 use super::views::{keys, menu, scene, side_panel, status_bar, timeline, windows};
 use std::path::PathBuf;
 
@@ -24,6 +25,14 @@ pub struct App {
     fitted: bool,
     /// The 3D view was aimed from the video camera since the last open.
     aimed: bool,
+    /// The panels' widths and the zoom per video, kept across restarts.
+    layout: Layout,
+    /// The layout changed since it was last written.
+    layout_changed: bool,
+    /// Where the 3D view's panel was drawn last (tests drag its edge).
+    view3d_rect: egui::Rect,
+    /// Where the 3D view drew its scene last.
+    view3d_canvas: egui::Rect,
 }
 
 impl App {
@@ -39,6 +48,7 @@ impl App {
         if let Some(p) = path {
             state.apply(Intent::Open(p));
         }
+        let layout = Layout::load(state.state_dir());
         App {
             state,
             frame_view: FrameView::default(),
@@ -48,6 +58,64 @@ impl App {
             opened: 0,
             fitted: false,
             aimed: false,
+            layout,
+            layout_changed: false,
+            view3d_rect: egui::Rect::NOTHING,
+            view3d_canvas: egui::Rect::NOTHING,
+        }
+    }
+
+    /// The layout kept across restarts (tests).
+    #[cfg(test)]
+    pub fn layout(&self) -> &Layout {
+        &self.layout
+    }
+
+    /// Where the 3D view's panel was drawn last.
+    #[cfg(test)]
+    pub fn view3d_rect(&self) -> egui::Rect {
+        self.view3d_rect
+    }
+
+    /// Where the 3D view drew its scene last.
+    #[cfg(test)]
+    pub fn view3d_canvas(&self) -> egui::Rect {
+        self.view3d_canvas
+    }
+
+    /// The video the frame view shows (its zoom is kept per video).
+    fn video(&self) -> Option<PathBuf> {
+        self.state.project().map(|p| p.video.clone())
+    }
+
+    /// Keeps a panel's width once the user has let go of it.
+    fn keep_width(
+        &mut self,
+        ctx: &egui::Context,
+        which: fn(&mut Layout) -> &mut Option<f32>,
+        px: f32,
+    ) {
+        if ctx.input(|i| i.pointer.any_down()) {
+            return;
+        }
+        let kept = which(&mut self.layout);
+        if kept.is_none_or(|k| (k - px).abs() > 0.5) {
+            *kept = Some(px);
+            self.layout_changed = true;
+        }
+    }
+
+    /// Keeps the frame view's zoom on this video, and writes the layout once nothing is held.
+    fn keep_layout(&mut self, ctx: &egui::Context) {
+        if let Some(video) = self.video()
+            && self.state.texture().is_some()
+            && self.layout.set_zoom(&video, self.frame_view.zoom_state())
+        {
+            self.layout_changed = true;
+        }
+        if self.layout_changed && !ctx.input(|i| i.pointer.any_down()) {
+            self.layout.save(self.state.state_dir());
+            self.layout_changed = false;
         }
     }
 
@@ -89,9 +157,10 @@ impl App {
         }
     }
 
-    /// The 3D view with its header; a clicked limb asks for a flip.
+    /// The 3D view with its header (reset, the view through the camera, follow) and the
+    /// limbs whose depth is unsure, each a link that flips it; a clicked limb asks for a flip.
     fn view3d(&mut self, ui: &mut egui::Ui, out: &mut Vec<Intent>) {
-        let scene = scene::scene(&self.state);
+        let mut scene = scene::scene(&self.state);
         // The first skeleton after opening is seen from the video camera, the floor below.
         if !self.aimed
             && let (Some((eye, _)), Some(joints)) = (&scene.camera, &scene.joints)
@@ -102,7 +171,9 @@ impl App {
             self.aimed = true;
         }
         let camera_eye = scene.camera.map(|(eye, _)| eye);
-        ui.horizontal(|ui| {
+        let mut through_camera = false;
+        // Wrapped: a narrow 3D view keeps its width (its buttons go on a second line).
+        ui.horizontal_wrapped(|ui| {
             ui.label(if self.state.volume().is_some() {
                 "3D (point volumes)"
             } else {
@@ -114,10 +185,55 @@ impl App {
                     None => Orbit::default(),
                 };
             }
+            through_camera = ui
+                .add_enabled(
+                    scene.camera.is_some(),
+                    egui::Button::new("View from the camera"),
+                )
+                .on_hover_text(
+                    "Look through the video camera, with its field of view: the skeleton lies \
+                     as it does over the video (drag to turn away, Reset view to come back)",
+                )
+                .clicked();
             ui.checkbox(&mut self.orbit.follow, "Follow").on_hover_text(
                 "Keep the view on the subject as they move across the floor (panning turns it off)",
             );
         });
+        if !scene.unsure.is_empty() {
+            ui.horizontal_wrapped(|ui| {
+                ui.label(egui::RichText::new("Depth unsure:").color(view3d::DOUBT));
+                for &bone in &scene.unsure {
+                    let link = ui.link(bone.plain_name()).on_hover_text(format!(
+                        "Flip the {}'s depth on this frame and lift again (Ctrl+Z undoes)",
+                        bone.plain_name()
+                    ));
+                    if link.hovered() {
+                        scene.highlight = Some(bone);
+                    }
+                    if link.clicked() {
+                        out.push(Intent::Flip(bone));
+                    }
+                }
+            });
+        }
+        if through_camera && let Some((eye, corners)) = &scene.camera {
+            let rect = ui.available_rect_before_wrap();
+            // Turn about the subject's depth along the axis (3 m without a skeleton).
+            let axis = (corners
+                .iter()
+                .map(|c| c.coords)
+                .sum::<nalgebra::Vector3<f64>>()
+                / 4.0
+                - eye.coords)
+                .normalize();
+            let depth = scene.joints.as_ref().map_or(3.0, |j| {
+                (j[videomocap_core::skeleton::Joint::Pelvis] - eye).dot(&axis)
+            });
+            if let Some(o) = Orbit::through_camera(eye, corners, depth, rect.aspect_ratio()) {
+                self.orbit = o;
+            }
+        }
+        self.view3d_canvas = ui.available_rect_before_wrap();
         if let Some(bone) = self.orbit.show(ui, &scene) {
             out.push(Intent::Flip(bone));
         }
@@ -133,6 +249,7 @@ impl App {
         let overlay = Overlay {
             points: self.state.points(current),
             asking: self.state.asking().map(|(_, j)| j),
+            hint: self.state.marking_hint(),
         };
         let size = self.state.video_info().map_or_else(
             || texture.size_vec2(),
@@ -155,6 +272,9 @@ impl eframe::App for App {
         if self.state.opened() != self.opened {
             self.opened = self.state.opened();
             self.frame_view.fit();
+            if let Some(zoom) = self.video().and_then(|v| self.layout.zoom_of(&v)) {
+                self.frame_view.set_zoom_state(zoom);
+            }
             self.orbit = Orbit::default();
             self.aimed = false;
         }
@@ -176,23 +296,30 @@ impl eframe::App for App {
             egui::Panel::bottom("timeline")
                 .show(ui, |ui| timeline::show(ui, &self.state, &mut out));
         }
-        egui::Panel::left("side")
+        let side = egui::Panel::left("side")
             .resizable(true)
-            .default_size(240.0)
+            .default_size(self.layout.side_px.unwrap_or(DEFAULT_SIDE_PX))
             .show(ui, |ui| {
                 egui::ScrollArea::vertical()
                     .show(ui, |ui| side_panel::show(ui, &self.state, &mut out));
             });
+        self.keep_width(&ctx, |l| &mut l.side_px, side.response.rect.width());
         if self.state.volume().is_some() {
             // Volume mode: the 3D viewport fills the window.
             egui::CentralPanel::default().show(ui, |ui| self.view3d(ui, &mut out));
         } else {
-            egui::Panel::right("3d")
+            // Resizable, its width kept across restarts; narrower by default than it was, so
+            // the video gets the room.
+            let view3d = egui::Panel::right("3d")
                 .resizable(true)
-                .default_size(380.0)
+                .min_size(160.0)
+                .default_size(self.layout.view3d_px.unwrap_or(DEFAULT_VIEW3D_PX))
                 .show(ui, |ui| self.view3d(ui, &mut out));
+            self.view3d_rect = view3d.response.rect;
+            self.keep_width(&ctx, |l| &mut l.view3d_px, view3d.response.rect.width());
             egui::CentralPanel::default().show(ui, |ui| self.frame(ui, &mut out));
         }
+        self.keep_layout(&ctx);
         windows::show(&ctx, &self.state, &mut self.guide, &mut out);
         for intent in out {
             self.state.apply(intent);

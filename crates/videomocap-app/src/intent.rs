@@ -35,6 +35,8 @@ pub enum Intent {
     PathEdited(String),
     /// The path field was confirmed (`Some`) or cancelled (`None`).
     PathChosen(Option<PathBuf>),
+    /// "Create the folder" in the path field: make the folder it names, then write.
+    CreateFolder,
     /// Undo the last edit.
     Undo,
     /// Redo an undone edit.

@@ -6,15 +6,88 @@ use super::State;
 use nalgebra::Point2;
 use videomocap_core::formats::FrameIndex;
 use videomocap_core::project::{History, Project, Settings};
-use videomocap_core::skeleton::{Bone, Joint};
+use videomocap_core::skeleton::{Bone, Joint, MarkingView, PerJoint};
 
 /// Undo or redo: the project to bring back and the name of the edit.
 type HistoryStep = fn(&mut History<Project>, Project) -> Option<(Project, String)>;
+
+/// A frame's pose before the user flipped a bone's depth on it: the 3D view draws it grey
+/// under the new pose, so the flip shows (a forearm's flip moved it a few pixels).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlipGhost {
+    /// The frame flipped on.
+    pub frame: usize,
+    /// The bone flipped.
+    pub bone: Bone,
+    /// The joints before the flip, world metres.
+    pub joints: PerJoint<nalgebra::Point3<f64>>,
+}
+
+/// What the marking guide asks and shows.
+impl State {
+    /// Whether the subject is seen from behind on the current frame (their own left on the
+    /// image's left): from the shoulders placed there, else the hips, else as the user said.
+    pub fn seen_from_behind(&self) -> bool {
+        let Some(keys) = self
+            .project
+            .as_ref()
+            .and_then(|p| p.keys.frames.get(&FrameIndex(self.current)))
+        else {
+            return self.from_behind;
+        };
+        [
+            (Joint::LeftShoulder, Joint::RightShoulder),
+            (Joint::LeftHip, Joint::RightHip),
+        ]
+        .into_iter()
+        .find_map(|(l, r)| Some(keys[l]?.x < keys[r]?.x))
+        .unwrap_or(self.from_behind)
+    }
+
+    /// The joint the marking guide asks for, if marking, and its place in the order.
+    pub fn asking(&self) -> Option<(usize, Joint)> {
+        self.marking
+            .and_then(|k| Joint::MARKING_ORDER.get(k).map(|&j| (k, j)))
+    }
+
+    /// Where the joint asked for lies by its definition, when the joints placed already say:
+    /// the pelvis halfway between the two hips placed on the current frame.
+    pub fn marking_hint(&self) -> Option<Point2<f64>> {
+        let (_, Joint::Pelvis) = self.asking()? else {
+            return None;
+        };
+        let keys = self
+            .project
+            .as_ref()?
+            .keys
+            .frames
+            .get(&FrameIndex(self.current))?;
+        Some(nalgebra::center(
+            &keys[Joint::LeftHip]?,
+            &keys[Joint::RightHip]?,
+        ))
+    }
+
+    /// The words the marking guide uses for what the camera sees.
+    pub fn marking_view(&self) -> MarkingView {
+        if self.seen_from_behind() {
+            MarkingView::Behind
+        } else {
+            MarkingView::Front
+        }
+    }
+
+    /// The pose before the last edit, when that edit was a flip of a bone's depth.
+    pub fn flip_ghost(&self) -> Option<&FlipGhost> {
+        self.flip_ghost.as_ref()
+    }
+}
 
 impl State {
     /// Applies an edit named `what` to the project, with undo and autosave.
     pub(super) fn edit(&mut self, what: &str, f: impl FnOnce(&mut Project)) {
         let Some(p) = &mut self.project else { return };
+        self.flip_ghost = None;
         self.history.record(p.clone(), what);
         f(p);
         self.dirty = true;
@@ -38,6 +111,7 @@ impl State {
             self.edit(what, |p| p.settings = settings);
         }
         self.settings_drag_recorded = dragging;
+        self.say_outdated();
     }
 
     pub(super) fn autosave(&self) {
@@ -59,6 +133,7 @@ impl State {
     /// Swaps the project for the one `step` brings back from the history, if any.
     fn step_history(&mut self, step: HistoryStep, done: &str) {
         let Some(p) = self.project.take() else { return };
+        self.flip_ghost = None;
         self.project = Some(match step(&mut self.history, p.clone()) {
             Some((other, what)) => {
                 self.status = format!("{done}: {what}");
@@ -85,7 +160,7 @@ impl State {
     pub(super) fn skip_joint(&mut self) {
         self.marking = self
             .marking
-            .filter(|&k| k + 1 < Joint::ALL.len())
+            .filter(|&k| k + 1 < Joint::MARKING_ORDER.len())
             .map(|k| k + 1);
     }
 
@@ -121,10 +196,11 @@ impl State {
 
     /// A click on the frame: places the joint the marking guide asks for.
     pub(super) fn click(&mut self, pos: Point2<f64>) {
-        let Some(k) = self.marking else { return };
-        let joint = Joint::ALL[k];
+        let Some((k, joint)) = self.asking() else {
+            return;
+        };
         self.place(&format!("mark the {}", words(joint)), joint, pos);
-        if k + 1 < Joint::ALL.len() {
+        if k + 1 < Joint::MARKING_ORDER.len() {
             self.marking = Some(k + 1);
         } else {
             self.marking = None;
@@ -194,11 +270,25 @@ impl State {
         let Some(current) = choices.bones.get(k).map(|c| c[bone.index()].root) else {
             return;
         };
+        let before = self.shown_world().and_then(|(w, _)| {
+            w.indices
+                .binary_search(&FrameIndex(frame))
+                .ok()
+                .map(|k| w.frames[k])
+        });
         self.edit(&format!("flip {} on frame {frame}", bone.key()), |p| {
             p.overrides
                 .insert((FrameIndex(frame), bone), current.flipped());
         });
-        self.status = format!("{} flipped on frame {frame}: lifting again", bone.key());
+        self.flip_ghost = before.map(|joints| FlipGhost {
+            frame,
+            bone,
+            joints,
+        });
+        self.status = format!(
+            "The {} flipped on frame {frame}: lifting again (grey in the 3D view: before)",
+            bone.plain_name()
+        );
         self.start_lift();
     }
 }
@@ -343,9 +433,9 @@ mod tests {
         s.apply(Intent::SeenFromBehind(true));
         assert!(s.seen_from_behind());
         s.apply(Intent::SeenFromBehind(false));
-        // Head, neck, chest, pelvis, then the left shoulder on the image's left and the left
-        // arm, then the right shoulder on the image's right.
-        for x in [30.0, 30.0, 30.0, 30.0, 20.0, 18.0, 16.0, 40.0] {
+        // Head, neck, chest, then the left shoulder on the image's left and the left arm, then
+        // the right shoulder on the image's right.
+        for x in [30.0, 30.0, 30.0, 20.0, 18.0, 16.0, 40.0] {
             s.apply(Intent::Click(Point2::new(x, 20.0)));
         }
         assert!(s.seen_from_behind());

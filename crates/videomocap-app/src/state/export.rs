@@ -97,9 +97,12 @@ impl State {
     /// Writes one export to `path`; the status line names the file or the reason.
     pub(super) fn export_to(&mut self, kind: ExportKind, path: &Path) -> Result<(), String> {
         let result = self.write_export(kind, path).map_err(|e| e.to_string());
+        let shown = path.display().to_string();
         self.status = match &result {
-            Ok(()) => format!("Wrote {}", path.display()),
-            Err(e) => format!("Nothing written to {}: {e}", path.display()),
+            Ok(()) => format!("Wrote {shown}"),
+            // The path once: most reasons name it already.
+            Err(e) if e.contains(&shown) => format!("Nothing written: {e}"),
+            Err(e) => format!("Nothing written to {shown}: {e}"),
         };
         result
     }

@@ -1,5 +1,5 @@
-//! The state's file actions: open (video, image folder, project, point volumes, marks), the
-//! recent list, recovery of an autosaved session, save, and leaving (opening something else,
+//! The state's file actions: open (video, image folder, project, point volumes, marks),
+//! recovery of an autosaved session, save, and leaving (opening something else,
 //! quitting) with "save changes?" first. Every save ends with a status line naming the file
 //! written or saying why not; when no file dialog can be shown, the app's own path field asks
 //! instead (for exports too: `export`).
@@ -82,6 +82,8 @@ pub struct PathRequest {
     pub text: String,
     /// Why the last path given did not work.
     pub error: Option<String>,
+    /// The folder the path lies in, when it does not exist (the window offers to create it).
+    pub missing_folder: Option<PathBuf>,
 }
 
 /// The status line when no dialog could be shown.
@@ -209,6 +211,7 @@ impl State {
             title: title.to_owned(),
             text: default.display().to_string(),
             error: None,
+            missing_folder: None,
         });
     }
 
@@ -216,6 +219,7 @@ impl State {
         if let Some(r) = &mut self.path_request {
             r.text = text;
             r.error = None;
+            r.missing_folder = None;
         }
     }
 
@@ -232,6 +236,26 @@ impl State {
             };
             return;
         };
+        // A file to write in a folder that does not exist: the window says so and offers to
+        // create it (a desktop's save dialog can make a folder; the path field does it so).
+        if !matches!(request.purpose, PathPurpose::Open(_))
+            && let Some(folder) = missing_folder(&path)
+        {
+            self.status = format!(
+                "Nothing written: the folder {} does not exist",
+                folder.display()
+            );
+            self.path_request = Some(PathRequest {
+                error: Some(format!(
+                    "The folder {} does not exist: create it, or change the path.",
+                    folder.display()
+                )),
+                missing_folder: Some(folder),
+                text: path.display().to_string(),
+                ..request
+            });
+            return;
+        }
         let failed = match &request.purpose {
             PathPurpose::Open(what) => {
                 if path.exists() {
@@ -258,9 +282,27 @@ impl State {
             // The window stays, saying why, so the user can change the path.
             self.path_request = Some(PathRequest {
                 error: Some(error),
+                missing_folder: None,
                 text: path.display().to_string(),
                 ..request
             });
+        }
+    }
+
+    /// "Create the folder" in the path field: makes the missing folder, then writes as asked.
+    pub(super) fn create_folder(&mut self) {
+        let Some(r) = &mut self.path_request else {
+            return;
+        };
+        let Some(folder) = r.missing_folder.take() else {
+            return;
+        };
+        match std::fs::create_dir_all(&folder) {
+            Ok(()) => {
+                let path = PathBuf::from(r.text.trim());
+                self.path_chosen(Some(path));
+            }
+            Err(e) => r.error = Some(format!("Cannot create {}: {e}", folder.display())),
         }
     }
 
@@ -357,10 +399,13 @@ impl State {
             match loaded {
                 Ok(p) => {
                     self.dirty = false;
-                    self.open_video(&p.video.clone());
+                    let video = p.video.clone();
+                    self.open_video(&video);
                     self.set_project(p);
                     self.project_path = Some(path.to_owned());
                     self.status = format!("Opened project {}", path.display());
+                    // Recent brings back the project, not its bare video.
+                    self.forget(&video);
                     self.remember(path);
                 }
                 Err(e) => {
@@ -375,66 +420,6 @@ impl State {
         }
     }
 
-    /// Puts `path` first in File ▸ Recent.
-    pub(super) fn remember(&mut self, path: &Path) {
-        self.recent.retain(|p| p != path);
-        self.recent.insert(0, path.to_owned());
-        self.recent.truncate(8);
-        self.save_recent();
-    }
-
-    /// Takes `path` out of File ▸ Recent (it did not open).
-    pub(super) fn forget(&mut self, path: &Path) {
-        let before = self.recent.len();
-        self.recent.retain(|p| p != path);
-        if self.recent.len() != before {
-            self.save_recent();
-        }
-    }
-
-    /// A video that opened: remembered in Recent unless a project holds it (the project is
-    /// what the user opened, and what Recent should bring back), and a project saved beside it
-    /// offered.
-    pub(super) fn remember_opened(&mut self, video: &Path) {
-        if self.project_path.is_none() {
-            self.remember(video);
-            // Work recovered or begun on this video is newer than any saved project: none is
-            // offered over it.
-            self.project_beside = project_beside(video).filter(|_| !self.dirty);
-            if let Some(p) = &self.project_beside {
-                self.status = format!("A saved project for this video: {}", p.display());
-            }
-        }
-    }
-
-    fn recent_path(&self) -> Option<PathBuf> {
-        self.config
-            .autosave_dir
-            .as_ref()
-            .map(|d| d.join("recent.json"))
-    }
-
-    /// The recent-files list kept beside the autosave (missing or unreadable: empty).
-    pub(super) fn load_recent(&self) -> Vec<PathBuf> {
-        self.recent_path()
-            .and_then(|p| std::fs::read_to_string(p).ok())
-            .and_then(|t| serde_json::from_str(&t).ok())
-            .unwrap_or_default()
-    }
-
-    fn save_recent(&self) {
-        let Some(path) = self.recent_path() else {
-            return;
-        };
-        if let Some(dir) = path.parent() {
-            let _ = std::fs::create_dir_all(dir);
-        }
-        if let Ok(text) = serde_json::to_string_pretty(&self.recent) {
-            // Losing the recent list is harmless; the write is still atomic.
-            let _ = videomocap_core::formats::write_atomically(&path, text.as_bytes());
-        }
-    }
-
     /// Volume mode: processes the point volumes of `dir` on a worker thread.
     fn open_volume(&mut self, dir: &Path) {
         self.close_current();
@@ -443,6 +428,7 @@ impl State {
             job: Job::volume(dir.to_owned(), 30.0, self.ctx.clone()),
             keys: Default::default(),
             overrides: Default::default(),
+            settings: Default::default(),
         });
         self.status = format!("Processing point volumes in {}…", dir.display());
     }
@@ -481,47 +467,16 @@ impl State {
         self.texture = None;
         self.marking = None;
         self.subject_fit = None;
+        self.flip_ghost = None;
         self.opened_count += 1;
     }
 }
 
-/// Whether `path` is a folder of point clouds (and no images): volume mode.
-/// A project file in `video`'s folder (`*.videomocap.json`) whose video is `video`, the newest
-/// first.
-fn project_beside(video: &Path) -> Option<PathBuf> {
-    let folder = video.parent()?;
-    let same = |p: &Path| match (p.canonicalize(), video.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => p == video,
-    };
-    let mut found: Vec<(std::time::SystemTime, PathBuf)> = std::fs::read_dir(folder)
-        .ok()?
-        .filter_map(Result::ok)
-        .map(|e| e.path())
-        .filter(|p| p.to_string_lossy().ends_with(".videomocap.json"))
-        .filter(|p| video_of(p).is_some_and(|v| same(&v)))
-        .map(|p| {
-            let modified = std::fs::metadata(&p)
-                .and_then(|m| m.modified())
-                .unwrap_or(std::time::UNIX_EPOCH);
-            (modified, p)
-        })
-        .collect();
-    found.sort();
-    found.pop().map(|(_, p)| p)
-}
-
-/// The video a project file is for, reading that field alone (the folder may hold several
-/// large projects, and this runs as a video opens).
-fn video_of(project: &Path) -> Option<PathBuf> {
-    #[derive(serde::Deserialize)]
-    struct VideoOnly {
-        video: PathBuf,
-    }
-    let file = std::fs::File::open(project).ok()?;
-    serde_json::from_reader::<_, VideoOnly>(std::io::BufReader::new(file))
-        .ok()
-        .map(|v| v.video)
+/// The folder `path` would be written in, when it does not exist.
+fn missing_folder(path: &Path) -> Option<PathBuf> {
+    path.parent()
+        .filter(|d| !d.as_os_str().is_empty() && !d.is_dir())
+        .map(Path::to_owned)
 }
 
 /// Why `path` cannot be opened, in the user's words, checked before anything is closed (a
@@ -545,6 +500,7 @@ fn openable(path: &Path) -> Result<Option<Project>, String> {
     Ok(None)
 }
 
+/// Whether `path` is a folder of point clouds (and no images): volume mode.
 fn is_volume_dir(path: &Path) -> bool {
     path.is_dir() && videomocap_volume::list_frames(path).is_ok() && !has_images(path)
 }

@@ -3,9 +3,11 @@
 //! what is derived from the results (reliability strips, weak spans, the 3D world). The views
 //! read it and return [`Intent`]s; [`State::apply`] carries them out.
 //!
-//! The actions live by subject: `files` (open, save, quit, the path field), `export`, `edit`
+//! The actions live by subject: `files` (open, save, quit, the path field), `recent` (File ▸
+//! Recent, the project offered beside a video), `export`, `edit`
 //! (marks, corrections, settings, flips, undo), `work` (tracking and lifting jobs, decoded
-//! frames arriving). The workers it owns: [`frame_loader`], [`jobs`], [`autosave`], and the
+//! frames arriving), `outdated` (results the settings changed under), `layout` (panel widths and
+//! zoom kept across restarts). The workers it owns: [`frame_loader`], [`jobs`], [`autosave`], and the
 //! desktop's [`file_dialogs`].
 
 pub mod autosave;
@@ -15,11 +17,16 @@ pub mod file_dialogs;
 mod files;
 pub mod frame_loader;
 pub mod jobs;
+pub mod layout;
+mod outdated;
+mod recent;
 pub mod volume;
 mod work;
 
+pub use edit::FlipGhost;
 pub use export::ExportKind;
 pub use files::{Choose, Leave, PathPurpose, PathRequest, SaveAnswer};
+pub use outdated::Outdated;
 
 use crate::intent::Intent;
 use crate::views::frame_view::PointState;
@@ -37,7 +44,7 @@ use videomocap_core::formats::{FrameIndex, FrameTracks, Skeleton3d};
 use videomocap_core::lift::BoneDepth;
 use videomocap_core::lift::SubjectFit;
 use videomocap_core::project::{History, Project};
-use videomocap_core::skeleton::{BONE_COUNT, Bone, JOINT_COUNT, Joint, PerJoint};
+use videomocap_core::skeleton::{BONE_COUNT, Bone, JOINT_COUNT, PerJoint};
 use videomocap_core::track::{KeyFrames, WeakSpan, weak_spans};
 use videomocap_core::video::VideoInfo;
 use volume::VolumeSequence;
@@ -67,6 +74,8 @@ struct Running {
     job: Job,
     keys: KeyFrames,
     overrides: videomocap_core::lift::DepthOverrides,
+    /// The project's settings when the job started (what its result is made with).
+    settings: videomocap_core::project::Settings,
 }
 
 /// What a lift chose per frame and bone, kept with the skeleton it produced (so that undo and
@@ -108,7 +117,7 @@ pub struct State {
     /// The texture holds the seek proxy's smaller picture of `shown`; the full frame follows.
     preview: bool,
     texture: Option<egui::TextureHandle>,
-    /// Index into [`Joint::ALL`] of the joint the marking guide asks for.
+    /// Index into [`Joint::MARKING_ORDER`] of the joint the marking guide asks for.
     marking: Option<usize>,
     /// The user said the subject is seen from behind (the marking guide's diagram mirrored),
     /// until both shoulders or both hips are placed and say it themselves.
@@ -128,6 +137,10 @@ pub struct State {
     choices: Vec<LiftChoices>,
     /// What the last lift read of the subject from the tracks (shown under the height).
     subject_fit: Option<SubjectFit>,
+    /// The pose before the last edit, when that edit was a flip.
+    flip_ghost: Option<FlipGhost>,
+    /// The settings the tracks and the 3D skeleton were made with.
+    made_with: outdated::MadeWith,
     /// The project's 3D skeleton in the exports' world (what exports write), with the skeleton
     /// it was made from.
     world: Option<(WorldSkeleton, Arc<Skeleton3d>)>,
@@ -194,6 +207,8 @@ impl State {
             strips: None,
             choices: Vec::new(),
             subject_fit: None,
+            flip_ghost: None,
+            made_with: outdated::MadeWith::default(),
             world: None,
             last_world: None,
             playing: false,
@@ -231,6 +246,7 @@ impl State {
             Intent::DismissProjectBeside => self.project_beside = None,
             Intent::PathEdited(text) => self.path_edited(text),
             Intent::PathChosen(path) => self.path_chosen(path),
+            Intent::CreateFolder => self.create_folder(),
             Intent::Undo => self.undo(),
             Intent::Redo => self.redo(),
             Intent::StartMarking => self.start_marking(),
@@ -265,6 +281,12 @@ impl State {
     }
 
     // ----- what the views read -----
+
+    /// The folder the app keeps its state in between sessions (recovery file, recent list,
+    /// layout); `None`: nothing is kept.
+    pub fn state_dir(&self) -> Option<&Path> {
+        self.config.autosave_dir.as_deref()
+    }
 
     /// The project being edited.
     pub fn project(&self) -> Option<&Project> {
@@ -336,30 +358,6 @@ impl State {
     /// The running job (the progress bar reads it).
     pub fn job(&self) -> Option<&Job> {
         self.running.as_ref().map(|r| &r.job)
-    }
-
-    /// Whether the subject is seen from behind on the current frame (their own left on the
-    /// image's left): from the shoulders placed there, else the hips, else as the user said.
-    pub fn seen_from_behind(&self) -> bool {
-        let Some(keys) = self
-            .project
-            .as_ref()
-            .and_then(|p| p.keys.frames.get(&FrameIndex(self.current)))
-        else {
-            return self.from_behind;
-        };
-        [
-            (Joint::LeftShoulder, Joint::RightShoulder),
-            (Joint::LeftHip, Joint::RightHip),
-        ]
-        .into_iter()
-        .find_map(|(l, r)| Some(keys[l]?.x < keys[r]?.x))
-        .unwrap_or(self.from_behind)
-    }
-
-    /// The joint the marking guide asks for, if marking, and its place in the order.
-    pub fn asking(&self) -> Option<(usize, Joint)> {
-        self.marking.map(|k| (k, Joint::ALL[k]))
     }
 
     /// Whether dragging a joint moves the limb below it.
@@ -535,6 +533,14 @@ impl State {
         }
     }
 
+    /// Gives the project's 3D skeleton the lift's depth choices `bones` (tests of the 3D view).
+    #[cfg(test)]
+    pub fn set_depth_choices_for_test(&mut self, bones: Vec<[BoneDepth; BONE_COUNT]>) {
+        if let Some(skeleton) = self.project.as_ref().and_then(|p| p.skeleton.clone()) {
+            self.choices.push(LiftChoices { skeleton, bones });
+        }
+    }
+
     /// Puts a project in place without a video (tests of the panels).
     #[cfg(test)]
     pub fn set_project_for_test(&mut self, p: Project) {
@@ -544,6 +550,7 @@ impl State {
     // ----- derived results -----
 
     fn set_project(&mut self, p: Project) {
+        self.made_with = outdated::MadeWith::of(&p);
         self.project = Some(p);
         self.background = None;
         self.network_seen = None;

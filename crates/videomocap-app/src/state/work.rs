@@ -45,6 +45,7 @@ impl State {
             job: Job::track(p.video.clone(), job, self.ctx.clone()),
             keys: p.keys.clone(),
             overrides: p.overrides.clone(),
+            settings: p.settings,
         });
         self.partial.clear();
     }
@@ -74,6 +75,7 @@ impl State {
             ),
             keys: p.keys.clone(),
             overrides: p.overrides.clone(),
+            settings: p.settings,
         });
     }
 
@@ -233,6 +235,7 @@ impl State {
                 }
                 self.background = out.background;
                 self.network_seen = out.network;
+                self.tracks_made_with(r.settings.tracker);
                 self.dirty = true;
                 self.autosave();
                 self.results_changed();
@@ -285,6 +288,7 @@ impl State {
                 if let Some(p) = &mut self.project {
                     p.skeleton = Some(skeleton);
                 }
+                self.skeleton_made_with(r.settings);
                 self.dirty = true;
                 self.autosave();
                 self.results_changed();

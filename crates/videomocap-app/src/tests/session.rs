@@ -228,7 +228,7 @@ fn mark_drag_undo_track_scrub_orbit_export_and_recover() {
     // Mark: the guide asks for each joint in turn; click where it is.
     h.key_press(egui::Key::M);
     h.step();
-    for j in Joint::ALL {
+    for j in Joint::MARKING_ORDER {
         assert_eq!(h.state().state().asking().map(|(_, j)| j), Some(j));
         let pos = screen(&h, truth.points[j]);
         click(&mut h, pos);

@@ -2,6 +2,7 @@
 //! button, or drag with Space held), joint names on hover, click to place a mark, drag a joint
 //! to correct it.
 
+use crate::state::layout::FrameZoom;
 use egui::{Color32, Pos2, Rect, Sense, Stroke, Vec2};
 use nalgebra::Point2;
 use videomocap_core::formats::{PointSource, TrackedPoint};
@@ -68,6 +69,8 @@ pub struct Overlay {
     pub points: PerJoint<Option<(Point2<f64>, PointState)>>,
     /// The joint the marking guide asks for next.
     pub asking: Option<Joint>,
+    /// Where that joint lies by its definition, from the joints placed (drawn as a cross).
+    pub hint: Option<Point2<f64>>,
 }
 
 /// What the user did in the view.
@@ -121,6 +124,11 @@ pub struct FrameView {
     last: Option<Transform>,
 }
 
+/// The zoom's range: a quarter of the fitted frame to 40 times it.
+const MIN_ZOOM: f32 = 0.25;
+/// See [`MIN_ZOOM`].
+const MAX_ZOOM: f32 = 40.0;
+
 /// Pick radius for joints, screen points.
 const PICK_PX: f32 = 10.0;
 
@@ -134,6 +142,27 @@ impl FrameView {
     pub fn fit(&mut self) {
         self.zoom = 1.0;
         self.centre = None;
+    }
+
+    /// The zoom and the image point at the view's centre (kept across restarts per video).
+    pub fn zoom_state(&self) -> FrameZoom {
+        FrameZoom {
+            zoom: if self.zoom > 0.0 { self.zoom } else { 1.0 },
+            centre: self.centre.map(|c| [c.x, c.y]),
+        }
+    }
+
+    /// Zooms as `z` says (a zoom kept from an earlier session).
+    pub fn set_zoom_state(&mut self, z: FrameZoom) {
+        self.zoom = if z.zoom.is_finite() {
+            z.zoom.clamp(MIN_ZOOM, MAX_ZOOM)
+        } else {
+            1.0
+        };
+        self.centre = z
+            .centre
+            .filter(|c| c.iter().all(|v| v.is_finite()))
+            .map(|c| Vec2::new(c[0], c[1]));
     }
 
     /// The transform of the last frame drawn (tests use it to click on joints).
@@ -170,7 +199,8 @@ impl FrameView {
             if scroll != 0.0 {
                 let t = self.transform_for(rect, size);
                 let under = t.to_image(hover);
-                self.zoom = (self.zoom.max(1e-3) * (scroll * 0.002).exp()).clamp(0.25, 40.0);
+                self.zoom =
+                    (self.zoom.max(1e-3) * (scroll * 0.002).exp()).clamp(MIN_ZOOM, MAX_ZOOM);
                 let scale = self.transform_for(rect, size).scale;
                 let p = Vec2::new(under.x as f32, under.y as f32);
                 self.centre = Some(p - (hover - rect.center()) / scale);
@@ -286,6 +316,13 @@ impl FrameView {
                 }
             }
         }
+        if let Some(h) = overlay.hint {
+            let s = t.to_screen(h);
+            let stroke = Stroke::new(2.0, Color32::YELLOW);
+            for d in [Vec2::new(7.0, 7.0), Vec2::new(7.0, -7.0)] {
+                painter.line_segment([s - d, s + d], stroke);
+            }
+        }
         if let (Some(j), Some(pos)) = (overlay.asking, response.hover_pos()) {
             painter.text(
                 pos + Vec2::new(14.0, 14.0),
@@ -341,6 +378,7 @@ mod tests {
                 let overlay = Overlay {
                     points,
                     asking: None,
+                    hint: None,
                 };
                 if let Some(e) = b.view.show(ui, &texture, Vec2::new(100.0, 100.0), &overlay) {
                     b.events.push(e);

@@ -1,6 +1,7 @@
 //! The Parameters panel's Lift section: the lift settings a project keeps (the same as the
 //! command line's `--lift-settings` file), the ones a user is likely to change.
 
+use super::fitted;
 use videomocap_core::lift::LiftParams;
 
 /// "on" or "off", for the hover texts' defaults.
@@ -23,14 +24,13 @@ pub fn lift_settings_ui(ui: &mut egui::Ui, l: &mut LiftParams) {
              already clean); default {}",
             on_off(d.smooth_tracks)
         ));
-    let width = egui::Slider::new(&mut l.smoothing_s, 0.0..=0.3).text("smoothing (s)");
-    ui.add_enabled(l.smooth_tracks, width)
-        .on_hover_text(format!(
-            "0: each joint's track is smoothed by as much as its own jitter calls for (nothing \
+    let width = egui::Slider::new(&mut l.smoothing_s, 0.0..=0.3);
+    fitted::slider_enabled(ui, l.smooth_tracks, width, "smoothing (s)").on_hover_text(format!(
+        "0: each joint's track is smoothed by as much as its own jitter calls for (nothing \
              for clean tracks); above 0: every joint by a Gaussian this many seconds wide; \
              default {}",
-            d.smoothing_s
-        ));
+        d.smoothing_s
+    ));
     ui.checkbox(&mut l.steady_trunk, "keep the trunk's path steady")
         .on_hover_text(format!(
             "The shoulders' and chest's 3D path is refitted over the whole clip (steadier depth \
@@ -44,26 +44,36 @@ pub fn lift_settings_ui(ui: &mut egui::Ui, l: &mut LiftParams) {
              slide; default {}",
             on_off(d.foot_lock)
         ));
-    ui.add(egui::Slider::new(&mut l.arm_swing, 0.0..=3.0).text("arm swing vs. legs"))
-        .on_hover_text(format!(
-            "When walking or running, how strongly each arm is taken to swing against its own leg \
+    fitted::slider(
+        ui,
+        egui::Slider::new(&mut l.arm_swing, 0.0..=3.0),
+        "arm swing vs. legs",
+    )
+    .on_hover_text(format!(
+        "When walking or running, how strongly each arm is taken to swing against its own leg \
              when its depth is in doubt (0 = off); default {}",
-            d.arm_swing
-        ));
-    ui.add(
-        egui::Slider::new(&mut l.hands_outside_body, 0.0..=30.0).text("hands outside the body"),
+        d.arm_swing
+    ));
+    fitted::slider(
+        ui,
+        egui::Slider::new(&mut l.hands_outside_body, 0.0..=30.0),
+        "hands outside the body",
     )
     .on_hover_text(format!(
         "How strongly a hand is kept out of the trunk and the thighs when its depth is in doubt \
          (0 = off); default {}",
         d.hands_outside_body
     ));
-    ui.add(egui::Slider::new(&mut l.image_depth, 0.0..=3.0).text("image depth evidence"))
-        .on_hover_text(format!(
-            "How much the pose network's 3D body counts for which way each bone points in depth \
+    fitted::slider(
+        ui,
+        egui::Slider::new(&mut l.image_depth, 0.0..=3.0),
+        "image depth evidence",
+    )
+    .on_hover_text(format!(
+        "How much the pose network's 3D body counts for which way each bone points in depth \
              and which way the body faces (0 = geometry alone; your flips always win); default {}",
-            d.image_depth
-        ));
+        d.image_depth
+    ));
     if ui.button("Defaults").clicked() {
         *l = d;
     }

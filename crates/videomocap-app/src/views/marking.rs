@@ -2,24 +2,33 @@
 //! body diagram with it highlighted.
 
 use crate::intent::Intent;
-use videomocap_core::skeleton::{Bone, Joint};
+use videomocap_core::skeleton::{Bone, Joint, MarkingView};
 
-/// Draws the guide for joint `k` of [`Joint::ALL`], its diagram seen from the front or from
-/// behind; Skip, Done and the view go to `out`.
-pub fn show(ui: &mut egui::Ui, k: usize, joint: Joint, behind: bool, out: &mut Vec<Intent>) {
+/// Draws the guide for joint `k` of [`Joint::MARKING_ORDER`], in the words and with the diagram
+/// for a subject seen from the front or from behind; Skip, Done and the view go to `out`.
+pub fn show(ui: &mut egui::Ui, k: usize, joint: Joint, view: MarkingView, out: &mut Vec<Intent>) {
+    let behind = view == MarkingView::Behind;
     ui.heading("Marking");
     ui.label(format!("{} of 16: {}", k + 1, joint_words(joint)));
     if let Some(side) = side_words(joint, behind) {
         ui.label(side);
     }
-    ui.label(egui::RichText::new(joint.definition()).italics());
+    ui.label(egui::RichText::new(joint.definition(view)).italics());
+    if joint == Joint::Pelvis {
+        ui.label(
+            egui::RichText::new("the cross on the frame is halfway between the hips you placed")
+                .small()
+                .weak(),
+        );
+    }
     body_diagram(ui, joint, behind);
     let mut from_behind = behind;
     if ui
         .checkbox(&mut from_behind, "seen from behind")
         .on_hover_text(
-            "Mirror the diagram for a subject with their back to the camera (follows the \
-             shoulders or hips once both are placed)",
+            "For a subject with their back to the camera: the diagram is mirrored and the \
+             joints are described by what shows on the back (follows the shoulders or hips \
+             once both are placed)",
         )
         .changed()
     {

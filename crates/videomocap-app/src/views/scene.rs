@@ -3,12 +3,13 @@
 //! volume mode the frame's points coloured by body, the skeleton curve and the fitted bodies.
 
 use super::frame_view::side_colour;
-use super::view3d::Scene;
+use super::marking::joint_words;
+use super::view3d::{Note, Scene};
 use crate::state::State;
 use crate::state::volume::VolumeSequence;
 use egui::{Color32, Stroke};
 use nalgebra::{Point3, Vector3};
-use videomocap_core::formats::FrameIndex;
+use videomocap_core::formats::{CONTACT_FLAG, FrameIndex};
 use videomocap_core::skeleton::{Bone, Joint};
 use videomocap_volume::Part;
 use videomocap_volume::bodies::Cylinder;
@@ -61,62 +62,123 @@ pub fn scene(state: &State) -> Scene {
         ..Scene::default()
     };
     if state.world_is_stale() {
-        scene
-            .notes
-            .push("the last 3D result: a new one is on its way".to_owned());
+        scene.notes.push(Note::info(
+            "the last 3D result: a new one is on its way".to_owned(),
+        ));
     }
-    let flags = skeleton
+    let frame = skeleton
         .frames
         .binary_search_by_key(&FrameIndex(current), |f| f.index)
         .ok()
-        .map(|k| &skeleton.frames[k].flags);
-    let mut too_long = Vec::new();
-    for flag in flags.into_iter().flatten() {
-        match flag.strip_prefix("too_long:").and_then(Bone::from_key) {
-            Some(bone) => too_long.push(bone),
-            None => scene.notes.push(format!("flagged: {}", plain_flag(flag))),
+        .map(|k| &skeleton.frames[k]);
+    let marked = |j: Joint| {
+        state
+            .project()
+            .is_some_and(|p| p.keys.is_key(FrameIndex(current), j))
+    };
+    for flag in frame.map(|f| f.flags.as_slice()).unwrap_or_default() {
+        if let Some(bone) = flag.strip_prefix("too_long:").and_then(Bone::from_key) {
+            scene.flagged.push(bone);
         }
+        if let Some(ankle) = flag.strip_prefix(CONTACT_FLAG).and_then(Joint::from_name) {
+            scene.planted.push(ankle);
+        }
+        scene.notes.push(flag_note(flag, &marked));
     }
-    if !too_long.is_empty() {
-        let what = if too_long.len() == 1 {
-            "1 bone (red) looks longer in the image than it can be".to_owned()
-        } else {
-            format!(
-                "{} bones (red) look longer in the image than they can be",
-                too_long.len()
-            )
-        };
-        scene.notes.insert(0, format!("flagged: {what}"));
-        scene.flagged = too_long;
-    }
+    // Problems first, what is merely so (a planted foot) after.
+    scene.notes.sort_by_key(|n| n.kind);
     let unsure: Vec<Bone> = state
         .unsure_bones(current)
         .into_iter()
         .filter(|b| scene.flippable.contains(b))
         .collect();
     if !unsure.is_empty() {
-        let names: Vec<String> = unsure.iter().map(|b| b.plain_name()).collect();
-        scene.notes.push(format!(
-            "depth unsure (amber): {}: if one points the wrong way, click it to flip",
-            names.join(", ")
-        ));
+        scene.notes.push(Note::warning(format!(
+            "depth unsure (magenta): {}. If one points the wrong way, click it (here or in \
+             the list above) to flip it",
+            unsure
+                .iter()
+                .map(|b| b.plain_name())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )));
         scene.unsure = unsure;
+    }
+    if let Some(ghost) = state.flip_ghost().filter(|g| g.frame == current) {
+        scene.notes.push(Note::info(format!(
+            "grey: the pose before you flipped the {} (Ctrl+Z takes the flip back)",
+            ghost.bone.plain_name()
+        )));
+        scene.ghost = Some(ghost.joints);
     }
     scene
 }
 
-/// A lift flag in words.
-fn plain_flag(flag: &str) -> String {
-    if flag == "key_triangle_not_converged" {
-        "the trunk's pose did not fit its three points".to_owned()
-    } else if let Some(j) = flag.strip_prefix(videomocap_core::formats::OFF_FRAME_FLAG) {
-        format!("{j} off the frame")
-    } else if let Some(j) = flag.strip_prefix(videomocap_core::formats::LOST_FLAG) {
-        format!("{j} lost: a guess")
-    } else if flag == videomocap_core::formats::NO_IMAGE_DEPTH_FLAG {
-        "the pose network saw no body here: depth from the geometry alone".to_owned()
+/// A lift flag of the frame in words: what it is, the bone or joint it concerns, and what to
+/// do about it. `marked` says which joints the user placed on this frame (their own marks are
+/// what to check, not the tracker). A planted foot is information, not a problem.
+pub fn flag_note(flag: &str, marked: &dyn Fn(Joint) -> bool) -> Note {
+    use videomocap_core::formats::{LOST_FLAG, NO_IMAGE_DEPTH_FLAG, OFF_FRAME_FLAG};
+    let joint = |prefix: &str| flag.strip_prefix(prefix).and_then(Joint::from_name);
+    if let Some(bone) = flag.strip_prefix("too_long:").and_then(Bone::from_key) {
+        let (a, b) = (joint_words(bone.parent), joint_words(bone.child));
+        let what = format!(
+            "The {} ({a} to {b}, red) looks longer in the image than the bone can be",
+            bone.plain_name()
+        );
+        return Note::warning(if marked(bone.parent) && marked(bone.child) {
+            format!(
+                "{what}. These are your own marks: check the {a} and the {b}, or the subject \
+                 height (Parameters)"
+            )
+        } else {
+            format!(
+                "{what}: drag the {a} or the {b} to its joint on this frame (it re-tracks from \
+                 here), or check the subject height (Parameters)"
+            )
+        });
+    }
+    if let Some(ankle) = joint(CONTACT_FLAG) {
+        return Note::info(format!(
+            "{} planted: the lift holds it still on the floor (brown on the timeline). \
+             Nothing to do",
+            foot_words(ankle)
+        ));
+    }
+    if let Some(j) = joint(LOST_FLAG) {
+        return Note::warning(format!(
+            "The {} is lost here: its place is the tracker's guess. Drag it to where it is on \
+             this frame (it re-tracks from here)",
+            joint_words(j)
+        ));
+    }
+    if let Some(j) = joint(OFF_FRAME_FLAG) {
+        return Note::warning(format!(
+            "The {} is off the frame: the 3D uses the tracker's estimate of where it is. \
+             Nothing to do unless it looks wrong",
+            joint_words(j)
+        ));
+    }
+    Note::warning(match flag {
+        "key_triangle_not_converged" => "The trunk (both shoulders and the chest) did not fit \
+            one rigid shape here: check those three joints on this frame"
+            .to_owned(),
+        f if f == NO_IMAGE_DEPTH_FLAG => "The pose network saw no body on this frame: which \
+            way each limb points in depth rests on the geometry alone. Check the limbs; click \
+            one to flip it"
+            .to_owned(),
+        other => format!("flagged: {other}"),
+    })
+}
+
+/// An ankle's foot in words: "left foot".
+fn foot_words(ankle: Joint) -> &'static str {
+    if ankle.name().starts_with("left") {
+        "Left foot"
+    } else if ankle.name().starts_with("right") {
+        "Right foot"
     } else {
-        flag.to_owned()
+        "A foot"
     }
 }
 
@@ -254,16 +316,53 @@ fn sphere(centre: Point3<f64>, r: f64, push: &mut impl FnMut(Point3<f64>, Point3
 
 #[cfg(test)]
 mod tests {
-    use super::plain_flag;
+    use super::*;
+    use crate::views::view3d::NoteKind;
 
+    /// Each flag names its bone or joint and says what to do; a bone too long on the user's
+    /// own marks asks to check those marks; a planted foot is information.
     #[test]
-    fn lift_flags_read_in_words_and_unknown_ones_pass_through() {
-        assert!(plain_flag("no_image_depth").contains("pose network saw no body"));
-        assert_eq!(plain_flag("lost:left_knee"), "left_knee lost: a guess");
-        assert_eq!(
-            plain_flag("off_frame:right_wrist"),
-            "right_wrist off the frame"
+    fn lift_flags_name_the_bone_or_foot_and_say_what_to_do() {
+        let none = |_: Joint| false;
+        let all = |_: Joint| true;
+        let neck = flag_note("too_long:chest-neck", &none);
+        assert_eq!(neck.kind, NoteKind::Warning);
+        assert!(
+            neck.text.contains("The neck (chest to neck, red)")
+                && neck.text.contains("drag the chest or the neck"),
+            "{}",
+            neck.text
         );
-        assert_eq!(plain_flag("a_later_flag"), "a_later_flag");
+        let marked = flag_note("too_long:chest-neck", &all);
+        assert!(
+            marked
+                .text
+                .contains("your own marks: check the chest and the neck"),
+            "{}",
+            marked.text
+        );
+        let foot = flag_note("contact:left_ankle", &none);
+        assert_eq!(foot.kind, NoteKind::Info);
+        assert!(
+            foot.text.starts_with("Left foot planted") && !foot.text.contains("contact:"),
+            "{}",
+            foot.text
+        );
+        let lost = flag_note("lost:left_knee", &none);
+        assert!(lost.text.contains("left knee is lost") && lost.text.contains("Drag it"));
+        assert!(
+            flag_note("off_frame:right_wrist", &none)
+                .text
+                .contains("right wrist is off")
+        );
+        assert!(
+            flag_note("no_image_depth", &none)
+                .text
+                .contains("pose network saw no body")
+        );
+        assert_eq!(
+            flag_note("a_later_flag", &none).text,
+            "flagged: a_later_flag"
+        );
     }
 }

@@ -2,10 +2,11 @@
 //! height and known lengths, tracker and lift settings); how much of the tracks is weak, with
 //! the weak spans to jump to. In volume mode: the layers drawn and the pipeline's warnings.
 
+use super::fitted;
 use super::{lift_settings, marking, tracker_settings};
 use crate::intent::Intent;
-use crate::state::State;
 use crate::state::volume::VolumeSequence;
+use crate::state::{Outdated, State};
 use videomocap_core::lift::default_focal;
 
 /// Draws the panel; what the user changed goes to `out`.
@@ -15,7 +16,7 @@ pub fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
         return;
     }
     if let Some((k, joint)) = state.asking() {
-        marking::show(ui, k, joint, state.seen_from_behind(), out);
+        marking::show(ui, k, joint, state.marking_view(), out);
     }
     ui.heading("Parameters");
     parameters(ui, state, out);
@@ -72,7 +73,7 @@ fn parameters(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
     )
     .on_hover_text(format!("Focal length in pixels; default {default_f:.0} px"));
     settings.focal_px = given.then_some(f);
-    ui.add(egui::Slider::new(&mut settings.height_m, 1.0..=2.3).text("subject height (m)"))
+    fitted::slider(ui, egui::Slider::new(&mut settings.height_m, 1.0..=2.3), "subject height (m)")
         .on_hover_text("The subject's stature (default 1.70 m): every length is read from the video and this fixes their overall scale, so the 3D skeleton's size and depth follow it. Lengths you know (below) set the scale instead.");
     let fit = state.subject_fit();
     // One line whether or not a lift has read the lengths (the whole reading on hover), so the
@@ -110,9 +111,19 @@ fn parameters(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
     ui.collapsing("Tracker", |ui| {
         tracker_settings::tracker_settings_ui(ui, &mut settings.tracker);
     });
+    for o in state.outdated() {
+        if let Outdated::Tracks(what) = o {
+            offer(ui, &what, "Track again (T)", Intent::Track, out);
+        }
+    }
     ui.collapsing("Lift", |ui| {
         lift_settings::lift_settings_ui(ui, &mut settings.lift);
     });
+    for o in state.outdated() {
+        if let Outdated::Skeleton(what) = o {
+            offer(ui, &what, "Lift again", Intent::Lift, out);
+        }
+    }
     let dragging = ui.ctx().dragged_id().is_some();
     if settings != before {
         out.push(Intent::Settings {
@@ -122,6 +133,16 @@ fn parameters(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
     } else if !dragging {
         out.push(Intent::SettingsReleased);
     }
+}
+
+/// A result out of date under the settings: what changed, and a button to make it again.
+fn offer(ui: &mut egui::Ui, what: &str, button: &str, intent: Intent, out: &mut Vec<Intent>) {
+    egui::Frame::group(ui.style()).show(ui, |ui| {
+        ui.colored_label(egui::Color32::from_rgb(240, 170, 90), format!("{what}."));
+        if ui.button(button).clicked() {
+            out.push(intent);
+        }
+    });
 }
 
 /// How much is weak (joint-frames and the share of the clip), then the spans to jump to.

@@ -4,6 +4,7 @@
 //! Hovering a strip names the joint, the frame and the state; clicking jumps there.
 
 use super::frame_view::PointState;
+use super::view3d::PLANTED;
 use crate::intent::Intent;
 use crate::state::State;
 use egui::{Color32, Rect, Sense, Stroke, Vec2};
@@ -138,7 +139,14 @@ pub fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
         })
         .inner;
     let width = ui.available_width();
-    let height = 2.0 * TICKS_H + 2.0 + STRIP_H * JOINT_COUNT as f32;
+    // Before tracking there is nothing to show in the strips: the ticks alone, and the frame
+    // above takes the height (16 empty strips took 180 points from a portrait clip).
+    let rows = if state.strips().is_some() {
+        JOINT_COUNT
+    } else {
+        0
+    };
+    let height = 2.0 * TICKS_H + 2.0 + STRIP_H * rows as f32;
     let (rect, response) = ui.allocate_exact_size(Vec2::new(width, height), Sense::click());
     let painter = ui.painter_at(rect);
     painter.rect_filled(rect, 0.0, Color32::from_gray(30));
@@ -148,7 +156,7 @@ pub fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
     let x_of = |k: f32| rail_left + k / last * span;
     let strips_top = rect.top() + 2.0 * TICKS_H + 2.0;
     let label_font = egui::FontId::proportional(STRIP_H);
-    for (row, j) in Joint::ALL.into_iter().enumerate() {
+    for (row, j) in Joint::ALL.into_iter().enumerate().take(rows) {
         let top = strips_top + row as f32 * STRIP_H;
         painter.text(
             egui::pos2(rect.left() + 2.0, top + STRIP_H / 2.0),
@@ -170,7 +178,7 @@ pub fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
             );
             painter.rect_filled(r, 0.0, point.colour());
         }
-        // A planted foot: a dark bar along the bottom of its ankle's strip.
+        // A planted foot: a brown bar along the bottom of its ankle's strip.
         for (f, _) in planted.iter().filter(|(_, c)| c[j]) {
             let r = Rect::from_min_max(
                 egui::pos2(x_of(*f as f32 - 0.5), top + STRIP_H - 4.0),
@@ -179,7 +187,7 @@ pub fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
                     top + STRIP_H - 1.0,
                 ),
             );
-            painter.rect_filled(r, 0.0, Color32::from_rgb(20, 40, 90));
+            painter.rect_filled(r, 0.0, PLANTED);
         }
     }
     let tick = |f: usize, row: f32, colour: Color32| {
@@ -230,7 +238,7 @@ pub fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
                     super::marking::joint_words(j),
                     p.word(),
                     if planted_at(f, j) {
-                        " · planted: the foot is held still (dark bar)"
+                        " · planted: the lift holds the foot still on the floor (brown bar)"
                     } else {
                         ""
                     }

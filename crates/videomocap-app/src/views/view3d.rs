@@ -24,20 +24,82 @@ pub struct Scene {
     pub segments: Vec<(Point3<f64>, Point3<f64>, Stroke)>,
     /// Bones the lift flagged on this frame (drawn red).
     pub flagged: Vec<Bone>,
-    /// Bones whose depth the lift was unsure of on this frame (drawn amber).
+    /// Bones whose depth the lift was unsure of on this frame (drawn thick in [`DOUBT`]).
     pub unsure: Vec<Bone>,
+    /// A bone to pick out (the one under the pointer in the list of unsure limbs).
+    pub highlight: Option<Bone>,
+    /// Ankles the lift found planted on the floor (a [`PLANTED`] ring under each).
+    pub planted: Vec<Joint>,
+    /// The frame's skeleton before the user's last flip on it (drawn grey under the new one).
+    pub ghost: Option<PerJoint<Point3<f64>>>,
     /// Lines written over the view's top-left corner (what the lift flagged, a stale view).
-    pub notes: Vec<String>,
+    pub notes: Vec<Note>,
     /// What the view says when it has nothing to draw (`None`: the video mode's "mark, then
     /// Track").
     pub empty_text: Option<String>,
 }
 
-/// Colour of a bone the lift flagged.
-const FLAGGED: Color32 = Color32::from_rgb(230, 60, 60);
+/// Whether a note over the 3D view is a problem to look at or information.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum NoteKind {
+    /// Something to check or act on (orange).
+    Warning,
+    /// A state worth knowing, nothing to do (grey).
+    Info,
+}
 
-/// Colour of a bone whose depth the lift was unsure of.
-const UNSURE: Color32 = Color32::from_rgb(255, 190, 40);
+/// A line written over the 3D view.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Note {
+    /// The words.
+    pub text: String,
+    /// Problem or information.
+    pub kind: NoteKind,
+}
+
+impl Note {
+    /// Something to check or act on.
+    pub fn warning(text: String) -> Note {
+        Note {
+            text,
+            kind: NoteKind::Warning,
+        }
+    }
+
+    /// A state worth knowing.
+    pub fn info(text: String) -> Note {
+        Note {
+            text,
+            kind: NoteKind::Info,
+        }
+    }
+
+    fn colour(&self) -> Color32 {
+        match self.kind {
+            NoteKind::Warning => Color32::from_rgb(240, 170, 90),
+            NoteKind::Info => Color32::from_gray(200),
+        }
+    }
+}
+
+/// Colour of a bone the lift flagged.
+pub const FLAGGED: Color32 = Color32::from_rgb(230, 60, 60);
+
+/// Colour of a bone whose depth the lift was unsure of: magenta, the hue farthest from every
+/// other colour of the view (the sides' cyan and orange, the middle's yellow, the flagged red,
+/// the frustum's lavender); the amber it replaced sat next to the middle's yellow.
+pub const DOUBT: Color32 = Color32::from_rgb(255, 40, 255);
+
+/// Width of an unsure bone, points (a normal bone is 2.5: a short hip segment drawn thin in
+/// a doubt colour went unseen).
+const DOUBT_WIDTH: f32 = 6.0;
+
+/// Colour of a planted foot (the 3D view's ring under the ankle and the timeline's bar).
+pub const PLANTED: Color32 = Color32::from_rgb(150, 100, 50);
+
+/// The orbit's default lens: the focal length over the view's height (about 45° seen top to
+/// bottom).
+const DEFAULT_LENS: f32 = 1.2;
 
 /// An orbiting view around a target point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -52,6 +114,9 @@ pub struct Orbit {
     pub target: Vector3<f32>,
     /// Keep the target above the skeleton's pelvis on the floor (its height stays).
     pub follow: bool,
+    /// Focal length over the view's height (the view through the video camera has the
+    /// camera's own).
+    pub lens: f32,
 }
 
 impl Default for Orbit {
@@ -62,6 +127,7 @@ impl Default for Orbit {
             distance: 4.5,
             target: Vector3::new(0.0, 0.9, 0.0),
             follow: true,
+            lens: DEFAULT_LENS,
         }
     }
 }
@@ -81,7 +147,44 @@ impl Orbit {
             distance,
             target,
             follow: true,
+            lens: DEFAULT_LENS,
         }
+    }
+
+    /// The view through the video camera itself: from its centre `eye`, along its optical axis
+    /// (through the middle of the frustum's image `corners` at 0.5 m), with its field of view
+    /// fitted into a view of `view_aspect` (width over height) as the frame view fits the
+    /// video, so the skeleton lies as it does over the video. `depth_m` is how far along the
+    /// axis the view turns about (the subject's distance). Not following: the camera stands.
+    /// `None` for a degenerate frustum.
+    pub fn through_camera(
+        eye: &Point3<f64>,
+        corners: &[Point3<f64>; 4],
+        depth_m: f64,
+        view_aspect: f32,
+    ) -> Option<Orbit> {
+        let centre = corners.iter().map(|c| c.coords).sum::<Vector3<f64>>() / 4.0;
+        let axis = centre - eye.coords;
+        let forward = axis.try_normalize(1e-9)?;
+        let across = (corners[1] - corners[0]).norm();
+        let down = (corners[3] - corners[0]).norm();
+        if down < 1e-9 || across < 1e-9 {
+            return None;
+        }
+        // At `axis`'s depth the image is `down` tall: focal over image height.
+        let f_over_h = axis.norm() / down;
+        let fit = (f64::from(view_aspect) / (across / down)).min(1.0);
+        let depth = depth_m.max(0.5);
+        let target = eye.coords + forward * depth;
+        let back = -forward.cast::<f32>();
+        Some(Orbit {
+            yaw: back.x.atan2(back.z),
+            pitch: back.y.clamp(-1.0, 1.0).asin(),
+            distance: depth as f32,
+            target: target.cast::<f32>(),
+            follow: false,
+            lens: (f_over_h * fit) as f32,
+        })
     }
 
     fn basis(&self) -> (Vector3<f32>, Vector3<f32>, Vector3<f32>, Vector3<f32>) {
@@ -105,7 +208,7 @@ impl Orbit {
         if z < 0.05 {
             return None;
         }
-        let f = rect.height() * 1.2;
+        let f = rect.height() * self.lens;
         Some(rect.center() + Vec2::new(d.dot(&right) / z * f, -d.dot(&up) / z * f))
     }
 
@@ -122,7 +225,7 @@ impl Orbit {
             || response.dragged_by(egui::PointerButton::Secondary)
         {
             let (_, right, up, _) = self.basis();
-            let d = response.drag_delta() * self.distance / (rect.height() * 1.2);
+            let d = response.drag_delta() * self.distance / (rect.height() * self.lens);
             self.target += -right * d.x + up * d.y;
             self.follow = false;
         }
@@ -194,15 +297,37 @@ impl Orbit {
                     .map(|(b, _)| b)
             };
             let hovered = hover.and_then(near_bone);
+            if let Some(ghost) = &scene.ghost {
+                let grey = Stroke::new(2.0, Color32::from_gray(110));
+                for b in Bone::ALL {
+                    line(&ghost[b.parent], &ghost[b.child], grey);
+                }
+            }
+            for ankle in &scene.planted {
+                let a = joints[*ankle];
+                let ring = |t: f64| Point3::new(a.x + 0.12 * t.cos(), 0.0, a.z + 0.12 * t.sin());
+                for k in 0..12 {
+                    let t = std::f64::consts::TAU * f64::from(k) / 12.0;
+                    let dt = std::f64::consts::TAU / 12.0;
+                    line(&ring(t), &ring(t + dt), Stroke::new(2.5, PLANTED));
+                }
+            }
             for b in Bone::ALL {
-                let width = if hovered == Some(b) { 5.0 } else { 2.5 };
-                let colour = if scene.flagged.contains(&b) {
-                    FLAGGED
+                let (mut width, colour) = if scene.flagged.contains(&b) {
+                    (2.5, FLAGGED)
                 } else if scene.unsure.contains(&b) {
-                    UNSURE
+                    (DOUBT_WIDTH, DOUBT)
                 } else {
-                    side_colour(b.child)
+                    (2.5, side_colour(b.child))
                 };
+                if hovered == Some(b) || scene.highlight == Some(b) {
+                    width += 3.0;
+                    line(
+                        &joints[b.parent],
+                        &joints[b.child],
+                        Stroke::new(width + 4.0, Color32::WHITE),
+                    );
+                }
                 line(
                     &joints[b.parent],
                     &joints[b.child],
@@ -239,9 +364,9 @@ impl Orbit {
         // Notes wrap to the view's width (a narrow 3D panel cut them off).
         let mut y = 8.0;
         for note in &scene.notes {
-            let colour = Color32::from_rgb(240, 170, 90);
+            let colour = note.colour();
             let galley = painter.layout(
-                note.clone(),
+                note.text.clone(),
                 egui::FontId::proportional(13.0),
                 colour,
                 (rect.width() - 16.0).max(60.0),
@@ -295,6 +420,88 @@ mod tests {
         h.state_mut().1 = 7.0;
         h.run();
         assert_eq!(h.state().0.target.x, 4.5);
+    }
+
+    /// Through the video camera: a pinhole camera's frustum corners land on the corners of the
+    /// video fitted into the view (as the frame view draws it), its axis at the centre.
+    #[test]
+    fn the_view_through_the_camera_lies_as_the_video_does() {
+        // A 1080×1920 portrait camera, focal 1663 px, at 1.5 m looking along −z, tilted down
+        // 10° about its x axis; corners at 0.5 m.
+        let (w, h, f) = (1080.0, 1920.0, 1663.0);
+        let eye = Point3::new(0.2, 1.5, 3.0);
+        let tilt = nalgebra::Rotation3::from_axis_angle(&Vector3::x_axis(), -0.17);
+        let ray = |u: f64, v: f64| {
+            let d = tilt * Vector3::new((u - w / 2.0) / f, -(v - h / 2.0) / f, -1.0);
+            eye + d * 0.5
+        };
+        let corners = [ray(0.0, 0.0), ray(w, 0.0), ray(w, h), ray(0.0, h)];
+        let rect = Rect::from_min_size(Pos2::new(10.0, 20.0), Vec2::new(400.0, 500.0));
+        let o = Orbit::through_camera(&eye, &corners, 3.0, rect.aspect_ratio()).unwrap();
+        assert!(!o.follow);
+        // The video fitted into 400×500: scale min(400/1080, 500/1920) = 500/1920.
+        let scale = (400.0 / w).min(500.0 / h) as f32;
+        let fitted = Rect::from_center_size(rect.center(), Vec2::new(w as f32, h as f32) * scale);
+        let at = |u: f64, v: f64| o.project(rect, &ray(u, v)).unwrap();
+        for (got, want) in [
+            (at(0.0, 0.0), fitted.left_top()),
+            (at(w, h), fitted.right_bottom()),
+            (at(w / 2.0, h / 2.0), fitted.center()),
+        ] {
+            assert!((got - want).length() < 0.5, "{got:?} vs {want:?}");
+        }
+    }
+
+    /// CIE L*a*b* of an sRGB colour (D65).
+    fn lab(c: Color32) -> [f64; 3] {
+        let lin = |v: u8| {
+            let v = f64::from(v) / 255.0;
+            if v <= 0.04045 {
+                v / 12.92
+            } else {
+                ((v + 0.055) / 1.055).powf(2.4)
+            }
+        };
+        let (r, g, b) = (lin(c.r()), lin(c.g()), lin(c.b()));
+        let x = (0.4124 * r + 0.3576 * g + 0.1805 * b) / 0.95047;
+        let y = 0.2126 * r + 0.7152 * g + 0.0722 * b;
+        let z = (0.0193 * r + 0.1192 * g + 0.9505 * b) / 1.08883;
+        let f = |t: f64| {
+            if t > 0.008856 {
+                t.cbrt()
+            } else {
+                7.787 * t + 16.0 / 116.0
+            }
+        };
+        [
+            116.0 * f(y) - 16.0,
+            500.0 * (f(x) - f(y)),
+            200.0 * (f(y) - f(z)),
+        ]
+    }
+
+    /// The doubt colour stands apart from every other colour of the 3D view by a colour
+    /// difference (CIE76 ΔE) of at least 60; the amber it replaced was 24 from the middle's
+    /// yellow.
+    #[test]
+    fn the_doubt_colour_is_far_from_every_limb_colour() {
+        let others = [
+            side_colour(Joint::LeftElbow),
+            side_colour(Joint::RightElbow),
+            side_colour(Joint::Chest),
+            FLAGGED,
+            PLANTED,
+            Color32::WHITE,
+            Color32::from_rgb(180, 180, 255),
+        ];
+        let d = |a: Color32, b: Color32| {
+            let (p, q) = (lab(a), lab(b));
+            ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+        };
+        for c in others {
+            assert!(d(DOUBT, c) >= 60.0, "{c:?}: ΔE {:.0}", d(DOUBT, c));
+        }
+        assert!(d(Color32::from_rgb(255, 190, 40), side_colour(Joint::Chest)) < 60.0);
     }
 
     /// Seen from the video camera: the target at the view's centre, the camera's own left and

@@ -184,6 +184,9 @@ fn path_field(ctx: &egui::Context, state: &State, out: &mut Vec<Intent>) {
         }
         let enter = edit.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
         ui.horizontal(|ui| {
+            if request.missing_folder.is_some() && ui.button("Create the folder").clicked() {
+                out.push(Intent::CreateFolder);
+            }
             if ui.button("OK").clicked() || enter {
                 out.push(Intent::PathChosen(Some(PathBuf::from(text.trim()))));
             }

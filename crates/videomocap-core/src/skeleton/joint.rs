@@ -31,6 +31,16 @@ pub enum Joint {
 /// Number of joints in the model.
 pub const JOINT_COUNT: usize = 16;
 
+/// Which side of the subject the camera sees while the joints are marked by hand: some joints'
+/// landmarks are on the front of the body, some on the back ([`Joint::definition`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MarkingView {
+    /// The subject faces the camera (or is seen from the side).
+    Front,
+    /// The subject has their back to the camera.
+    Behind,
+}
+
 impl Joint {
     /// All joints in file order.
     pub const ALL: [Joint; JOINT_COUNT] = [
@@ -84,8 +94,51 @@ impl Joint {
         Joint::ALL.into_iter().find(|j| j.name() == name)
     }
 
-    /// Where exactly to put the joint when marking it by hand (shown in the GUI and the docs).
-    pub fn definition(self) -> &'static str {
+    /// The order a user marks the joints in by hand: down the middle to the chest, each arm,
+    /// both hips before the pelvis (their midpoint, which cannot be placed before them), then
+    /// each leg.
+    pub const MARKING_ORDER: [Joint; JOINT_COUNT] = [
+        Joint::HeadTop,
+        Joint::Neck,
+        Joint::Chest,
+        Joint::LeftShoulder,
+        Joint::LeftElbow,
+        Joint::LeftWrist,
+        Joint::RightShoulder,
+        Joint::RightElbow,
+        Joint::RightWrist,
+        Joint::LeftHip,
+        Joint::RightHip,
+        Joint::Pelvis,
+        Joint::LeftKnee,
+        Joint::LeftAnkle,
+        Joint::RightKnee,
+        Joint::RightAnkle,
+    ];
+
+    /// Where exactly to put the joint when marking it by hand (shown in the GUI and the docs),
+    /// in words for what the camera sees: from behind, the landmarks on the back (the chest's
+    /// breastbone cannot be seen; the same height on the spine can).
+    pub fn definition(self, view: MarkingView) -> &'static str {
+        match (self, view) {
+            (Joint::Neck, MarkingView::Behind) => {
+                "base of the neck: the bump of the 7th cervical vertebra at the back of the base of the neck, midway between the shoulders"
+            }
+            (Joint::Chest, MarkingView::Behind) => {
+                "on the spine, level with the lower tips of the shoulder blades (the height of the nipple line in front), about a third of the way from neck to pelvis"
+            }
+            (Joint::LeftElbow | Joint::RightElbow, MarkingView::Behind) => {
+                "centre of the elbow joint: level with the elbow's point (olecranon), midway between the bony points either side"
+            }
+            (Joint::LeftKnee | Joint::RightKnee, MarkingView::Behind) => {
+                "centre of the knee joint: level with the crease at the back of the knee, midway across the leg"
+            }
+            (joint, _) => joint.front_definition(),
+        }
+    }
+
+    /// The definition seen from the front (and from behind where the same words hold).
+    fn front_definition(self) -> &'static str {
         match self {
             Joint::HeadTop => "top of the skull (vertex), on the head's middle line",
             Joint::Neck => {
@@ -94,7 +147,7 @@ impl Joint {
             Joint::Chest => {
                 "sternum (breastbone), on the trunk's middle line about a third of the way from neck to pelvis"
             }
-            Joint::Pelvis => "midpoint of the two hip joints",
+            Joint::Pelvis => "midpoint of the two hip joints: halfway between the two hips",
             Joint::LeftShoulder | Joint::RightShoulder => {
                 "centre of the shoulder joint (head of the humerus), under the acromion (the bony tip of the shoulder)"
             }
@@ -236,6 +289,39 @@ mod tests {
             }
             assert_eq!(cur, Joint::Pelvis);
         }
+    }
+
+    /// Every joint is asked once, and each hip before the pelvis, their midpoint.
+    #[test]
+    fn marking_asks_each_joint_once_and_the_hips_before_their_midpoint() {
+        let mut seen: Vec<Joint> = Joint::MARKING_ORDER.to_vec();
+        seen.sort();
+        assert_eq!(seen, Joint::ALL);
+        let at = |j: Joint| Joint::MARKING_ORDER.iter().position(|&k| k == j);
+        assert!(at(Joint::LeftHip) < at(Joint::Pelvis));
+        assert!(at(Joint::RightHip) < at(Joint::Pelvis));
+    }
+
+    /// From behind, no joint is defined by a landmark on the front of the body.
+    #[test]
+    fn from_behind_no_definition_names_the_breastbone() {
+        for j in Joint::ALL {
+            let words = j.definition(MarkingView::Behind);
+            assert!(
+                !words.contains("sternum") && !words.contains("breastbone"),
+                "{j}: {words}"
+            );
+        }
+        assert!(
+            Joint::Chest
+                .definition(MarkingView::Front)
+                .contains("breastbone")
+        );
+        assert!(
+            Joint::Chest
+                .definition(MarkingView::Behind)
+                .contains("shoulder blades")
+        );
     }
 
     #[test]

@@ -9,6 +9,6 @@ mod standing;
 
 pub use bone::{BONE_COUNT, BodyPart, Bone, Breadth};
 pub use distance::segment_distance;
-pub use joint::{JOINT_COUNT, Joint, PerJoint};
+pub use joint::{JOINT_COUNT, Joint, MarkingView, PerJoint};
 pub use proportions::{DEFAULT_HEIGHT_M, Proportions, ProportionsError, SubjectModel};
 pub use standing::{LimbDirections, standing_pose};
