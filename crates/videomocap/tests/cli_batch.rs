@@ -24,6 +24,33 @@ fn batch(manifest: &Path, out: &Path, args: &[&str]) -> (i32, String) {
     )
 }
 
+/// Runs `videomocap batch` with `args` and without `--quiet`; (exit code, stderr).
+fn batch_loud(manifest: &Path, out: &Path, args: &[&str]) -> (i32, String) {
+    let o = Command::cargo_bin("videomocap")
+        .unwrap()
+        .arg("batch")
+        .arg(manifest)
+        .arg("--out-dir")
+        .arg(out)
+        .args(["--no-network"])
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// The hidden entries of a folder (temporary row folders).
+fn hidden_entries(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.'))
+        .collect()
+}
+
 /// The summary without its seconds column (timings differ between runs).
 fn summary_without_seconds(dir: &Path) -> Vec<String> {
     std::fs::read_to_string(dir.join("summary.csv"))
@@ -86,24 +113,20 @@ fn three_shards_run_every_row_once_and_gather_the_one_process_summary() {
     assert!(summary[6].starts_with("gone,failed,"), "{}", summary[6]);
     assert!(summary[6].contains("missing.mp4"), "{}", summary[6]);
     // No half-written row is left behind.
-    let partial = std::fs::read_dir(&one)
-        .unwrap()
-        .filter(|e| {
-            e.as_ref()
-                .unwrap()
-                .file_name()
-                .to_string_lossy()
-                .starts_with('.')
-        })
-        .count();
-    assert_eq!(partial, 0);
+    assert_eq!(hidden_entries(&one), Vec::<String>::new());
 
-    // A rerun skips the finished rows (their status files are not rewritten).
+    // A rerun skips the finished rows (their status files are not rewritten) and says which.
     let status = one.join("take_0/status.json");
     let before = std::fs::read_to_string(&status).unwrap();
     let other = one.join("take_1/status.json");
     let other_before = std::fs::read_to_string(&other).unwrap();
-    batch(&m, &one, &[]);
+    let (code, err) = batch_loud(&m, &one, &[]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("skipped 4 rows already done")
+            && err.contains("take_0, take_1, take_2, take_3"),
+        "{err}"
+    );
     assert_eq!(std::fs::read_to_string(&status).unwrap(), before);
     // A changed input (the stated height) redoes that row only.
     std::fs::write(
@@ -117,17 +140,22 @@ fn three_shards_run_every_row_once_and_gather_the_one_process_summary() {
     assert_ne!(std::fs::read_to_string(&status).unwrap(), before);
     assert_eq!(std::fs::read_to_string(&other).unwrap(), other_before);
 
-    // Three shards, three processes, then the summary gathered.
+    // A Slurm array of three tasks (`--shard slurm`, --array=1-3), three processes, then the
+    // summary gathered.
     let sharded = dir.path().join("sharded");
     let mut seen = Vec::new();
-    let children: Vec<_> = (0..3)
+    let children: Vec<_> = (1..=3)
         .map(|k| {
             std::process::Command::new(assert_cmd::cargo::cargo_bin("videomocap"))
                 .args(["--quiet", "--json", "batch"])
                 .arg(&m)
                 .arg("--out-dir")
                 .arg(&sharded)
-                .args(["--no-network", "--shard", &format!("{k}/3")])
+                .args(["--no-network", "--shard", "slurm"])
+                .env("SLURM_ARRAY_TASK_ID", k.to_string())
+                .env("SLURM_ARRAY_TASK_MIN", "1")
+                .env("SLURM_ARRAY_TASK_MAX", "3")
+                .env("SLURM_ARRAY_TASK_COUNT", "3")
                 .stdout(std::process::Stdio::piped())
                 .spawn()
                 .unwrap()
@@ -135,7 +163,10 @@ fn three_shards_run_every_row_once_and_gather_the_one_process_summary() {
         .collect();
     for c in children {
         let o = c.wait_with_output().unwrap();
-        seen.extend(reported(&String::from_utf8_lossy(&o.stdout)));
+        let rows = reported(&String::from_utf8_lossy(&o.stdout));
+        // Six rows over three tasks: two each.
+        assert_eq!(rows.len(), 2, "{rows:?}");
+        seen.extend(rows);
     }
     let ids: Vec<&str> = seen.iter().map(|(id, _)| id.as_str()).collect();
     let unique: BTreeSet<&str> = ids.iter().copied().collect();
@@ -165,4 +196,68 @@ fn a_malformed_manifest_exits_2_naming_the_line() {
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("m.csv: line 3: column height_m"), "{err}");
+}
+
+#[test]
+fn every_manifest_problem_is_reported_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = dir.path().join("m.csv");
+    // A duplicate id before a bad height and a bad field of view: all three are named.
+    std::fs::write(
+        &m,
+        "video,height_m,fov_deg,id\na.mp4,1.7,,x\nb.mp4,1.7,,x\nc.mp4,tall,,c\nd.mp4,,-60,d\n",
+    )
+    .unwrap();
+    let (code, err) = batch_loud(&m, &dir.path().join("out"), &[]);
+    assert_eq!(code, 2);
+    for want in [
+        "3 problems",
+        "m.csv: line 3: column id: \"x\" is used twice",
+        "m.csv: line 4: column height_m: \"tall\"",
+        "m.csv: line 5: column fov_deg: \"-60\"",
+    ] {
+        assert!(err.contains(want), "{want}: {err}");
+    }
+    assert!(!dir.path().join("out").exists(), "nothing runs");
+}
+
+#[test]
+fn a_killed_batch_leaves_nothing_behind_after_the_rerun() {
+    let dir = tempfile::tempdir().unwrap();
+    render_small_clip(dir.path(), ProceduralMotion::Wave, 12, View::Oblique).unwrap();
+    let m = dir.path().join("manifest.csv");
+    std::fs::write(&m, "video,keys,id\nframes,marks.json,take\n").unwrap();
+    let out = dir.path().join("out");
+    // Killed (as by a time limit or scancel) while it writes its row.
+    let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("videomocap"))
+        .args(["--quiet", "batch"])
+        .arg(&m)
+        .arg("--out-dir")
+        .arg(&out)
+        .args(["--no-network", "--threads", "1"])
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while !out.is_dir() || hidden_entries(&out).is_empty() {
+        assert!(
+            started.elapsed().as_secs() < 60,
+            "no temporary folder appeared"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let left = hidden_entries(&out);
+    assert_eq!(left.len(), 1, "{left:?}");
+    assert!(left[0].starts_with(".partial-take-"), "{left:?}");
+    assert!(
+        !out.join("take").exists(),
+        "a row's folder is complete or absent"
+    );
+    // The rerun does the row and removes the dead process's folder.
+    let (code, err) = batch_loud(&m, &out, &[]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("removed 1 unfinished row folder"), "{err}");
+    assert_eq!(hidden_entries(&out), Vec::<String>::new());
+    assert!(out.join("take/motion.bvh").exists());
 }

@@ -93,8 +93,18 @@ fn display_rotation(stream: &ff::format::stream::Stream) -> u32 {
 }
 
 impl FfmpegSource {
-    /// Opens a video file and indexes its frames.
+    /// Opens a video file and indexes its frames, decoding on as many threads as the process
+    /// may use.
     pub fn open(path: &Path) -> Result<FfmpegSource, VideoError> {
+        Self::open_with_threads(path, None)
+    }
+
+    /// [`FfmpegSource::open`] with the decoder's threads given (`None`: as many as the process
+    /// may use; 1: none besides the caller's).
+    pub fn open_with_threads(
+        path: &Path,
+        threads: Option<usize>,
+    ) -> Result<FfmpegSource, VideoError> {
         init();
         std::fs::File::open(path).map_err(|source| VideoError::Io {
             path: path.to_owned(),
@@ -128,7 +138,9 @@ impl FfmpegSource {
             .map_err(|e| not_a_video(path, e))?;
         ctx.set_threading(ff::codec::threading::Config {
             kind: ff::codec::threading::Type::Frame,
-            count: std::thread::available_parallelism().map_or(2, |n| n.get()),
+            count: threads
+                .unwrap_or_else(|| std::thread::available_parallelism().map_or(2, |n| n.get()))
+                .max(1),
             ..Default::default()
         });
         let decoder = ctx.decoder().video().map_err(|e| not_a_video(path, e))?;

@@ -89,6 +89,8 @@ pub struct OpenOptions {
     pub cache_bytes: usize,
     /// Frame rate assumed for image sequences.
     pub sequence_fps: f64,
+    /// Threads a video file's decoder may use (`None`: as many as the process may use).
+    pub decoder_threads: Option<usize>,
 }
 
 impl Default for OpenOptions {
@@ -96,6 +98,7 @@ impl Default for OpenOptions {
         OpenOptions {
             cache_bytes: DEFAULT_CACHE_BYTES,
             sequence_fps: DEFAULT_SEQUENCE_FPS,
+            decoder_threads: None,
         }
     }
 }
@@ -116,7 +119,7 @@ impl Video {
         let source: Box<dyn VideoSource> = if meta.is_dir() {
             Box::new(ImageSequence::open(path, options.sequence_fps)?)
         } else {
-            open_file(path)?
+            open_file(path, options.decoder_threads)?
         };
         Ok(Video::from_source(source, options.cache_bytes))
     }
@@ -199,12 +202,12 @@ impl Video {
 }
 
 #[cfg(feature = "ffmpeg")]
-fn open_file(path: &Path) -> Result<Box<dyn VideoSource>, VideoError> {
-    Ok(Box::new(FfmpegSource::open(path)?))
+fn open_file(path: &Path, threads: Option<usize>) -> Result<Box<dyn VideoSource>, VideoError> {
+    Ok(Box::new(FfmpegSource::open_with_threads(path, threads)?))
 }
 
 #[cfg(not(feature = "ffmpeg"))]
-fn open_file(path: &Path) -> Result<Box<dyn VideoSource>, VideoError> {
+fn open_file(path: &Path, _threads: Option<usize>) -> Result<Box<dyn VideoSource>, VideoError> {
     Err(VideoError::FfmpegDisabled {
         path: path.to_owned(),
     })

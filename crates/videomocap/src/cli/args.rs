@@ -84,7 +84,8 @@ pub struct TrackArgs {
     /// Where to write tracks2d.json (needed unless re-tracking a project).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
-    /// Worker threads (default: all cores; 1 = decode and track on one thread).
+    /// Worker threads (default: the CPUs this process may use, and no more than Slurm's
+    /// SLURM_CPUS_PER_TASK; 1 = decode, track and run the network on one thread).
     #[arg(long)]
     pub threads: Option<usize>,
     /// Tracker settings as JSON (see docs/formats.md; every field optional, defaults documented).
@@ -189,6 +190,10 @@ pub struct RunArgs {
     /// Track with VBA alone, without the pose network's evidence.
     #[arg(long)]
     pub no_network: bool,
+    /// Worker threads (default: the CPUs this process may use, and no more than Slurm's
+    /// SLURM_CPUS_PER_TASK).
+    #[arg(long)]
+    pub threads: Option<usize>,
     #[command(flatten)]
     pub options: LiftOptions,
 }
@@ -204,11 +209,15 @@ pub struct BatchArgs {
     /// DIR/summary.csv.
     #[arg(long)]
     pub out_dir: PathBuf,
-    /// Rows run at once (each gets its share of the cores).
+    /// Rows run at once (each gets its share of the threads; never more rows than threads).
     #[arg(long, default_value_t = 1)]
     pub jobs: usize,
-    /// K/N: run only the rows of shard K of N (by a stable hash of the id), e.g. one task of
-    /// a Slurm job array.
+    /// Threads for the whole batch (default: the CPUs this process may use, and no more than
+    /// Slurm's SLURM_CPUS_PER_TASK).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// K/N: run only shard K of N (rows dealt in manifest order: row i to shard i mod N); or
+    /// `slurm`: K and N from the Slurm job array (SLURM_ARRAY_TASK_ID, SLURM_ARRAY_TASK_COUNT).
     #[arg(long)]
     pub shard: Option<String>,
     /// Redo every row, also those complete and unchanged.

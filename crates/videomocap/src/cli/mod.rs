@@ -4,6 +4,7 @@
 pub mod args;
 mod batch;
 mod carve;
+mod cpus;
 pub mod export;
 mod info;
 pub mod lift;

@@ -18,6 +18,8 @@ pub const TRC: &str = "motion.trc";
 
 /// `run`.
 pub fn run(a: &RunArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+    let threads = super::cpus::thread_budget(a.threads)?.threads;
+    super::cpus::limit_global_pool(threads);
     run_into(
         &RunInput {
             video: &a.video,
@@ -25,7 +27,7 @@ pub fn run(a: &RunArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             keys: a.keys.as_deref(),
             tracker: videomocap_core::track::TrackerParams::default(),
             no_network: a.no_network,
-            threads: None,
+            threads,
             options: &a.options,
         },
         &a.out_dir,
@@ -46,8 +48,8 @@ pub struct RunInput<'a> {
     pub tracker: videomocap_core::track::TrackerParams,
     /// Track with VBA alone.
     pub no_network: bool,
-    /// Worker threads (`None`: all cores).
-    pub threads: Option<usize>,
+    /// Threads for every pool of the run (decoder, tracker, pose network); see `cli::cpus`.
+    pub threads: usize,
     /// Camera, subject and lift settings.
     pub options: &'a LiftOptions,
 }
@@ -70,7 +72,8 @@ pub fn run_into(
     global: &GlobalArgs,
 ) -> Result<RunReport, ExitError> {
     let (params, known) = super::lift::check_options(input.options)?;
-    let (mut video, keys) = super::track::open_checked(input.video, input.marks, input.keys)?;
+    let (mut video, keys) =
+        super::track::open_checked(input.video, input.marks, input.keys, input.threads)?;
     std::fs::create_dir_all(out_dir)
         .map_err(|e| ExitError::failed(anyhow!("{}: cannot create: {e}", out_dir.display())))?;
     let out = super::track::track_with_progress(

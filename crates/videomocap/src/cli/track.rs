@@ -14,12 +14,13 @@ use videomocap_core::track::{
 };
 use videomocap_core::video::{OpenOptions, Video};
 
-/// Opens the video and the hand-placed joints (a marks file or a keys file) and checks that
-/// they fit together.
+/// Opens the video (its decoder on `threads` threads) and the hand-placed joints (a marks file
+/// or a keys file) and checks that they fit together.
 pub fn open_checked(
     video: &Path,
     marks: Option<&Path>,
     keys: Option<&Path>,
+    threads: usize,
 ) -> Result<(Video, KeyFrames), ExitError> {
     let (path, keys) = match (marks, keys) {
         (_, Some(k)) => (k, KeyFrames::load(k).map_err(ExitError::bad_input)?),
@@ -33,9 +34,17 @@ pub fn open_checked(
             )));
         }
     };
-    let v = Video::open(video, &OpenOptions::default()).map_err(ExitError::bad_input)?;
+    let v = Video::open(video, &decoding_on(threads)).map_err(ExitError::bad_input)?;
     check_keys(&v, &keys, path)?;
     Ok((v, keys))
+}
+
+/// Video options with the decoder on `threads` threads.
+fn decoding_on(threads: usize) -> OpenOptions {
+    OpenOptions {
+        decoder_threads: Some(threads),
+        ..OpenOptions::default()
+    }
 }
 
 /// Checks keys against the video (frames in range, points on the image, one full key); the
@@ -61,26 +70,17 @@ pub fn load_network(off: bool, threads: usize) -> Option<Arc<PoseNetwork>> {
     }
 }
 
-/// Runs the tracker with a progress bar, with the pose network unless `no_network`; shared by
-/// `track` and `run`.
+/// Runs the tracker on `threads` threads (its pool and the pose network's) with a progress
+/// bar, with the pose network unless `no_network`; shared by `track` and `run`.
 pub fn track_with_progress(
     video: &mut Video,
     keys: &KeyFrames,
-    threads: Option<usize>,
+    threads: usize,
     params: TrackerParams,
     no_network: bool,
     global: &GlobalArgs,
 ) -> Result<TrackOutput, ExitError> {
-    let threads = threads.unwrap_or_else(|| {
-        std::thread::available_parallelism()
-            .map(|n| n.get())
-            .unwrap_or(1)
-    });
-    if threads == 0 {
-        return Err(ExitError::bad_input(anyhow!(
-            "--threads must be at least 1"
-        )));
-    }
+    let threads = threads.max(1);
     let network = load_network(no_network || !params.network, threads);
     let job = TrackJob {
         keys: keys.clone(),
@@ -196,6 +196,8 @@ pub fn run(a: &TrackArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     } else {
         None
     };
+    let threads = super::cpus::thread_budget(a.threads)?.threads;
+    super::cpus::limit_global_pool(threads);
     let (mut video, keys, settings) = match &project {
         Some(p) => {
             // A relative video path is relative to the project's folder.
@@ -204,7 +206,7 @@ pub fn run(a: &TrackArgs, global: &GlobalArgs) -> Result<(), ExitError> {
                 _ => p.video.clone(),
             };
             let v =
-                Video::open(&video_path, &OpenOptions::default()).map_err(ExitError::bad_input)?;
+                Video::open(&video_path, &decoding_on(threads)).map_err(ExitError::bad_input)?;
             check_keys(&v, &p.keys, &a.video)?;
             (v, p.keys.clone(), Some(p.settings.tracker))
         }
@@ -214,7 +216,7 @@ pub fn run(a: &TrackArgs, global: &GlobalArgs) -> Result<(), ExitError> {
                     "give --output tracks2d.json (only a project keeps its tracks itself)"
                 )));
             }
-            let (v, k) = open_checked(&a.video, a.marks.as_deref(), a.keys.as_deref())?;
+            let (v, k) = open_checked(&a.video, a.marks.as_deref(), a.keys.as_deref(), threads)?;
             (v, k, None)
         }
     };
@@ -224,7 +226,7 @@ pub fn run(a: &TrackArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         (None, None) => TrackerParams::default(),
     };
     let t0 = std::time::Instant::now();
-    let out = track_with_progress(&mut video, &keys, a.threads, params, a.no_network, global)?;
+    let out = track_with_progress(&mut video, &keys, threads, params, a.no_network, global)?;
     let seconds = t0.elapsed().as_secs_f64();
     let mut written = Vec::new();
     if let Some(output) = &a.output {
