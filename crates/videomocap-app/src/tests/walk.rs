@@ -300,7 +300,7 @@ fn recent_lists_a_saved_project_in_place_of_its_video() {
     h.get_by_label("Open the project").click();
     h.run_steps(2);
     wait(&mut h, "the project", |s| s.frame_count() == 60);
-    assert_eq!(h.state().state().recent(), [project.clone()]);
+    assert_eq!(h.state().state().recent(), std::slice::from_ref(&project));
     h.state_mut().state_mut().apply(Intent::Open(video.clone()));
     wait(&mut h, "the clip again", |s| s.project_beside().is_some());
     assert_eq!(h.state().state().recent(), [project]);
