@@ -6,18 +6,25 @@ use std::collections::BTreeSet;
 use std::path::Path;
 use videomocap_testkit::synth::{ProceduralMotion, View, render_small_clip};
 
-/// Runs `videomocap batch` with `args`; (exit code, stdout).
-fn batch(manifest: &Path, out: &Path, args: &[&str]) -> (i32, String) {
-    let o = Command::cargo_bin("videomocap")
+/// Runs `videomocap batch` (without the pose network) with `leading` before and `args` after
+/// the manifest and output folder.
+fn run_batch(leading: &[&str], manifest: &Path, out: &Path, args: &[&str]) -> std::process::Output {
+    Command::cargo_bin("videomocap")
         .unwrap()
-        .args(["--quiet", "--json", "batch"])
+        .args(leading)
+        .arg("batch")
         .arg(manifest)
         .arg("--out-dir")
         .arg(out)
         .args(["--no-network"])
         .args(args)
         .output()
-        .unwrap();
+        .unwrap()
+}
+
+/// Runs `videomocap batch` with `args`, quiet, in JSON; (exit code, stdout).
+fn batch(manifest: &Path, out: &Path, args: &[&str]) -> (i32, String) {
+    let o = run_batch(&["--quiet", "--json"], manifest, out, args);
     (
         o.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&o.stdout).into_owned(),
@@ -26,16 +33,7 @@ fn batch(manifest: &Path, out: &Path, args: &[&str]) -> (i32, String) {
 
 /// Runs `videomocap batch` with `args` and without `--quiet`; (exit code, stderr).
 fn batch_loud(manifest: &Path, out: &Path, args: &[&str]) -> (i32, String) {
-    let o = Command::cargo_bin("videomocap")
-        .unwrap()
-        .arg("batch")
-        .arg(manifest)
-        .arg("--out-dir")
-        .arg(out)
-        .args(["--no-network"])
-        .args(args)
-        .output()
-        .unwrap();
+    let o = run_batch(&[], manifest, out, args);
     (
         o.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&o.stderr).into_owned(),

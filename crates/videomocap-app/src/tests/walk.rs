@@ -136,16 +136,22 @@ fn switching_the_pose_network_offers_to_track_again() {
     assert!(h.query_by_label("Track again (T)").is_none());
 }
 
+/// The app with a new project on a video that is never opened, state kept under `dir`.
+fn with_empty_project(dir: &Path) -> Harness<'static, App> {
+    let mut h = harness(None, &PreparedDialogs::default(), &dir.join("state"));
+    h.state_mut()
+        .state_mut()
+        .set_project_for_test(Project::new(dir.join("v.mp4")));
+    h.run();
+    h
+}
+
 /// The side panel's setting labels fit beside their sliders at the panel's width (a label ran
 /// past the edge, cut: "interpolate up to (s"), and the panel keeps its width.
 #[test]
 fn every_setting_label_fits_the_side_panel() {
     let dir = tempfile::tempdir().unwrap();
-    let mut h = harness(None, &PreparedDialogs::default(), &dir.path().join("state"));
-    h.state_mut()
-        .state_mut()
-        .set_project_for_test(Project::new(dir.path().join("v.mp4")));
-    h.run();
+    let mut h = with_empty_project(dir.path());
     let width = h.state().layout().side_px.expect("drawn");
     h.get_by_label("Tracker").click();
     h.run();
@@ -246,11 +252,7 @@ fn the_panel_widths_and_the_zoom_are_kept_across_restarts() {
 #[test]
 fn the_hips_come_before_the_pelvis_and_the_words_follow_a_subject_seen_from_behind() {
     let dir = tempfile::tempdir().unwrap();
-    let mut h = harness(None, &PreparedDialogs::default(), &dir.path().join("state"));
-    h.state_mut()
-        .state_mut()
-        .set_project_for_test(Project::new(dir.path().join("v.mp4")));
-    h.run();
+    let mut h = with_empty_project(dir.path());
     h.get_by_label("Edit").click();
     h.run();
     h.get_by_label("Mark joints (M)").click();
