@@ -11,7 +11,8 @@
 //! Every shortest-path edge is kept, so the graph stays connected and the geodesic distances
 //! from the head do not change.
 
-use super::isomap::{Graph, dijkstra};
+use super::isomap::{Graph, Neighbours, dijkstra};
+use nalgebra::Point3;
 use std::collections::BinaryHeap;
 
 /// Bands (each as wide as the longest graph edge) a loop must span at least, from where its two
@@ -214,6 +215,21 @@ pub(super) fn cut_handles(g: &Graph, source: usize) -> Option<(Graph, usize)> {
     let opened = g.without(cut);
     let removed = (g.targets_len() - opened.targets_len()) / 2;
     (removed > 0).then_some((opened, removed))
+}
+
+impl Neighbours {
+    /// Opens the graph's loops as seen from the kept point nearest `head`; returns how many
+    /// edges were removed (0: no loop).
+    pub fn open_handles(&mut self, head: Point3<f64>) -> usize {
+        let Some((opened, cut)) = self
+            .nearest(head)
+            .and_then(|s| cut_handles(self.graph(), s))
+        else {
+            return 0;
+        };
+        self.set_opened(opened, cut);
+        cut
+    }
 }
 
 #[cfg(test)]

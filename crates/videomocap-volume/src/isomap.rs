@@ -259,21 +259,24 @@ impl Neighbours {
         &self.points
     }
 
-    /// Opens the graph's loops as seen from the kept point nearest `head`
-    /// (`volume::handles`); returns how many edges were removed (0: no loop).
-    pub fn open_handles(&mut self, head: Point3<f64>) -> usize {
-        let source = (0..self.points.len()).min_by(|&a, &b| {
+    /// The kept point nearest `head`.
+    pub(crate) fn nearest(&self, head: Point3<f64>) -> Option<usize> {
+        (0..self.points.len()).min_by(|&a, &b| {
             (self.points[a] - head)
                 .norm_squared()
                 .total_cmp(&(self.points[b] - head).norm_squared())
-        });
-        let Some((opened, cut)) = source.and_then(|s| super::handles::cut_handles(&self.graph, s))
-        else {
-            return 0;
-        };
+        })
+    }
+
+    /// The neighbourhood graph.
+    pub(crate) fn graph(&self) -> &Graph {
+        &self.graph
+    }
+
+    /// Puts `opened` in place of the graph, `cut` edges fewer (`volume::handles`).
+    pub(crate) fn set_opened(&mut self, opened: Graph, cut: usize) {
         self.graph = opened;
         self.cut_edges += cut;
-        cut
     }
 }
 

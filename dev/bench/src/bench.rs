@@ -12,14 +12,19 @@ use std::time::Instant;
 use videomocap_core::video::{OpenOptions, Video};
 use videomocap_testkit::synth::{SynthParams, VideoOutput, render_clip};
 
-/// Runs the benchmark `what` (track, correct, lift, volume, scrub, or all, decode, synth).
-pub fn run(what: &str, a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+/// Says so when this is a debug build (its figures are not the product's).
+pub fn note_debug_build(global: &GlobalArgs) {
     if cfg!(debug_assertions) {
         say(
             global,
             "note: this is a debug build; run `cargo run --release -p videomocap-bench -- …` for real figures",
         );
     }
+}
+
+/// Runs the benchmark `what` (track, correct, lift, volume, or all, decode, synth).
+pub fn run(what: &str, a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+    note_debug_build(global);
     if what == "track" {
         return crate::bench_track::run(a, global);
     }
@@ -39,9 +44,6 @@ pub fn run(what: &str, a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitErr
     }
     if what == "volume" {
         return crate::bench_volume::run(a, global);
-    }
-    if what == "scrub" {
-        return crate::bench_scrub::run(a, global);
     }
     let dir = tempfile::tempdir().map_err(ExitError::failed)?;
     let mut rows: Vec<[String; 4]> = Vec::new();

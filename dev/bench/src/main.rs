@@ -32,7 +32,7 @@ fn main() -> ExitCode {
         Command::Lift(a) => bench::run("lift", a, global),
         Command::Volume(a) => bench::run("volume", a, global),
         Command::Motion(a) => bench_motion::run(a, global),
-        Command::Scrub(a) => bench::run("scrub", a, global),
+        Command::Scrub(a) => bench_scrub::run(a, global),
         Command::Learned(a) => bench_learned::run(a, global),
         Command::Speed { what, args } => bench::run(what, args, global),
         Command::Synth(a) => synth::run(a, global),
