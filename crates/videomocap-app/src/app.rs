@@ -12,6 +12,11 @@ use super::views::view3d::{self, Orbit};
 use super::views::{keys, menu, scene, side_panel, status_bar, timeline, windows};
 use std::path::PathBuf;
 
+/// The share of the frame's height the timeline's strips may take by default: a 4:3 clip in a
+/// 1440 × 900 window loses 2 % to them and shows them; a portrait clip would lose a fifth and
+/// gets one folded strip.
+const STRIPS_MAY_TAKE: f32 = 0.1;
+
 /// The desktop app.
 pub struct App {
     state: State,
@@ -33,6 +38,9 @@ pub struct App {
     view3d_rect: egui::Rect,
     /// Where the 3D view drew its scene last.
     view3d_canvas: egui::Rect,
+    /// Where the frame view's panel was drawn last, and whether the timeline's strips were
+    /// unfolded then (what decides the strips' default).
+    central: (egui::Rect, bool),
 }
 
 impl App {
@@ -62,6 +70,7 @@ impl App {
             layout_changed: false,
             view3d_rect: egui::Rect::NOTHING,
             view3d_canvas: egui::Rect::NOTHING,
+            central: (egui::Rect::NOTHING, true),
         }
     }
 
@@ -117,6 +126,41 @@ impl App {
             self.layout.save(self.state.state_dir());
             self.layout_changed = false;
         }
+    }
+
+    /// Whether the timeline shows a strip per joint: the user's choice if they made one, else
+    /// only where the strips take little height the video needs: the frame, fitted to the
+    /// panel, keeps at least [`STRIPS_MAY_TAKE`]'s complement of its height with them (a
+    /// landscape clip beside the panels). A portrait clip keeps the height: one folded strip.
+    fn each_joint(&self) -> bool {
+        if let Some(choice) = self.layout.each_joint {
+            return choice;
+        }
+        let (central, unfolded) = self.central;
+        let Some(info) = self.state.video_info().filter(|i| i.width > 0) else {
+            return true;
+        };
+        if central == egui::Rect::NOTHING {
+            return true;
+        }
+        let extra = timeline::UNFOLDED_EXTRA_H;
+        let folded_room = central.height() + if unfolded { extra } else { 0.0 };
+        let fitted = central.width() * info.height as f32 / info.width as f32;
+        let folded = fitted.min(folded_room);
+        let with_strips = fitted.min(folded_room - extra);
+        with_strips >= (1.0 - STRIPS_MAY_TAKE) * folded
+    }
+
+    /// Whether the timeline showed a strip per joint last (tests).
+    #[cfg(test)]
+    pub fn timeline_unfolded(&self) -> bool {
+        self.central.1
+    }
+
+    /// Where the frame view's panel was drawn last (tests).
+    #[cfg(test)]
+    pub fn central_rect(&self) -> egui::Rect {
+        self.central.0
     }
 
     /// The app's state (tests read it).
@@ -292,9 +336,17 @@ impl eframe::App for App {
         egui::Panel::bottom("status")
             .exact_size(status_bar::HEIGHT)
             .show(ui, |ui| status_bar::show(ui, &self.state, &mut out));
+        let each_joint = self.each_joint();
         if self.state.frame_count() > 0 {
-            egui::Panel::bottom("timeline")
-                .show(ui, |ui| timeline::show(ui, &self.state, &mut out));
+            let fold = egui::Panel::bottom("timeline")
+                .show(ui, |ui| {
+                    timeline::show(ui, &self.state, each_joint, &mut out)
+                })
+                .inner;
+            if fold {
+                self.layout.each_joint = Some(!each_joint);
+                self.layout_changed = true;
+            }
         }
         let side = egui::Panel::left("side")
             .resizable(true)
@@ -317,7 +369,11 @@ impl eframe::App for App {
                 .show(ui, |ui| self.view3d(ui, &mut out));
             self.view3d_rect = view3d.response.rect;
             self.keep_width(&ctx, |l| &mut l.view3d_px, view3d.response.rect.width());
-            egui::CentralPanel::default().show(ui, |ui| self.frame(ui, &mut out));
+            let central = egui::CentralPanel::default().show(ui, |ui| self.frame(ui, &mut out));
+            self.central = (
+                central.response.rect,
+                each_joint && self.state.strips().is_some(),
+            );
         }
         self.keep_layout(&ctx);
         windows::show(&ctx, &self.state, &mut self.guide, &mut out);

@@ -4,11 +4,12 @@
 //! written or saying why not; when no file dialog can be shown, the app's own path field asks
 //! instead (for exports too: `export`).
 
+use super::export_kind::ExportKind;
 use super::file_dialogs::Picked;
 use super::frame_loader::FrameLoader;
 use super::jobs::Job;
 use super::volume::VolumeSequence;
-use super::{ExportKind, Running, State};
+use super::{Running, State};
 use std::path::{Path, PathBuf};
 use videomocap_core::formats::Marks;
 use videomocap_core::project::Project;

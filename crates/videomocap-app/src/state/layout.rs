@@ -1,5 +1,6 @@
 //! The window's layout as the user left it, kept across restarts beside the recent list and the
-//! autosave (`layout.json`): the side panel's and the 3D view's widths, and per video the
+//! autosave (`layout.json`): the side panel's and the 3D view's widths, the timeline's strips
+//! folded or not, and per video the
 //! frame view's zoom and the image point at its centre (marking a portrait clip at one screen
 //! pixel per three video pixels needs the zoom, and it was forgotten on every start). A file
 //! that is missing or unreadable gives the defaults; losing it is harmless.
@@ -45,6 +46,10 @@ pub struct Layout {
     /// The 3D view's width, points.
     #[serde(default)]
     pub view3d_px: Option<f32>,
+    /// The timeline's strips: one per joint (`true`) or folded into one (`false`), as the user
+    /// last chose (`None`: folded only where they would take height from the video).
+    #[serde(default)]
+    pub each_joint: Option<bool>,
     /// The frame view's zoom per video, the latest first.
     #[serde(default)]
     zooms: Vec<VideoZoom>,

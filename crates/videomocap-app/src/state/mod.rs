@@ -13,6 +13,7 @@
 pub mod autosave;
 mod edit;
 mod export;
+mod export_kind;
 pub mod file_dialogs;
 mod files;
 pub mod frame_loader;
@@ -20,17 +21,18 @@ pub mod jobs;
 pub mod layout;
 mod outdated;
 mod recent;
+mod strips;
 pub mod volume;
 mod work;
 
 pub use edit::FlipGhost;
-pub use export::ExportKind;
+pub use export_kind::ExportKind;
 pub use files::{Choose, Leave, PathPurpose, PathRequest, SaveAnswer};
 pub use outdated::Outdated;
+pub use strips::Strips;
 
 use crate::intent::Intent;
 use crate::views::frame_view::PointState;
-use crate::views::timeline::Strips;
 use autosave::Autosaver;
 use file_dialogs::{Dialogs, RfdDialogs};
 use frame_loader::FrameLoader;

@@ -181,7 +181,7 @@ fn quitting_asks_to_save_unsaved_work_and_leaves_no_recovery_prompt() {
     assert!(h.state().state().leaving().is_none());
 }
 
-/// Tracks for `n` frames of a 8×6 image folder: the left wrist weak on frames 3–5.
+/// Tracks for `n` frames of an image folder (the points inside 8×6): the left wrist weak on frames 3–5.
 fn weak_wrist_tracks(dir: &Path, n: usize) -> Tracks2d {
     Tracks2d {
         source: SourceInfo {
@@ -211,14 +211,15 @@ fn weak_wrist_tracks(dir: &Path, n: usize) -> Tracks2d {
 
 /// The reliability strips carry their joints' names, hovering one names the joint, the frame
 /// and the state there, and the side panel says how much is weak (joint-frames and the share
-/// of the clip), not how many fragments.
+/// of the clip), not how many fragments. A 16:9 clip beside the panels shows a strip per joint
+/// by default (they take no height the video needs).
 #[test]
 fn strips_are_named_and_the_panel_says_how_much_is_weak() {
     let dir = tempfile::tempdir().unwrap();
     let frames = dir.path().join("frames");
     std::fs::create_dir(&frames).unwrap();
     for i in 0..12 {
-        image::RgbImage::from_pixel(8, 6, image::Rgb([i * 20, 0, 0]))
+        image::RgbImage::from_pixel(16, 9, image::Rgb([i * 20, 0, 0]))
             .save(frames.join(format!("f{i:02}.png")))
             .unwrap();
     }
@@ -233,6 +234,7 @@ fn strips_are_named_and_the_panel_says_how_much_is_weak() {
     h.state_mut().state_mut().set_project_for_test(p);
     h.run_steps(2);
 
+    assert!(h.state().timeline_unfolded(), "a strip per joint");
     // 3 of 12 × 16 joint-frames.
     let share = h.state().state().weak_share().unwrap();
     assert_eq!((share.joint_frames, share.total), (3, 192));

@@ -11,7 +11,7 @@ use videomocap_core::lift::{BoneDepth, Root};
 use videomocap_core::project::Project;
 use videomocap_core::skeleton::{BONE_COUNT, Bone, Joint, MarkingView};
 
-/// The bundled synthetic clip (60 frames, 640×360), with its marks beside it.
+/// The bundled synthetic clip (60 frames, 640×480), with its marks beside it.
 fn sample_clip() -> PathBuf {
     videomocap_testkit::repo_root().join("sample_videos/synth_walk_oblique/video.mp4")
 }
@@ -342,4 +342,68 @@ fn an_export_into_a_missing_folder_offers_to_create_it() {
         h.state().state().status(),
         format!("Wrote {}", target.display())
     );
+}
+
+/// A portrait clip keeps its height once tracked: the timeline folds its sixteen strips into
+/// one (the video lost 180 points to them); "each joint" unfolds them, and that choice is
+/// kept across a restart. (A landscape clip beside the panels gets the strips unfolded: the
+/// desktop tests hover a joint's strip.)
+#[test]
+fn a_tracked_portrait_clip_keeps_its_height_and_the_strips_unfold_on_asking() {
+    let dir = tempfile::tempdir().unwrap();
+    let frames = dir.path().join("portrait");
+    std::fs::create_dir(&frames).unwrap();
+    for i in 0..3u8 {
+        image::RgbImage::from_pixel(108, 192, image::Rgb([i * 60, 40, 40]))
+            .save(frames.join(format!("f{i}.png")))
+            .unwrap();
+    }
+    let state = dir.path().join("state");
+    let open = |h: &mut Harness<'static, App>| {
+        wait(h, "the folder", |s| {
+            s.frame_count() == 3 && s.shown() == Some(0)
+        });
+        h.run_steps(3);
+        let before = h.state().central_rect().height();
+        let p = lifted_project(frames.clone(), 3, &[]);
+        h.state_mut().state_mut().set_project_for_test(p);
+        h.run_steps(4);
+        assert!(h.state().state().strips().is_some());
+        before
+    };
+    let dialogs = PreparedDialogs::default();
+    let mut h = harness(Some(frames.clone()), &dialogs, &state);
+    let before = open(&mut h);
+    let tracked = h.state().central_rect().height();
+    assert!(!h.state().timeline_unfolded(), "folded by default");
+    assert!(
+        before - tracked < 40.0,
+        "the strips took {} points from the video",
+        before - tracked
+    );
+    h.get_by_label("each joint").click();
+    h.run_steps(4);
+    assert!(h.state().timeline_unfolded());
+    let unfolded = h.state().central_rect().height();
+    assert!(tracked - unfolded > 150.0, "{tracked} → {unfolded}");
+    drop(h);
+
+    let mut h = harness(Some(frames.clone()), &dialogs, &state);
+    open(&mut h);
+    assert!(h.state().timeline_unfolded(), "the user's choice is kept");
+}
+
+/// A landscape clip shows a strip per joint: the bundled 640×480 walk beside the panels loses
+/// less than a tenth of its height to them.
+#[test]
+fn a_landscape_clip_shows_a_strip_per_joint() {
+    let dir = tempfile::tempdir().unwrap();
+    let dialogs = PreparedDialogs::default();
+    let mut h = harness(Some(sample_clip()), &dialogs, &dir.path().join("state"));
+    wait(&mut h, "the clip", |s| s.shown() == Some(0));
+    h.run_steps(3);
+    let p = lifted_project(sample_clip(), 60, &[]);
+    h.state_mut().state_mut().set_project_for_test(p);
+    h.run_steps(4);
+    assert!(h.state().timeline_unfolded());
 }
