@@ -58,3 +58,83 @@ fn a_model_file_that_is_missing_truncated_or_not_a_model_is_refused_by_name() {
     let e = PoseNetwork::load(&text).err().unwrap();
     assert!(e.to_string().contains("text.onnx"), "{e}");
 }
+
+/// Our limb joints and BlazePose's landmarks for them.
+const LIMB_LANDMARKS: [(Joint, usize); 12] = [
+    (Joint::LeftShoulder, 11),
+    (Joint::RightShoulder, 12),
+    (Joint::LeftElbow, 13),
+    (Joint::RightElbow, 14),
+    (Joint::LeftWrist, 15),
+    (Joint::RightWrist, 16),
+    (Joint::LeftHip, 23),
+    (Joint::RightHip, 24),
+    (Joint::LeftKnee, 25),
+    (Joint::RightKnee, 26),
+    (Joint::LeftAnkle, 27),
+    (Joint::RightAnkle, 28),
+];
+
+/// The model run plainly, as tract loads it with its defaults (every output, one thread): the
+/// slow reference the product's pruned graph is checked against.
+fn plain_landmarks(
+    plan: &std::sync::Arc<tract_onnx::prelude::TypedRunnableModel>,
+    input: Vec<f32>,
+) -> (Vec<f32>, f32) {
+    use tract_onnx::prelude::*;
+    let input = tract_ndarray::Array4::from_shape_vec((1, 256, 256, 3), input).unwrap();
+    let outputs = plan.run(tvec!(Tensor::from(input).into())).unwrap();
+    let values = |n: usize| -> Vec<f32> {
+        let o = outputs.iter().find(|o| o.len() == n).unwrap();
+        o.to_plain_array_view::<f32>()
+            .unwrap()
+            .iter()
+            .copied()
+            .collect()
+    };
+    (values(195), values(1)[0])
+}
+
+#[test]
+fn the_products_network_gives_the_plain_models_landmarks_within_half_a_pixel() {
+    use tract_onnx::prelude::*;
+    let root = videomocap_testkit::repo_root();
+    let plain = tract_onnx::onnx()
+        .model_for_path(root.join("assets/blazepose/pose_landmark_full.onnx"))
+        .unwrap()
+        .with_input_fact(0, f32::fact([1, 256, 256, 3]).into())
+        .unwrap()
+        .into_optimized()
+        .unwrap()
+        .into_runnable()
+        .unwrap();
+    let network = PoseNetwork::bundled().unwrap().with_threads(2);
+    let (mut worst, mut crops) = (0.0f64, 0);
+    for clip in [
+        "pose2sim_balancing_cam01",
+        "pose2sim_distractor_cam01",
+        "synth_walk_oblique",
+    ] {
+        let dir = root.join("sample_videos").join(clip);
+        let gt = GroundTruth::load(&dir.join("gt.json")).unwrap();
+        let mut video = Video::open(&dir.join("video.mp4"), &OpenOptions::default()).unwrap();
+        for index in [0, 25, 50] {
+            let frame = video.frame(index).unwrap();
+            let p = &gt.frames[index].points2d;
+            let truth = PerJoint::from_fn(|j| Point2::new(p[j.index()][0], p[j.index()][1]));
+            let crop = Crop::around(&truth).unwrap();
+            let pose = network.run(&frame.image, &crop).unwrap();
+            let (landmarks, flag) = plain_landmarks(&plain, crop.sample(&frame.image));
+            let presence = 1.0 / (1.0 + (-f64::from(flag)).exp());
+            assert!((pose.presence - presence).abs() < 1e-3, "{clip} {index}");
+            for (j, i) in LIMB_LANDMARKS {
+                let reference =
+                    crop.to_image(f64::from(landmarks[i * 5]), f64::from(landmarks[i * 5 + 1]));
+                worst = worst.max((pose.joints[j].pos - reference).norm());
+            }
+            crops += 1;
+        }
+    }
+    eprintln!("{crops} crops: largest difference to the plain model {worst:.4} px");
+    assert!(worst <= 0.5, "largest difference {worst} px");
+}

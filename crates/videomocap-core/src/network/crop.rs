@@ -85,28 +85,42 @@ impl Crop {
     /// outside the frame.
     pub fn sample(&self, frame: &RgbImage) -> Vec<f32> {
         let mut out = vec![0.0f32; INPUT_PX * INPUT_PX * 3];
-        let (w, h) = (frame.width() as i64, frame.height() as i64);
+        self.sample_into(frame, &mut out);
+        out
+    }
+
+    /// [`Crop::sample`] written into `out` (256 × 256 × 3 values): bilinear, the image point of
+    /// each crop pixel stepped along the crop's turned axes rather than turned anew per pixel.
+    pub(crate) fn sample_into(&self, frame: &RgbImage, out: &mut [f32]) {
+        let (w, h) = (i64::from(frame.width()), i64::from(frame.height()));
         let raw = frame.as_raw();
-        let at = |x: i64, y: i64, c: usize| -> f32 {
+        let at = |x: i64, y: i64| -> [f32; 3] {
             if x < 0 || y < 0 || x >= w || y >= h {
-                return 0.0;
+                return [0.0; 3];
             }
-            f32::from(raw[((y * w + x) * 3) as usize + c])
+            let i = ((y * w + x) * 3) as usize;
+            [raw[i], raw[i + 1], raw[i + 2]].map(f32::from)
         };
-        for v in 0..INPUT_PX {
-            for u in 0..INPUT_PX {
-                let p = self.to_image(u as f64 + 0.5, v as f64 + 0.5);
+        // The image point of crop pixel (u, v) is origin + u·step_u + v·step_v (`to_image`).
+        let origin = self.to_image(0.5, 0.5);
+        let step_u = self.to_image(1.5, 0.5) - origin;
+        let step_v = self.to_image(0.5, 1.5) - origin;
+        for (v, row) in out.chunks_exact_mut(INPUT_PX * 3).enumerate() {
+            let start = origin + step_v * v as f64;
+            for (u, px) in row.chunks_exact_mut(3).enumerate() {
+                let p = start + step_u * u as f64;
                 let (fx, fy) = (p.x.floor(), p.y.floor());
                 let (tx, ty) = ((p.x - fx) as f32, (p.y - fy) as f32);
                 let (x0, y0) = (fx as i64, fy as i64);
-                for c in 0..3 {
-                    let top = at(x0, y0, c) * (1.0 - tx) + at(x0 + 1, y0, c) * tx;
-                    let bottom = at(x0, y0 + 1, c) * (1.0 - tx) + at(x0 + 1, y0 + 1, c) * tx;
-                    out[(v * INPUT_PX + u) * 3 + c] = (top * (1.0 - ty) + bottom * ty) / 255.0;
+                let (a, b) = (at(x0, y0), at(x0 + 1, y0));
+                let (c, d) = (at(x0, y0 + 1), at(x0 + 1, y0 + 1));
+                for k in 0..3 {
+                    let top = a[k] * (1.0 - tx) + b[k] * tx;
+                    let bottom = c[k] * (1.0 - tx) + d[k] * tx;
+                    px[k] = (top * (1.0 - ty) + bottom * ty) / 255.0;
                 }
             }
         }
-        out
     }
 }
 

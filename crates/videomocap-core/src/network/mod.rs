@@ -12,8 +12,11 @@
 //! marks them: callers carry the offset the key frames show.
 
 mod crop;
+mod graph;
+mod profile;
 
 pub use crop::{Crop, INPUT_PX};
+pub use profile::{NetworkProfile, OpTime};
 
 use crate::skeleton::{Joint, PerJoint};
 use image::RgbImage;
@@ -133,30 +136,42 @@ impl PoseNetwork {
             reason: e.to_string(),
         };
         let input = [1, INPUT_PX, INPUT_PX, 3];
-        let plan = tract_onnx::onnx()
+        let mut model = tract_onnx::onnx()
             .model_for_read(reader)
             .map_err(|e| bad(&e))?
             .with_input_fact(0, f32::fact(input).into())
             .map_err(|e| bad(&e))?
+            .into_typed()
+            .map_err(|e| bad(&e))?;
+        graph::keep_read_outputs(&mut model, &[LANDMARKS * 5, 1, LANDMARKS * 3])
+            .map_err(|e| bad(&e))?;
+        let mut model = model.into_decluttered().map_err(|e| bad(&e))?;
+        graph::channels_last(&mut model).map_err(|e| bad(&e))?;
+        let plan = model
             .into_optimized()
             .map_err(|e| bad(&e))?
             .into_runnable()
             .map_err(|e| bad(&e))?;
         let network = PoseNetwork { plan, pool: None };
         // The outputs this code reads must be there, with their sizes.
-        let probe = network
-            .raw(vec![0.0; INPUT_PX * INPUT_PX * 3])
-            .map_err(|e| bad(&e))?;
+        let probe = network.raw(&mut |_: &mut [f32]| {}).map_err(|e| bad(&e))?;
         drop(probe);
         Ok(network)
     }
 
-    /// The landmarks (39 × 5), the pose flag and the world coordinates (39 × 3) of one input.
-    fn raw(&self, input: Vec<f32>) -> Result<(Vec<f32>, f32, Vec<f32>), NetworkError> {
+    /// The landmarks (39 × 5), the pose flag and the world coordinates (39 × 3) of the input
+    /// `fill` writes (into zeros, 256 × 256 × 3 values, in place in the network's input).
+    fn raw(
+        &self,
+        fill: &mut dyn FnMut(&mut [f32]),
+    ) -> Result<(Vec<f32>, f32, Vec<f32>), NetworkError> {
         let run = |e: &dyn std::fmt::Display| NetworkError::Run(e.to_string());
-        let tensor = tract_ndarray::Array4::from_shape_vec((1, INPUT_PX, INPUT_PX, 3), input)
-            .map_err(|e| run(&e))?;
-        let input = tvec!(Tensor::from(tensor).into());
+        let mut tensor = Tensor::zero::<f32>(&[1, INPUT_PX, INPUT_PX, 3]).map_err(|e| run(&e))?;
+        {
+            let mut view = tensor.try_as_plain_ram_mut().map_err(|e| run(&e))?;
+            fill(view.as_slice_mut::<f32>().map_err(|e| run(&e))?);
+        }
+        let input = tvec!(tensor.into());
         let outputs = match &self.pool {
             Some(pool) => multithread_tract_scope(pool.clone(), || self.plan.run(input)),
             None => self.plan.run(input),
@@ -193,7 +208,7 @@ impl PoseNetwork {
 
     /// Runs the network on `crop` of `frame`.
     pub fn run(&self, frame: &RgbImage, crop: &Crop) -> Result<NetworkPose, NetworkError> {
-        let (landmarks, flag, world) = self.raw(crop.sample(frame))?;
+        let (landmarks, flag, world) = self.raw(&mut |input| crop.sample_into(frame, input))?;
         let lm = |i: usize| {
             let r = &landmarks[i * 5..i * 5 + 5];
             NetJoint {
