@@ -1,7 +1,7 @@
 //! Where the network's time goes: tract's own evaluation loop run with a timer around each
 //! operator (`SimpleState::run_plan_with_eval`), and the graph's operator counts at each stage
-//! of loading (the ONNX file, tract's decluttered graph, the optimised plan). For
-//! `videomocap-bench speed network` and `docs/method.md` (issue 95).
+//! of loading (the ONNX file and the plan the product runs). Its figures are in
+//! `docs/method.md` (issue 95).
 
 use super::{INPUT_PX, NetworkError, PoseNetwork};
 use std::collections::BTreeMap;
