@@ -89,8 +89,10 @@ impl Crop {
         out
     }
 
-    /// [`Crop::sample`] written into `out` (256 × 256 × 3 values): bilinear, the image point of
-    /// each crop pixel stepped along the crop's turned axes rather than turned anew per pixel.
+    /// [`Crop::sample`] written into `out` (256 × 256 × 3 values, the network's input in
+    /// place). Each crop pixel's image point is computed anew ([`Crop::to_image`]), as before:
+    /// stepping along the crop's axes changes the input by 1e-7, enough to turn a tracking
+    /// decision (`docs/log.md`, 2026-12-06).
     pub(crate) fn sample_into(&self, frame: &RgbImage, out: &mut [f32]) {
         let (w, h) = (i64::from(frame.width()), i64::from(frame.height()));
         let raw = frame.as_raw();
@@ -101,14 +103,9 @@ impl Crop {
             let i = ((y * w + x) * 3) as usize;
             [raw[i], raw[i + 1], raw[i + 2]].map(f32::from)
         };
-        // The image point of crop pixel (u, v) is origin + u·step_u + v·step_v (`to_image`).
-        let origin = self.to_image(0.5, 0.5);
-        let step_u = self.to_image(1.5, 0.5) - origin;
-        let step_v = self.to_image(0.5, 1.5) - origin;
         for (v, row) in out.chunks_exact_mut(INPUT_PX * 3).enumerate() {
-            let start = origin + step_v * v as f64;
             for (u, px) in row.chunks_exact_mut(3).enumerate() {
-                let p = start + step_u * u as f64;
+                let p = self.to_image(u as f64 + 0.5, v as f64 + 0.5);
                 let (fx, fy) = (p.x.floor(), p.y.floor());
                 let (tx, ty) = ((p.x - fx) as f32, (p.y - fy) as f32);
                 let (x0, y0) = (fx as i64, fy as i64);
