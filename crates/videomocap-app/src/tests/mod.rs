@@ -175,3 +175,14 @@ pub fn lifted_project(
     }));
     p
 }
+
+/// The app with a new project on a video that is never opened, state kept under `dir`, one
+/// frame drawn.
+fn with_empty_project(dir: &Path) -> Harness<'static, App> {
+    let mut h = harness(None, &PreparedDialogs::default(), &dir.join("state"));
+    h.state_mut()
+        .state_mut()
+        .set_project_for_test(videomocap_core::project::Project::new(dir.join("v.mp4")));
+    h.run();
+    h
+}

@@ -3,19 +3,9 @@ use egui_kittest::kittest::Queryable;
 use videomocap_core::project::Project;
 use videomocap_core::track::TrackerParams;
 
-/// The app on a fresh project (no video) in `dir`, one frame drawn.
-fn with_project(dir: &Path) -> Harness<'static, App> {
-    let mut h = harness(None, &PreparedDialogs::default(), &dir.join("state"));
-    h.state_mut()
-        .state_mut()
-        .set_project_for_test(Project::new(dir.join("v.mp4")));
-    h.run();
-    h
-}
-
 /// The app on a fresh project in `dir` with the Parameters panel's Tracker section open.
 fn with_tracker_panel(dir: &Path) -> Harness<'static, App> {
-    let mut h = with_project(dir);
+    let mut h = with_empty_project(dir);
     h.get_by_label("Tracker").click();
     h.run();
     h
@@ -128,7 +118,7 @@ fn each_tracker_switch_is_an_undoable_setting() {
 #[test]
 fn the_global_refinement_is_switched_in_the_lift_settings() {
     let dir = tempfile::tempdir().unwrap();
-    let mut h = with_project(dir.path());
+    let mut h = with_empty_project(dir.path());
     let refine = |h: &Harness<'_, App>| h.state().state().project().unwrap().settings.lift.refine;
     assert!(refine(&h));
     h.get_by_label("Lift").click();
@@ -153,7 +143,7 @@ fn the_global_refinement_is_switched_in_the_lift_settings() {
 #[test]
 fn the_lift_panel_shows_the_eight_settings() {
     let dir = tempfile::tempdir().unwrap();
-    let mut h = with_project(dir.path());
+    let mut h = with_empty_project(dir.path());
     h.get_by_label("Lift").click();
     h.run();
     for label in [
@@ -206,7 +196,7 @@ fn the_shoulder_spring_is_greyed_out_without_the_chain_refinement() {
 #[test]
 fn a_known_length_is_ticked_into_the_project() {
     let dir = tempfile::tempdir().unwrap();
-    let mut h = with_project(dir.path());
+    let mut h = with_empty_project(dir.path());
     h.get_by_label("Lengths you know").click();
     h.run();
     assert_eq!(

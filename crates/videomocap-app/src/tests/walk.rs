@@ -136,16 +136,6 @@ fn switching_the_pose_network_offers_to_track_again() {
     assert!(h.query_by_label("Track again (T)").is_none());
 }
 
-/// The app with a new project on a video that is never opened, state kept under `dir`.
-fn with_empty_project(dir: &Path) -> Harness<'static, App> {
-    let mut h = harness(None, &PreparedDialogs::default(), &dir.join("state"));
-    h.state_mut()
-        .state_mut()
-        .set_project_for_test(Project::new(dir.join("v.mp4")));
-    h.run();
-    h
-}
-
 /// The side panel's setting labels fit beside their sliders at the panel's width (a label ran
 /// past the edge, cut: "interpolate up to (s"), and the panel keeps its width.
 #[test]
