@@ -14,14 +14,16 @@
 
 mod body;
 mod model;
+mod points;
 mod solve;
 
 pub use model::{Pose, SubjectBody};
+pub use points::{FitPoints, fit_points};
 
 use crate::sequence::Assembled;
 use nalgebra::{Point3, Rotation3, Vector3};
 use solve::{FrameData, Quality};
-use std::collections::{BTreeMap, HashSet};
+use std::collections::BTreeMap;
 use videomocap_core::formats::{Frame3d, FrameIndex, Skeleton3d};
 use videomocap_core::skeleton::{Bone, PerJoint};
 
@@ -48,123 +50,6 @@ impl Default for ArticulatedParams {
             body_frames: 8,
             poor_unexplained: 0.25,
             poor_gap_voxels: 2.5,
-        }
-    }
-}
-
-/// One frame's points as the fit takes them: surface points thinned, and the point spacing.
-#[derive(Debug, Clone, Default)]
-pub struct FitPoints {
-    /// Surface points (a voxel missing one of its six face neighbours), evenly thinned.
-    pub points: Vec<Point3<f64>>,
-    /// The cloud's point spacing (voxel size), metres.
-    pub spacing_m: f64,
-}
-
-/// The surface points of `cloud` (spacing `spacing_m`), at most `max_points` of them: a point
-/// is on the surface when one of the six lattice neighbours one spacing away is missing (every
-/// point of a cloud that is not a voxel lattice is).
-pub fn fit_points(cloud: &[Point3<f64>], spacing_m: f64, max_points: usize) -> FitPoints {
-    let finite: Vec<Point3<f64>> = cloud
-        .iter()
-        .filter(|p| p.coords.iter().all(|c| c.is_finite()))
-        .copied()
-        .collect();
-    let surface = if spacing_m > 0.0 && spacing_m.is_finite() && !finite.is_empty() {
-        let cells: Vec<[i64; 3]> = finite
-            .iter()
-            .map(|p| [p.x, p.y, p.z].map(|c| (c / spacing_m).round() as i64))
-            .collect();
-        let occupied = Occupancy::new(&cells);
-        finite
-            .iter()
-            .zip(&cells)
-            .filter(|(_, c)| {
-                [
-                    [1, 0, 0],
-                    [-1, 0, 0],
-                    [0, 1, 0],
-                    [0, -1, 0],
-                    [0, 0, 1],
-                    [0, 0, -1],
-                ]
-                .iter()
-                .any(|d| !occupied.has([c[0] + d[0], c[1] + d[1], c[2] + d[2]]))
-            })
-            .map(|(p, _)| *p)
-            .collect()
-    } else {
-        finite
-    };
-    let step = surface.len().div_ceil(max_points.max(1)).max(1);
-    FitPoints {
-        points: surface.into_iter().step_by(step).collect(),
-        spacing_m,
-    }
-}
-
-/// Which lattice cells hold a point: a dense box when it is small enough (the usual case, and
-/// much faster than hashing), else a hash set.
-enum Occupancy {
-    Dense {
-        lo: [i64; 3],
-        dims: [i64; 3],
-        bits: Vec<bool>,
-    },
-    Sparse(HashSet<[i64; 3]>),
-}
-
-/// The dense box's largest size, cells (a 64 MB box at most; a cloud spread wider is hashed).
-const DENSE_CELLS: i64 = 1 << 26;
-
-impl Occupancy {
-    fn new(cells: &[[i64; 3]]) -> Occupancy {
-        let mut lo = [i64::MAX; 3];
-        let mut hi = [i64::MIN; 3];
-        for c in cells {
-            for k in 0..3 {
-                lo[k] = lo[k].min(c[k]);
-                hi[k] = hi[k].max(c[k]);
-            }
-        }
-        let dims = [0, 1, 2].map(|k| hi[k].saturating_sub(lo[k]).saturating_add(1));
-        let size = dims
-            .iter()
-            .try_fold(1i64, |a, &d| a.checked_mul(d))
-            .unwrap_or(i64::MAX);
-        if size > DENSE_CELLS {
-            return Occupancy::Sparse(cells.iter().copied().collect());
-        }
-        let mut bits = vec![false; size as usize];
-        let mut occ = Occupancy::Dense {
-            lo,
-            dims,
-            bits: Vec::new(),
-        };
-        for c in cells {
-            if let Some(i) = occ.index(*c) {
-                bits[i] = true;
-            }
-        }
-        if let Occupancy::Dense { bits: b, .. } = &mut occ {
-            *b = bits;
-        }
-        occ
-    }
-    fn index(&self, c: [i64; 3]) -> Option<usize> {
-        let Occupancy::Dense { lo, dims, .. } = self else {
-            return None;
-        };
-        let r = [0, 1, 2].map(|k| c[k] - lo[k]);
-        if (0..3).any(|k| r[k] < 0 || r[k] >= dims[k]) {
-            return None;
-        }
-        Some(((r[2] * dims[1] + r[1]) * dims[0] + r[0]) as usize)
-    }
-    fn has(&self, c: [i64; 3]) -> bool {
-        match self {
-            Occupancy::Dense { bits, .. } => self.index(c).is_some_and(|i| bits[i]),
-            Occupancy::Sparse(set) => set.contains(&c),
         }
     }
 }
