@@ -6,6 +6,7 @@
 //! Data flows `cloud`/`carve` → `isomap` → `shells` → `curve` → `bodies` (one frame, [`process_frame`])
 //! → `sequence` (all frames, [`assemble`]).
 
+pub mod articulated;
 pub mod bodies;
 pub mod carve;
 pub mod cloud;
@@ -17,6 +18,7 @@ pub mod sequence;
 pub mod shells;
 pub mod voxel;
 
+pub use articulated::{ArticulatedParams, FitPoints, Fitted, fit_points};
 pub use bodies::{BodyFit, BodyParams, Part};
 pub use cloud::{PointCloud, list_frames, read_cloud};
 pub use curve::{CurveParams, SkeletonCurve};
@@ -88,6 +90,11 @@ pub struct VolumeParams {
     pub bodies: BodyParams,
     /// Frames with fewer points are skipped.
     pub min_points: usize,
+    /// The skeleton curve sees at most about this many points: a denser cloud is merged onto a
+    /// coarser lattice first (the curve only starts the fit; the fit takes every point's share).
+    pub curve_points: usize,
+    /// The subject's articulated body fitted over the clip.
+    pub articulated: ArticulatedParams,
 }
 
 impl Default for VolumeParams {
@@ -99,6 +106,8 @@ impl Default for VolumeParams {
             curve: CurveParams::default(),
             bodies: BodyParams::default(),
             min_points: 100,
+            curve_points: usize::MAX,
+            articulated: ArticulatedParams::default(),
         }
     }
 }
@@ -245,8 +254,13 @@ pub struct Processed {
     pub files: Vec<PathBuf>,
     /// Per frame: its result, or the problem that left it without a pose.
     pub results: Vec<Result<FrameResult, FrameProblem>>,
-    /// Labels, sides and the 16-joint skeleton.
+    /// Labels, sides and the 16-joint skeleton: the subject's body fitted over the clip when
+    /// it could be (`fitted`), else the paper's skeleton curve alone; the warnings of both.
     pub assembled: Assembled,
+    /// The paper's skeleton curve alone (labels and sides over the clip), before the fit.
+    pub curve_skeleton: videomocap_core::formats::Skeleton3d,
+    /// The articulated fit, when the curve posed a frame to start it.
+    pub fitted: Option<Fitted>,
 }
 
 impl Processed {
@@ -259,6 +273,70 @@ impl Processed {
     pub fn posed_frames(&self) -> usize {
         self.results.iter().filter(|r| r.is_ok()).count()
     }
+}
+
+/// One frame as the sequence needs it: the curve's result and the points the fit takes.
+pub fn process_frame_for_fit(
+    points: &[Point3<f64>],
+    params: &VolumeParams,
+) -> (Result<FrameResult, FrameProblem>, FitPoints) {
+    let spacing = point_spacing(points);
+    let fit = fit_points(points, spacing, params.articulated.max_points);
+    let coarse = coarsen(points, spacing, params.curve_points);
+    (process_frame(&coarse, params), fit)
+}
+
+/// `points` (lattice spacing `spacing_m`) merged onto a lattice coarse enough to leave about
+/// `max_points`: one point, the mean of its members, per coarse cell.
+fn coarsen(points: &[Point3<f64>], spacing_m: f64, max_points: usize) -> Vec<Point3<f64>> {
+    if points.len() <= max_points || spacing_m <= 0.0 {
+        return points.to_vec();
+    }
+    let cell = spacing_m * (points.len() as f64 / max_points as f64).cbrt().ceil();
+    let mut cells: std::collections::HashMap<[i64; 3], (nalgebra::Vector3<f64>, usize)> =
+        std::collections::HashMap::new();
+    for p in points {
+        let key = [p.x, p.y, p.z].map(|c| (c / cell).floor() as i64);
+        let e = cells.entry(key).or_insert((nalgebra::Vector3::zeros(), 0));
+        e.0 += p.coords;
+        e.1 += 1;
+    }
+    let mut out: Vec<(_, Point3<f64>)> = cells
+        .into_iter()
+        .map(|(k, (s, n))| (k, Point3::from(s / n as f64)))
+        .collect();
+    // A fixed order, whatever the hash map's.
+    out.sort_by_key(|(k, _)| *k);
+    out.into_iter().map(|(_, p)| p).collect()
+}
+
+/// The second pass over the clip and the articulated fit: assembles the curve's `results`
+/// (labels, sides, skeleton) and fits the subject's body to `points` started from it; the
+/// returned [`Assembled`] holds the fitted skeleton (and both stages' warnings) when the fit
+/// could run, and the curve's skeleton is returned beside it.
+pub fn assemble_and_fit(
+    results: &[Result<FrameResult, FrameProblem>],
+    points: &[FitPoints],
+    names: &[String],
+    fps: f64,
+    params: &VolumeParams,
+) -> (
+    Assembled,
+    videomocap_core::formats::Skeleton3d,
+    Option<Fitted>,
+) {
+    let mut assembled = assemble(results, names, fps);
+    let curve = assembled.skeleton.clone();
+    let clean: Vec<bool> = results
+        .iter()
+        .map(|r| r.as_ref().is_ok_and(|f| f.curve.arms_unseen() == 0))
+        .collect();
+    let fitted = articulated::fit_clip(points, &assembled, &clean, names, &params.articulated);
+    if let Some(f) = &fitted {
+        assembled.skeleton = f.skeleton.clone();
+        assembled.warnings.extend(f.warnings.iter().cloned());
+    }
+    (assembled, curve, fitted)
 }
 
 /// Frames of `results` whose skeleton curve showed all five limbs.
@@ -297,19 +375,26 @@ pub fn process_directory(
 ) -> Result<Processed, SequenceError> {
     let files = list_frames(dir)?;
     let done = AtomicUsize::new(0);
-    let results: Vec<Result<FrameResult, FrameProblem>> = files
+    let (results, points): (Vec<Result<FrameResult, FrameProblem>>, Vec<FitPoints>) = files
         .par_iter()
         .map(|f| {
             if cancel.load(Ordering::Relaxed) {
-                return Err(FrameProblem::Unreadable("cancelled".into()));
+                return (
+                    Err(FrameProblem::Unreadable("cancelled".into())),
+                    FitPoints::default(),
+                );
             }
-            let r = read_cloud(f)
-                .map_err(|e| FrameProblem::Unreadable(e.to_string()))
-                .and_then(|points| process_frame(&points, params));
+            let r = match read_cloud(f) {
+                Ok(points) => process_frame_for_fit(&points, params),
+                Err(e) => (
+                    Err(FrameProblem::Unreadable(e.to_string())),
+                    FitPoints::default(),
+                ),
+            };
             progress(done.fetch_add(1, Ordering::Relaxed) + 1, files.len());
             r
         })
-        .collect();
+        .unzip();
     if cancel.load(Ordering::Relaxed) {
         return Err(SequenceError::Cancelled);
     }
@@ -333,10 +418,13 @@ pub fn process_directory(
                 .into_owned()
         })
         .collect();
-    let assembled = assemble(&results, &names, fps);
+    let (assembled, curve_skeleton, fitted) =
+        assemble_and_fit(&results, &points, &names, fps, params);
     Ok(Processed {
         files,
         results,
         assembled,
+        curve_skeleton,
+        fitted,
     })
 }

@@ -115,7 +115,7 @@ fn a_hand_stub_at_the_hip_is_not_named_head() {
 /// Writes a march sequence with bad frames in it; returns the directory and the motion.
 fn sequence_with_bad_frames() -> (tempfile::TempDir, videomocap_testkit::synth::Motion) {
     let dir = tempfile::tempdir().unwrap();
-    let motion = procedural(ProceduralMotion::March, &SubjectModel::default(), 8, 10.0);
+    let motion = procedural(ProceduralMotion::March, &SubjectModel::default(), 10, 10.0);
     let stature = stature_of(&motion);
     let mut rng = rand::rngs::StdRng::seed_from_u64(2);
     for (i, j) in motion.frames.iter().enumerate() {
@@ -134,6 +134,11 @@ fn sequence_with_bad_frames() -> (tempfile::TempDir, videomocap_testkit::synth::
             3 => pts.truncate(5),
             // A body without its left arm: four leaves.
             5 => pts.retain(|p| p.x < 0.25),
+            // Half a body: everything above the hips outside the carving volume.
+            8 => {
+                let hips = j[Joint::Pelvis].y;
+                pts.retain(|p| p.y < hips);
+            }
             _ => {}
         }
         if i != 4 {
@@ -156,7 +161,7 @@ fn bad_frames_are_warned_about_and_interpolated_never_a_panic() {
         &AtomicBool::new(false),
     )
     .unwrap();
-    assert_eq!(p.files.len(), 8);
+    assert_eq!(p.files.len(), 10);
     assert!(p.results[2].is_ok(), "{:?}", p.results[2].as_ref().err());
     assert!(matches!(
         p.results[3],
@@ -179,9 +184,10 @@ fn bad_frames_are_warned_about_and_interpolated_never_a_panic() {
             && w.contains("placed between frames 2 and 6"),
         "{w}"
     );
+    // The curve's skeleton places the arm (the fitted body lays it where points are: against
+    // the trunk).
     let placed = p
-        .assembled
-        .skeleton
+        .curve_skeleton
         .frames
         .iter()
         .find(|f| f.index == FrameIndex(5));
@@ -189,16 +195,44 @@ fn bad_frames_are_warned_about_and_interpolated_never_a_panic() {
     let off = (wrist - motion.frames[5][Joint::LeftWrist]).norm();
     assert!(off < 0.2, "left wrist placed {off:.3} m from the truth");
     let frames = &p.assembled.skeleton.frames;
-    assert_eq!(frames.len(), 8);
+    assert_eq!(frames.len(), 10);
+    let flags = |i: usize| {
+        frames
+            .iter()
+            .find(|f| f.index == FrameIndex(i))
+            .unwrap()
+            .flags
+            .clone()
+    };
     for f in frames {
-        let bad = p.results[f.index.get()].is_err();
+        // Frames without points (3: five of them, 4: unreadable) are interpolated and flagged.
+        let empty = [3, 4].contains(&f.index.get());
         assert_eq!(
-            f.flags.contains(&"interpolated".to_owned()),
-            bad,
-            "frame {}",
-            f.index
+            f.flags == ["interpolated", "no_points"],
+            empty,
+            "frame {}: {:?}",
+            f.index,
+            f.flags
         );
     }
+    // Half a body: flagged, never dropped; the frames after it are posed again.
+    assert!(
+        flags(8).iter().any(|f| f.starts_with("poor_fit")),
+        "{:?}",
+        flags(8)
+    );
+    for i in [0, 1, 6, 7, 9] {
+        assert!(flags(i).is_empty(), "frame {i}: {:?}", flags(i));
+        let t = &motion.frames[i];
+        let f = frames.iter().find(|f| f.index == FrameIndex(i)).unwrap();
+        let err = Joint::ALL
+            .iter()
+            .map(|&j| (f.points[j] - t[j]).norm())
+            .sum::<f64>()
+            / 16.0;
+        assert!(err < 0.08, "frame {i}: {err:.3} m");
+    }
+    assert!(w.contains("frame 8 (f8.ply): poor fit"), "{w}");
 }
 
 #[test]
@@ -232,4 +266,75 @@ fn marching_carved_from_four_silhouettes_gives_the_pose() {
     assert!(voxels > 1000.0, "{voxels} voxels per frame");
     assert!(s.topology() >= 0.95, "topology {}", s.topology());
     assert!(s.mean_mm() <= 2.0 * 40.0, "mean error {} mm", s.mean_mm());
+}
+
+/// The curve's skeleton and the fitted body's for `motion` voxelised at `voxel_m` (the
+/// product's path: the curve, then the subject's body fitted over the clip).
+fn curve_and_fit(motion: &Motion, voxel_m: f64) -> (VolumeScore, VolumeScore, usize) {
+    let voxel = VoxelParams {
+        voxel_m,
+        ..VoxelParams::default()
+    };
+    let params = VolumeParams::default();
+    let stature = stature_of(motion);
+    let (results, points): (Vec<_>, Vec<_>) = motion
+        .frames
+        .iter()
+        .enumerate()
+        .map(|(i, j)| {
+            let mut rng = rand::rngs::StdRng::seed_from_u64(voxel.seed + i as u64);
+            videomocap_volume::process_frame_for_fit(
+                &voxelise(j, stature, &voxel, &mut rng),
+                &params,
+            )
+        })
+        .unzip();
+    let names: Vec<String> = (0..results.len()).map(|i| i.to_string()).collect();
+    let (a, curve, fitted) =
+        videomocap_volume::assemble_and_fit(&results, &points, &names, motion.fps, &params);
+    let five = videomocap_volume::five_limb_frames(&results);
+    let truth = volume_truth(motion);
+    let flagged = a
+        .skeleton
+        .frames
+        .iter()
+        .filter(|f| !f.flags.is_empty())
+        .count();
+    assert!(fitted.is_some());
+    (
+        score_volume(&truth, &curve, five),
+        score_volume(&truth, &a.skeleton, five),
+        flagged,
+    )
+}
+
+/// Jumping jacks at 40 mm: the subject's body fitted over the clip keeps the sides the curve's
+/// clip-wide choice gave and brings the joints nearer than the curve alone.
+#[test]
+fn the_fitted_body_is_nearer_the_truth_than_the_curve_on_jumping_jacks() {
+    let motion = procedural(
+        ProceduralMotion::JumpingJacks,
+        &SubjectModel::default(),
+        16,
+        10.0,
+    );
+    let (curve, fit, flagged) = curve_and_fit(&motion, 0.04);
+    eprintln!(
+        "curve {:.1} mm sides {:.2}; fit {:.1} mm sides {:.2}; flagged {flagged}",
+        curve.mean_reported_mm(),
+        curve.sides_right_share(),
+        fit.mean_reported_mm(),
+        fit.sides_right_share()
+    );
+    assert!(fit.mean_reported_mm() < curve.mean_reported_mm());
+    assert!(
+        fit.mean_reported_mm() <= 60.0,
+        "{} mm",
+        fit.mean_reported_mm()
+    );
+    assert!(
+        fit.sides_right_share() >= 0.98,
+        "{}",
+        fit.sides_right_share()
+    );
 }

@@ -6,6 +6,7 @@
 //! N = 3k, 10k and 30k points on one core with Isomap's share.
 
 use crate::args::{BenchArgs, GlobalArgs};
+use crate::bench_suite::Merge;
 use crate::bench_suite::{BenchClip, Tally, parse_split};
 use crate::{ExitError, say};
 use rayon::prelude::*;
@@ -15,10 +16,12 @@ use videomocap_testkit::eval::suite::{Split, Suite};
 use videomocap_testkit::eval::volume::{CarveCase, VolumeScore, carve_and_score, score_volume};
 use videomocap_testkit::repo_root;
 use videomocap_testkit::synth::{
-    Motion, ProceduralMotion, SilhouetteFaults, SynthParams, VoxelParams, from_bvh, load_motion,
-    procedural, stature_of, subject_stature, volume_truth, voxelise,
+    Motion, ProceduralMotion, SilhouetteFaults, Surface, SynthParams, VoxelParams, from_bvh,
+    load_motion, procedural, stature_of, subject_stature, volume_truth, voxelise,
 };
-use videomocap_volume::{VolumeParams, assemble, five_limb_frames, process_frame};
+use videomocap_volume::{
+    VolumeParams, assemble_and_fit, five_limb_frames, process_frame, process_frame_for_fit,
+};
 
 /// Frames per sequence (the paper's sequences had about 50).
 const FRAMES: usize = 50;
@@ -61,8 +64,29 @@ struct Row {
     name: String,
     voxel_mm: f64,
     points: f64,
+    /// The subject's body fitted over the clip (the product's output).
     score: VolumeScore,
+    /// The paper's skeleton curve alone, same run.
+    curve: VolumeScore,
+    /// Frames the fit flagged.
+    flagged: usize,
     sides: String,
+}
+
+/// The curve alone and the fitted body of one or more sequences, and the frames flagged.
+#[derive(Debug, Clone, Default)]
+struct Both {
+    curve: VolumeScore,
+    fitted: VolumeScore,
+    flagged: usize,
+}
+
+impl Merge for Both {
+    fn merge_from(&mut self, o: &Self) {
+        self.curve.merge(&o.curve);
+        self.fitted.merge(&o.fitted);
+        self.flagged += o.flagged;
+    }
 }
 
 fn run_sequence(
@@ -82,34 +106,57 @@ fn run_sequence(
             voxelise(j, stature, &voxel, &mut rng)
         })
         .collect();
-    let results: Vec<_> = clouds
+    let (results, fit_points): (Vec<_>, Vec<_>) = clouds
         .par_iter()
-        .map(|c| process_frame(c, params))
-        .collect();
+        .map(|c| process_frame_for_fit(c, params))
+        .unzip();
     let names: Vec<String> = (0..results.len()).map(|i| format!("frame {i}")).collect();
-    let assembled = assemble(&results, &names, motion.fps);
+    let (assembled, curve, _) = assemble_and_fit(&results, &fit_points, &names, motion.fps, params);
     let ok = five_limb_frames(&results);
-    let score = score_volume(&volume_truth(motion), &assembled.skeleton, ok);
+    let truth = volume_truth(motion);
     Row {
         name: name.to_owned(),
         voxel_mm: voxel.voxel_m * 1000.0,
         points: clouds.iter().map(Vec::len).sum::<usize>() as f64 / clouds.len().max(1) as f64,
-        score,
+        score: score_volume(&truth, &assembled.skeleton, ok),
+        curve: score_volume(&truth, &curve, ok),
+        flagged: flagged(&assembled.skeleton),
         sides: format!("{:?}", assembled.sides_from).to_lowercase(),
     }
 }
 
-/// One split's column of the suite table: topology, the error with sides as reported (in mm and
-/// voxel sizes), sides right, labels consistent.
-fn suite_cell(s: &VolumeScore, voxel_mm: f64) -> String {
+/// Frames of `s` with a flag.
+fn flagged(s: &videomocap_core::formats::Skeleton3d) -> usize {
+    s.frames.iter().filter(|f| !f.flags.is_empty()).count()
+}
+
+/// One split's column of the suite table: the curve alone and the fitted body, each as the
+/// error with sides as reported (mm, voxel sizes) and sides right; labels consistent and frames
+/// flagged of the fit.
+fn suite_cell(b: &Both, voxel_mm: f64) -> String {
+    let (c, f) = (&b.curve, &b.fitted);
     format!(
-        "{:>6.1}% {:>6.1} {:>5.2} {:>6.1}% {:>6.1}%",
-        100.0 * s.topology(),
-        s.mean_reported_mm(),
-        s.mean_reported_mm() / voxel_mm,
-        100.0 * s.sides_right_share(),
-        100.0 * s.consistency()
+        "{:>6.1} {:>5.1}% | {:>6.1} {:>5.2} {:>5.1}% {:>5.1}%",
+        c.mean_reported_mm(),
+        100.0 * c.sides_right_share(),
+        f.mean_reported_mm(),
+        f.mean_reported_mm() / voxel_mm,
+        100.0 * f.sides_right_share(),
+        100.0 * b.flagged as f64 / f.scored_frames.max(1) as f64,
     )
+}
+
+/// A sequence's figures as JSON.
+fn take_json(b: &Both) -> serde_json::Value {
+    serde_json::json!({
+        "curve_reported_mm": b.curve.mean_reported_mm(),
+        "curve_sides_right": b.curve.sides_right_share(),
+        "curve_topology": b.curve.topology(),
+        "reported_mm": b.fitted.mean_reported_mm(),
+        "sides_right": b.fitted.sides_right_share(),
+        "matched_once_mm": b.fitted.mean_mm(),
+        "flagged_share": b.flagged as f64 / b.fitted.scored_frames.max(1) as f64,
+    })
 }
 
 /// The voxelisations of the suite's takes: 30, 40 and 50 mm clean, and 40 mm with noise voxels
@@ -173,23 +220,24 @@ fn suite_takes(
         } else {
             format!("{voxel_mm:.0} mm")
         };
-        let mut tally: Tally<VolumeScore> = Tally::default();
+        let mut tally: Tally<Both> = Tally::default();
         let mut per_take = serde_json::Map::new();
         for (take, bench, motion, stature) in &takes {
             say(global, &format!("volumes of take {take} at {label} …"));
             let r = run_sequence(take, motion, *stature, voxel, params);
-            tally.add(bench, &r.score);
-            per_take.insert(
-                take.clone(),
-                serde_json::json!({
-                    "curve": r.score.topology(), "reported_mm": r.score.mean_reported_mm(),
-                    "matched_once_mm": r.score.mean_mm(), "sides_right": r.score.sides_right_share(),
-                    "family": bench.family.name(), "split": bench.split.name(),
-                }),
-            );
+            let both = Both {
+                curve: r.curve,
+                fitted: r.score,
+                flagged: r.flagged,
+            };
+            tally.add(bench, &both);
+            let mut j = take_json(&both);
+            j["family"] = bench.family.name().into();
+            j["split"] = bench.split.name().into();
+            per_take.insert(take.clone(), j);
         }
         let title = format!(
-            "suite v3 takes at {label} (the bodies of their first clips, {FRAMES} frames at {FPS} fps): frames with a five-limb curve, mean error with left and right as reported (mm, voxel sizes), sides right, labels consistent"
+            "suite v4 takes at {label} (the bodies of their first clips, {FRAMES} frames at {FPS} fps)"
         );
         push_table(lines, &mut json, &title, &label, &tally, per_take, voxel_mm);
     }
@@ -199,34 +247,36 @@ fn suite_takes(
         faults: SilhouetteFaults::typical(),
         ..CarveCase::clean(4, 0.04)
     };
+    let mesh = |case: &CarveCase| CarveCase {
+        surface: Surface::Mesh,
+        ..case.clone()
+    };
     let cases = [
         ("4 views", CarveCase::clean(4, 0.04)),
         ("8 views", CarveCase::clean(8, 0.04)),
         ("4 faulty views", faulty.clone()),
-        (
-            "4 faulty views, 3 votes",
-            CarveCase {
-                min_votes: Some(3),
-                ..faulty
-            },
-        ),
+        ("mesh bodies, 8 views", mesh(&CarveCase::clean(8, 0.04))),
+        ("mesh bodies, 4 views", mesh(&CarveCase::clean(4, 0.04))),
+        ("mesh bodies, 4 faulty views", mesh(&faulty)),
     ];
     for (label, case) in cases {
-        let mut tally: Tally<VolumeScore> = Tally::default();
+        let mut tally: Tally<Both> = Tally::default();
         let mut per_take = serde_json::Map::new();
         for (take, bench, motion, _) in &takes {
             say(global, &format!("take {take} carved from {label} …"));
             let r = carve_and_score(motion, &case, params).map_err(ExitError::failed)?;
-            tally.add(bench, &r.score);
-            per_take.insert(
-                take.clone(),
-                serde_json::json!({
-                    "curve": r.score.topology(), "reported_mm": r.score.mean_reported_mm(),
-                    "sides_right": r.score.sides_right_share(), "voxels": r.voxels,
-                    "dropped_voxels": r.dropped,
-                    "family": bench.family.name(), "split": bench.split.name(),
-                }),
-            );
+            let both = Both {
+                curve: r.curve_score,
+                fitted: r.score,
+                flagged: r.flagged,
+            };
+            tally.add(bench, &both);
+            let mut j = take_json(&both);
+            j["voxels"] = r.voxels.into();
+            j["dropped_voxels"] = r.dropped.into();
+            j["family"] = bench.family.name().into();
+            j["split"] = bench.split.name().into();
+            per_take.insert(take.clone(), j);
         }
         let what = if case.faults.any() {
             "; faults: edges eroded and dilated 2 px on two views, the right forearm missing on one, a shadow at the feet, a second person 1.2 m away; the blob nearest the person kept"
@@ -234,7 +284,7 @@ fn suite_takes(
             ""
         };
         let title = format!(
-            "suite v3 takes carved at 40 mm from {label} (640×480 cameras on a ring{what})"
+            "suite v4 takes carved at 40 mm from {label} (640×480 cameras on a ring{what})"
         );
         let key = format!("carved {label}");
         push_table(lines, &mut json, &title, &key, &tally, per_take, 40.0);
@@ -249,31 +299,22 @@ fn push_table(
     json: &mut serde_json::Map<String, serde_json::Value>,
     title: &str,
     key: &str,
-    tally: &Tally<VolumeScore>,
+    tally: &Tally<Both>,
     per_take: serde_json::Map<String, serde_json::Value>,
     voxel_mm: f64,
 ) {
-    const WIDTH: usize = 36;
-    lines.push(title.to_owned());
-    lines.extend(Tally::<VolumeScore>::heading(
+    const WIDTH: usize = 44;
+    lines.push(format!(
+        "{title}: mean error with left and right as reported (mm) and sides right, the paper's curve alone | the fitted body (mm, voxel sizes, sides right, frames flagged)"
+    ));
+    lines.extend(Tally::<Both>::heading(
         WIDTH,
-        "  curve     mm voxel  sides labels",
+        " curve  sides |    fit voxel sides  flag",
     ));
     lines.extend(tally.lines(WIDTH, |s| suite_cell(s, voxel_mm)));
     lines.push(String::new());
     json.insert(format!("{key} takes"), serde_json::Value::Object(per_take));
-    json.insert(
-        key.to_owned(),
-        tally.json(|s| {
-            serde_json::json!({
-                "topology": s.topology(), "reported_mm": s.mean_reported_mm(),
-                "voxel_sizes": s.mean_reported_mm() / voxel_mm,
-                "sides_right": s.sides_right_share(),
-                "labels_consistent": s.consistency(),
-                "matched_once_mm": s.mean_mm(),
-            })
-        }),
-    );
+    json.insert(key.to_owned(), tally.json(take_json));
 }
 
 /// Runs the volume benchmark and prints its tables.
@@ -284,6 +325,13 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     if split.is_some() {
         let mut lines = Vec::new();
         let suite_json = suite_takes(&params, split, a.clip.as_deref(), global, &mut lines)?;
+        let march = procedural(
+            ProceduralMotion::March,
+            &SubjectModel::default(),
+            FRAMES,
+            FPS,
+        );
+        speed_table(&march, &params, global, &mut lines);
         print_tables(global, suite_json, &lines);
         return Ok(());
     }
@@ -388,17 +436,33 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     }
     lines.push(String::new());
 
-    // Speed on one core: voxel sizes chosen so that a marching frame has about N points.
-    let march = &motions[0].1;
+    speed_table(&motions[0].1, &params, global, &mut lines);
+    print_tables(global, suite_json, &lines);
+    Ok(())
+}
+
+/// Speed on one core: voxel sizes chosen so that a marching frame has about N points; the
+/// paper's pipeline as it was (the curve on every point) against the product's (the curve on at
+/// most `curve_points`, then the articulated fit over the clip), same frames, same run.
+fn speed_table(
+    march: &Motion,
+    params: &VolumeParams,
+    global: &GlobalArgs,
+    lines: &mut Vec<String>,
+) {
     let stature = stature_of(march);
     let mut rng = <rand::rngs::StdRng as rand::SeedableRng>::seed_from_u64(3);
     let at_40 = voxelise(&march.frames[0], stature, &VoxelParams::default(), &mut rng).len();
-    lines.push("Speed on one core (marching, 10 frames each)".to_owned());
+    let before = VolumeParams {
+        curve_points: usize::MAX,
+        ..*params
+    };
+    lines.push("Speed on one core (marching, 10 consecutive frames): the curve on every point (before) and the product (curve on fewer points + the fitted body)".to_owned());
     lines.push(format!(
-        "{:>8} {:>8} {:>12} {:>12} {:>10} {:>9}",
-        "N target", "voxel", "points", "ms / frame", "Isomap", "topology"
+        "{:>8} {:>8} {:>8} {:>12} {:>12} {:>9} {:>7}",
+        "N target", "voxel", "points", "before ms", "after ms", "fit ms", "ratio"
     ));
-    for target in [3_000.0, 10_000.0, 30_000.0] {
+    for target in [3_000.0, 11_000.0, 30_000.0] {
         let voxel_m = 0.04 * (at_40 as f64 / target).cbrt();
         let voxel = VoxelParams {
             voxel_m,
@@ -407,35 +471,38 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         let clouds: Vec<_> = march
             .frames
             .iter()
-            .step_by(5)
             .take(10)
             .map(|j| voxelise(j, stature, &voxel, &mut rng))
             .collect();
         say(global, &format!("speed at N ≈ {target:.0} …"));
-        let (mut total, mut iso, mut ok) = (0.0, 0.0, 0);
+        let t0 = Instant::now();
         for c in &clouds {
-            let t0 = Instant::now();
-            let r = process_frame(c, &params);
-            total += t0.elapsed().as_secs_f64();
-            if let Ok(r) = r {
-                iso += r.seconds[0];
-                ok += 1;
-            }
+            let _ = process_frame(c, &before);
         }
+        let old = t0.elapsed().as_secs_f64();
+        let t0 = Instant::now();
+        let (results, points): (Vec<_>, Vec<_>) = clouds
+            .iter()
+            .map(|c| process_frame_for_fit(c, params))
+            .unzip();
+        let t1 = Instant::now();
+        let names: Vec<String> = (0..clouds.len()).map(|i| i.to_string()).collect();
+        let _ = assemble_and_fit(&results, &points, &names, march.fps, params);
+        let fit = t1.elapsed().as_secs_f64();
+        let new = t0.elapsed().as_secs_f64();
         let n = clouds.len().max(1) as f64;
         lines.push(format!(
-            "{:>8.0} {:>6.1}mm {:>12.0} {:>12.1} {:>9.0}% {:>6}/{}",
+            "{:>8.0} {:>6.1}mm {:>8.0} {:>12.1} {:>12.1} {:>9.1} {:>7.2}",
             target,
             voxel_m * 1000.0,
             clouds.iter().map(Vec::len).sum::<usize>() as f64 / n,
-            1000.0 * total / n,
-            100.0 * iso / total.max(1e-12),
-            ok,
-            clouds.len()
+            1000.0 * old / n,
+            1000.0 * new / n,
+            1000.0 * fit / n,
+            new / old.max(1e-12)
         ));
     }
-    print_tables(global, suite_json, &lines);
-    Ok(())
+    lines.push(String::new());
 }
 
 /// Prints the tables, or with `--json` the suite's figures and the tables as JSON.

@@ -67,6 +67,28 @@ pub fn run(a: &VolumeArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             100.0 * iso / (iso + rest).max(1e-12),
         ),
     );
+    match &processed.fitted {
+        Some(f) => {
+            let flagged = f
+                .skeleton
+                .frames
+                .iter()
+                .filter(|k| !k.flags.is_empty())
+                .count();
+            say(
+                global,
+                &format!(
+                    "the subject's body fitted over the clip: {flagged} of {} frames flagged (see the warnings), {} started from the curve's pose",
+                    f.skeleton.frames.len(),
+                    f.from_curve
+                ),
+            );
+        }
+        None => say(
+            global,
+            "warning: the articulated fit could not start (no frame with a five-limb curve and points); the skeleton is the curve's",
+        ),
+    }
     say(global, &format!("wrote {}", skeleton_path.display()));
     let outputs = Outputs3d {
         bvh: Some(a.out_dir.join("motion.bvh")),

@@ -177,6 +177,8 @@ pub struct CarveCase {
     pub faults: crate::synth::SilhouetteFaults,
     /// Masks that must contain a voxel.
     pub min_votes: Option<usize>,
+    /// What the person is drawn as: the capsule body, or MakeHuman's mesh (suite v4's people).
+    pub surface: crate::synth::Surface,
 }
 
 impl CarveCase {
@@ -187,6 +189,7 @@ impl CarveCase {
             voxel_m,
             faults: crate::synth::SilhouetteFaults::default(),
             min_votes: None,
+            surface: crate::synth::Surface::Capsules,
         }
     }
 }
@@ -195,12 +198,17 @@ impl CarveCase {
 /// voxels the carve dropped per frame (other components: a second person, fragments).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CarveResult {
-    /// Accuracy against the truth.
+    /// Accuracy against the truth: the subject's body fitted over the clip (the product's
+    /// output; the curve's when the fit could not run).
     pub score: VolumeScore,
+    /// The paper's skeleton curve alone.
+    pub curve_score: VolumeScore,
     /// Mean voxels kept per frame.
     pub voxels: f64,
     /// Mean voxels dropped per frame.
     pub dropped: f64,
+    /// Frames the fit flagged.
+    pub flagged: usize,
 }
 
 /// Carves `motion` as `case` says (640×480 cameras around the body, see
@@ -218,12 +226,13 @@ pub fn carve_and_score(
     use videomocap_volume::{VolumeError, process_directory};
     let dir = tempfile::tempdir().map_err(VolumeError::io(&std::env::temp_dir()))?;
     let (setup_dir, grids) = (dir.path().join("setup"), dir.path().join("grids"));
-    crate::synth::write_carving_setup(
+    crate::synth::write_carving_setup_of(
         motion,
         &setup_dir,
         case.views,
         (640, 480),
         &case.faults,
+        case.surface,
         &|_, _| {},
     )?;
     let setup = open_setup(&setup_dir)?;
@@ -245,13 +254,18 @@ pub fn carve_and_score(
     )?;
     let p = process_directory(&grids, params, motion.fps, &|_, _| {}, &never)?;
     let n = kept.len().max(1) as f64;
+    let truth = crate::synth::volume_truth(motion);
     Ok(CarveResult {
-        score: score_volume(
-            &crate::synth::volume_truth(motion),
-            &p.assembled.skeleton,
-            p.five_limb_frames(),
-        ),
+        score: score_volume(&truth, &p.assembled.skeleton, p.five_limb_frames()),
+        curve_score: score_volume(&truth, &p.curve_skeleton, p.five_limb_frames()),
         voxels: kept.iter().map(|k| k.voxels).sum::<usize>() as f64 / n,
         dropped: kept.iter().map(|k| k.dropped_voxels).sum::<usize>() as f64 / n,
+        flagged: p
+            .assembled
+            .skeleton
+            .frames
+            .iter()
+            .filter(|f| !f.flags.is_empty())
+            .count(),
     })
 }

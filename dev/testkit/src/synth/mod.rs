@@ -23,7 +23,7 @@ pub use motion::{
 pub use render::{Figure, Rendered, SensorEffects, Surface, background, render_frame};
 pub use volume::{
     VoxelParams, ring_cameras, silhouette, truth as volume_truth, voxelise, write_carving_setup,
-    write_volume_sequence,
+    write_carving_setup_of, write_volume_sequence,
 };
 
 use nalgebra::{Matrix3, Point2, Point3, Rotation3, Vector3};

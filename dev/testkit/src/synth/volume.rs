@@ -5,7 +5,7 @@
 
 use super::faults::SilhouetteFaults;
 use super::motion::{Motion, stature_of};
-use super::render::Body;
+use super::render::{Body, Surface};
 use image::GrayImage;
 use nalgebra::{Point3, Vector3};
 use rand::{Rng, SeedableRng};
@@ -164,8 +164,87 @@ pub fn write_carving_setup(
     motion: &Motion,
     dir: &Path,
     views: usize,
+    size: (u32, u32),
+    faults: &SilhouetteFaults,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<(), VolumeError> {
+    write_carving_setup_of(
+        motion,
+        dir,
+        views,
+        size,
+        faults,
+        Surface::Capsules,
+        progress,
+    )
+}
+
+/// The person's silhouette in `cam`: the capsule body's voxel centres `pts` (the forearm left
+/// out when `no_forearm`), or MakeHuman's mesh posed on `joints` (the capsule forearm's
+/// silhouette then cut from it).
+fn person_mask(
+    surface: Surface,
+    pts: &[Point3<f64>],
+    joints: &PerJoint<Point3<f64>>,
+    stature: f64,
+    no_forearm: Option<&SilhouetteFaults>,
+    cam: &CalibratedCamera,
+    voxel_m: f64,
+) -> Result<GrayImage, VolumeError> {
+    let forearm = |p: &&Point3<f64>| no_forearm.is_some_and(|f| f.is_forearm(joints, p));
+    match surface {
+        Surface::Capsules => {
+            let kept: Vec<Point3<f64>> = pts.iter().filter(|p| !forearm(p)).copied().collect();
+            Ok(silhouette(&kept, voxel_m, cam))
+        }
+        Surface::Mesh => {
+            let pinhole = PinholeCamera {
+                focal_px: cam.fx,
+                cx: cam.cx,
+                cy: cam.cy,
+                width: cam.width,
+                height: cam.height,
+            };
+            let in_camera = joints.map(|_, p| Point3::from(cam.to_camera(p)));
+            let mut img = image::RgbImage::new(cam.width, cam.height);
+            let depth = super::mesh::paint(
+                &pinhole,
+                &in_camera,
+                stature,
+                &super::appearance::Appearance::default(),
+                &mut img,
+            )
+            .map_err(|e| VolumeError::Invalid {
+                path: std::path::PathBuf::from("mesh"),
+                problem: e.to_string(),
+            })?;
+            let mut mask = GrayImage::from_fn(cam.width, cam.height, |x, y| {
+                let d = depth[(y * cam.width + x) as usize];
+                image::Luma([if d.is_finite() { 255 } else { 0 }])
+            });
+            if no_forearm.is_some() {
+                let cut: Vec<Point3<f64>> = pts.iter().filter(forearm).copied().collect();
+                let hole = silhouette(&cut, voxel_m, cam);
+                for (m, h) in mask.pixels_mut().zip(hole.pixels()) {
+                    if h.0[0] > 0 {
+                        m.0[0] = 0;
+                    }
+                }
+            }
+            Ok(mask)
+        }
+    }
+}
+
+/// [`write_carving_setup`] with the person drawn as `surface`: the capsule body, or MakeHuman's
+/// skinned mesh (suite v4's people) rasterised into each view.
+pub fn write_carving_setup_of(
+    motion: &Motion,
+    dir: &Path,
+    views: usize,
     (width, height): (u32, u32),
     faults: &SilhouetteFaults,
+    surface: Surface,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(), VolumeError> {
     let stature = stature_of(motion);
@@ -227,15 +306,16 @@ pub fn write_carving_setup(
                     .join("masks")
                     .join(&c.name)
                     .join(format!("frame_{i:04}.png"));
-                let drawn: Vec<Point3<f64>> = pts
-                    .iter()
-                    .filter(|p| {
-                        faults.missing_forearm_view != Some(view) || !faults.is_forearm(joints, p)
-                    })
-                    .chain(&extra)
-                    .copied()
-                    .collect();
-                let mask = faults.edges(view, silhouette(&drawn, fine.voxel_m, c));
+                let no_forearm = (faults.missing_forearm_view == Some(view)).then_some(faults);
+                let mut mask =
+                    person_mask(surface, &pts, joints, stature, no_forearm, c, fine.voxel_m)?;
+                if !extra.is_empty() {
+                    let other = silhouette(&extra, fine.voxel_m, c);
+                    for (m, o) in mask.pixels_mut().zip(other.pixels()) {
+                        m.0[0] = m.0[0].max(o.0[0]);
+                    }
+                }
+                let mask = faults.edges(view, mask);
                 mask.save(&path).map_err(|e| VolumeError::Invalid {
                     path: path.clone(),
                     problem: format!("cannot write the mask: {e}"),
