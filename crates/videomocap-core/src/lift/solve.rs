@@ -86,6 +86,9 @@ pub struct LiftOutput {
 /// Checks the job's inputs.
 fn check(job: &LiftJob<'_>) -> Result<(), LiftError> {
     job.params.validate()?;
+    if job.params.pose_prior > 0.0 {
+        super::prior::PosePrior::bundled()?;
+    }
     let f = job.camera.focal_px;
     if !(f.is_finite() && f > 0.0) {
         return Err(LiftError::BadFocal(f));
@@ -319,6 +322,7 @@ fn per_frame_solve(
             let lengths = &job.subject.bone_length_m;
             let solved = (&resolved.points[..], &images[..], lengths);
             flag_too_long(job, &mut reports, solved, doubt, shortened);
+            flag_unusual(job, &mut reports, &resolved);
             best = Some((score, reports, resolved));
         }
     }
@@ -356,6 +360,23 @@ pub fn fit_score(miss_m: f64, group_costs: &[f64]) -> f64 {
         .chain(group_costs.iter().copied())
         .map(|c| c.max(FIT_FLOOR).ln())
         .sum()
+}
+
+/// Flags the frames whose pose the learned prior finds unusual ([`FrameFlag::UnusualPose`]),
+/// the camera's up (−Y) standing in for the world's.
+fn flag_unusual(job: &LiftJob<'_>, reports: &mut [FrameReport], resolved: &Resolved) {
+    let Some(prior) = super::prior::PosePrior::bundled()
+        .ok()
+        .filter(|_| job.params.pose_prior > 0.0)
+    else {
+        return;
+    };
+    let up = -nalgebra::Vector3::y();
+    for (report, p) in reports.iter_mut().zip(&resolved.points) {
+        if prior.is_unusual(p, &up) {
+            report.flags.push(FrameFlag::UnusualPose);
+        }
+    }
 }
 
 /// Each frame's 3D body from the pose network, where the tracks carry one.
