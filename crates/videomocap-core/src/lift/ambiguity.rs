@@ -20,12 +20,15 @@
 //! bone on a frame ([`DepthOverrides`]) is a hard constraint.
 mod gait;
 mod margins;
+mod memo;
 mod priors;
 mod viterbi;
 mod weights;
 
 pub use priors::image_facing_cost;
 pub use weights::AmbiguityWeights;
+
+pub(crate) use memo::PriorMemo;
 
 use super::backproject::{Root, bone_roots};
 use super::prior::{PosePrior, PriorGroup, Side, TrunkFrame};
@@ -150,6 +153,32 @@ pub fn resolve(
     weights: &AmbiguityWeights,
     overrides: &DepthOverrides,
 ) -> Resolved {
+    let memo = PriorMemo::new(key.len());
+    resolve_with(
+        key,
+        rays,
+        frame_index,
+        bodies,
+        subject,
+        weights,
+        overrides,
+        &memo,
+    )
+}
+
+/// [`resolve`] keeping the pose prior's costs in `memo` for the next solve of the same lift
+/// (the same rays, subject and weights).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn resolve_with(
+    key: &[[Point3<f64>; 3]],
+    rays: &[PerJoint<Vector3<f64>>],
+    frame_index: &[FrameIndex],
+    bodies: &[Option<NetworkBody>],
+    subject: &SubjectModel,
+    weights: &AmbiguityWeights,
+    overrides: &DepthOverrides,
+    memo: &PriorMemo,
+) -> Resolved {
     let n = key.len();
     let points: Vec<PerJoint<Point3<f64>>> = key
         .iter()
@@ -173,6 +202,7 @@ pub fn resolve(
         prior: PosePrior::bundled()
             .ok()
             .filter(|_| weights.pose_prior > 0.0),
+        memo,
     };
     let mut resolved = Resolved {
         points,
@@ -219,6 +249,8 @@ struct Inputs<'a> {
     trunks: &'a [TrunkFrame],
     /// The learned pose prior (`None`: unreadable, checked before the lift runs).
     prior: Option<&'a PosePrior>,
+    /// The prior's costs already computed in this lift.
+    memo: &'a PriorMemo,
 }
 
 /// Chooses the roots of group `g` over the whole sequence on the trajectories already chosen
@@ -238,12 +270,13 @@ fn solve_group(
         weights,
         overrides,
         trunks,
-        prior,
+        ..
     } = *inputs;
     let group = &GROUPS[g];
     let combos = 1usize << group.bones.len();
     let candidates: Vec<Vec<Candidate>> = (0..resolved.points.len())
         .map(|t| {
+            let nats = prior_costs(g, t, inputs, &resolved.points[t]);
             (0..combos)
                 .map(|combo| {
                     let mut p = resolved.points[t];
@@ -277,11 +310,7 @@ fn solve_group(
                     }
                     if c.unary.is_finite() {
                         c.steer = swing_cost(group, &p, &trunks[t], weights);
-                        if group.prior == PriorGroup::Spine && weights.lookahead > 0.0 {
-                            c.steer += weights.lookahead
-                                * weights.pose_prior
-                                * hanging_cost(&p, &rays[t], &trunks[t], subject, prior);
-                        }
+                        c.steer += weights.lookahead * weights.pose_prior * nats[combo].1;
                         if let Some(symmetry) = symmetry {
                             c.steer += weights.gait_symmetry * symmetry.cost(group, &p, t);
                         }
@@ -290,13 +319,11 @@ fn solve_group(
                         {
                             c.steer += weights.image_depth * image_depth_cost(group, &p, body);
                         }
-                        let nats =
-                            prior.map_or(0.0, |prior| prior.cost(group.prior, &p, &trunks[t]));
                         if matches!(group.prior, PriorGroup::Arm(_)) {
                             let end = group.bones[1].child;
                             c.unary += weights.contact * inside_body(&p[end], &p, subject);
                         }
-                        c.unary += weights.pose_prior * nats + c.steer;
+                        c.unary += weights.pose_prior * nats[combo].0 + c.steer;
                     }
                     c
                 })
@@ -332,6 +359,34 @@ fn solve_group(
             resolved.margins[t][b] = (other - cost).max(0.0) / per_nat;
         }
     }
+}
+
+/// Group `g`'s candidates' pose prior on frame `t` (their joints placed from `p`): per
+/// combination of roots, its cost and, for the spine, the look ahead's (both nats; zeros
+/// without the prior). Read from the lift's memo where the joints they hang from are unchanged.
+fn prior_costs(
+    g: usize,
+    t: usize,
+    inputs: &Inputs<'_>,
+    p: &PerJoint<Point3<f64>>,
+) -> [(f64, f64); 4] {
+    let Some(prior) = inputs.prior else {
+        return [(0.0, 0.0); 4];
+    };
+    let group = &GROUPS[g];
+    let (rays, trunk, subject) = (&inputs.rays[t], &inputs.trunks[t], inputs.subject);
+    let look = group.prior == PriorGroup::Spine && inputs.weights.lookahead > 0.0;
+    inputs.memo.costs(t, g, group.prior, p, || {
+        let mut costs = [(0.0, 0.0); 4];
+        for (combo, c) in costs.iter_mut().enumerate().take(1 << group.bones.len()) {
+            let q = placed(g, combo, p, rays, subject);
+            c.0 = prior.cost(group.prior, &q, trunk);
+            if look {
+                c.1 = hanging_cost(&q, rays, trunk, subject, prior);
+            }
+        }
+        costs
+    })
 }
 
 /// The root a group's `combo` gives its `k`-th bone (bit `k`: 0 near, 1 far).

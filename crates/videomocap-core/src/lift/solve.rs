@@ -3,7 +3,7 @@
 //! (`facing`), the depth roots (`ambiguity`), the optional global refinement (`refine`), the
 //! per-frame report and the planted feet (`contact`). Its settings are in `params`.
 
-use super::ambiguity::{DepthOverrides, Resolved, resolve};
+use super::ambiguity::{DepthOverrides, PriorMemo, Resolved, resolve_with};
 use super::facing::facing_by_segments;
 use super::key_candidates::{deepest_trunk, key_candidates, plausible_key, smoothest_key_path};
 use super::params::LiftParams;
@@ -228,6 +228,8 @@ fn per_frame_solve(
     let noise_px = median_noise_px(tracks, &KEY_JOINTS);
     let mut best: Option<(f64, Vec<FrameReport>, Resolved)> = None;
     let weights = job.params.ambiguity();
+    // The prior's costs, kept between the whole-clip solves below (same rays and subject).
+    let memo = PriorMemo::new(n);
     // Every frame's candidate poses, computed once.
     let per_frame: Vec<(Vec<[Point3<f64>; 3]>, bool)> = (0..n)
         .map(|t| {
@@ -263,7 +265,7 @@ fn per_frame_solve(
         }
         // The whole body built on a key path, and how well it explains the clip.
         let build = |key: &[[Point3<f64>; 3]]| {
-            let resolved = resolve(
+            let resolved = resolve_with(
                 key,
                 &rays,
                 &frame_index,
@@ -271,6 +273,7 @@ fn per_frame_solve(
                 &job.subject,
                 &weights,
                 &job.overrides,
+                &memo,
             );
             let miss: f64 = (0..n)
                 .map(|t| miss_m(cam, &resolved.points[t], &images[t]))

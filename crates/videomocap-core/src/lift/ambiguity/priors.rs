@@ -134,11 +134,8 @@ pub(super) fn hanging_cost(
     rays: &PerJoint<Vector3<f64>>,
     trunk: &TrunkFrame,
     subject: &SubjectModel,
-    prior: Option<&PosePrior>,
+    prior: &PosePrior,
 ) -> f64 {
-    let Some(prior) = prior else {
-        return 0.0;
-    };
     let least = |g: usize, p: &PerJoint<Point3<f64>>| {
         (0..1usize << GROUPS[g].bones.len())
             .map(|combo| prior.cost(GROUPS[g].prior, &placed(g, combo, p, rays, subject), trunk))

@@ -371,7 +371,7 @@ fn the_spine_looks_ahead_at_the_legs_hanging_from_it() {
     );
     // On every frame the look ahead alone (the least prior of the hips and legs hung from
     // each pelvis root) prefers the true root: its legs need not bend or splay.
-    let prior = PosePrior::bundled().ok();
+    let prior = PosePrior::bundled().unwrap();
     let spine = group_of(Bone::new(Pelvis, Chest));
     for (t, truth) in frames.iter().enumerate() {
         let costs = [0, 1].map(|combo| {

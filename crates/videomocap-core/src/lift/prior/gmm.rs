@@ -15,15 +15,22 @@ pub struct Component {
     pub cov_chol: Vec<f64>,
 }
 
-/// A Gaussian mixture over `dims`-vectors, with each component's normalising constant (log)
-/// precomputed.
+/// A Gaussian mixture over `dims`-vectors, with what its density needs precomputed per
+/// component and packed in one slice (no allocation when it is evaluated): the normalising
+/// constant's log, the mean, and the inverse of the covariance's Cholesky factor.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Gmm {
     pub(crate) dims: usize,
     pub(crate) components: Vec<Component>,
-    /// Per component: ln weight − ½ d ln 2π − Σ ln Lᵢᵢ.
-    log_norm: Vec<f64>,
+    /// Per component [`Gmm::stride`] numbers: ln weight − ½ d ln 2π − Σ ln Lᵢᵢ (the log of the
+    /// weight over the normalising constant, the log-determinant taken from the factor's
+    /// diagonal), the mean (`dims`), then `L⁻¹` (lower triangular, row by row, `dims (dims + 1)
+    /// / 2`), so that (x − μ)ᵀ Σ⁻¹ (x − μ) = |L⁻¹ (x − μ)|².
+    packed: Vec<f64>,
 }
+
+/// The most dimensions a mixture may have (the pose prior's largest group has 9).
+pub const MAX_DIMS: usize = 16;
 
 impl Gmm {
     /// A mixture from its components; `Err` names what is wrong (dimensions, weights, a factor
@@ -32,7 +39,10 @@ impl Gmm {
         if components.is_empty() {
             return Err("a mixture without components".to_owned());
         }
-        let mut log_norm = Vec::with_capacity(components.len());
+        if dims == 0 || dims > MAX_DIMS {
+            return Err(format!("{dims} dimensions (1 to {MAX_DIMS})"));
+        }
+        let mut packed = Vec::with_capacity(components.len() * stride(dims));
         let mut total = 0.0;
         for (k, c) in components.iter().enumerate() {
             if c.mean.len() != dims || c.cov_chol.len() != dims * dims {
@@ -55,10 +65,18 @@ impl Gmm {
                 }
                 log_det += d.ln();
             }
+            let inverse = lower_inverse(&c.cov_chol, dims);
+            if inverse.iter().any(|v| !v.is_finite()) {
+                return Err(format!("component {k}: covariance not invertible"));
+            }
             total += c.weight;
-            log_norm.push(
+            packed.push(
                 c.weight.ln() - 0.5 * dims as f64 * (2.0 * std::f64::consts::PI).ln() - log_det,
             );
+            packed.extend_from_slice(&c.mean);
+            for i in 0..dims {
+                packed.extend_from_slice(&inverse[i * dims..i * dims + i + 1]);
+            }
         }
         if (total - 1.0).abs() > 1e-3 {
             return Err(format!("weights sum to {total}, not 1"));
@@ -66,34 +84,51 @@ impl Gmm {
         Ok(Gmm {
             dims,
             components,
-            log_norm,
+            packed,
         })
     }
 
-    /// The log density at `x` (`x.len() == dims`).
+    /// Each component's log term at `x`: ln(weight · N(x; μ, Σ)), in order.
+    fn terms<'a>(&'a self, x: &'a [f64]) -> impl Iterator<Item = f64> + 'a {
+        let dims = self.dims;
+        self.packed.chunks_exact(stride(dims)).map(move |c| {
+            let (mean, inverse) = c[1..].split_at(dims);
+            let mut d = [0.0f64; MAX_DIMS];
+            for i in 0..dims {
+                d[i] = x[i] - mean[i];
+            }
+            let mut sum = 0.0;
+            let mut row = 0;
+            for i in 0..dims {
+                let y: f64 = inverse[row..row + i + 1]
+                    .iter()
+                    .zip(&d[..=i])
+                    .map(|(a, b)| a * b)
+                    .sum();
+                sum += y * y;
+                row += i + 1;
+            }
+            c[0] - 0.5 * sum
+        })
+    }
+
+    /// The log density at `x` (`x.len() == dims`): the components' terms summed by a running
+    /// log-sum-exp.
     pub fn log_density(&self, x: &[f64]) -> f64 {
-        let mut best = f64::NEG_INFINITY;
-        let mut terms = [0.0f64; 64];
-        let k = self.components.len().min(terms.len());
-        for (i, (c, norm)) in self
-            .components
-            .iter()
-            .zip(&self.log_norm)
-            .take(k)
-            .enumerate()
-        {
-            let t = norm - 0.5 * mahalanobis_sq(&c.cov_chol, &c.mean, x, self.dims);
-            terms[i] = t;
-            best = best.max(t);
+        let (mut best, mut sum) = (f64::NEG_INFINITY, 0.0);
+        for t in self.terms(x) {
+            if t > best {
+                sum = sum * (best - t).exp() + 1.0;
+                best = t;
+            } else {
+                sum += (t - best).exp();
+            }
         }
-        if !best.is_finite() {
-            return best;
+        if best.is_finite() {
+            best + sum.ln()
+        } else {
+            best
         }
-        best + terms[..k]
-            .iter()
-            .map(|t| (t - best).exp())
-            .sum::<f64>()
-            .ln()
     }
 
     /// The highest log density over the components' means (about the mixture's mode).
@@ -105,19 +140,25 @@ impl Gmm {
     }
 }
 
-/// (x − μ)ᵀ Σ⁻¹ (x − μ) with Σ = L Lᵀ: forward substitution for L y = x − μ, then |y|².
-fn mahalanobis_sq(chol: &[f64], mean: &[f64], x: &[f64], dims: usize) -> f64 {
-    let mut y = [0.0f64; 16];
-    let mut sum = 0.0;
-    for i in 0..dims {
-        let mut v = x[i] - mean[i];
-        for j in 0..i {
-            v -= chol[i * dims + j] * y[j];
+/// How many numbers one component takes in [`Gmm::packed`].
+fn stride(dims: usize) -> usize {
+    1 + dims + dims * (dims + 1) / 2
+}
+
+/// The inverse of a lower triangular `dims × dims` matrix with a positive diagonal (row-major;
+/// lower triangular too), by forward substitution column by column.
+fn lower_inverse(l: &[f64], dims: usize) -> Vec<f64> {
+    let mut inv = vec![0.0; dims * dims];
+    for col in 0..dims {
+        for i in col..dims {
+            let mut v = if i == col { 1.0 } else { 0.0 };
+            for j in col..i {
+                v -= l[i * dims + j] * inv[j * dims + col];
+            }
+            inv[i * dims + col] = v / l[i * dims + i];
         }
-        y[i] = v / chol[i * dims + i];
-        sum += y[i] * y[i];
     }
-    sum
+    inv
 }
 
 /// The lower Cholesky factor of a symmetric `dims × dims` matrix (row-major); `None` if it is
@@ -146,8 +187,15 @@ fn cholesky(a: &[f64], dims: usize) -> Option<Vec<f64>> {
 /// Fits a `k`-component mixture to `data` (each `dims` long) by expectation–maximisation,
 /// `iterations` rounds from k-means++ seeds drawn by a fixed linear congruential sequence (so
 /// the same data give the same file). `floor` is added to every covariance's diagonal (the
-/// directions of unit vectors and of mirrored pairs lie on lower-dimensional sets).
-pub fn fit(data: &[Vec<f64>], dims: usize, k: usize, iterations: usize, floor: f64) -> Gmm {
+/// directions of unit vectors and of mirrored pairs lie on lower-dimensional sets). `Err` where
+/// `dims` is beyond [`MAX_DIMS`].
+pub fn fit(
+    data: &[Vec<f64>],
+    dims: usize,
+    k: usize,
+    iterations: usize,
+    floor: f64,
+) -> Result<Gmm, String> {
     let n = data.len();
     let mut state: u64 = 0x9e37_79b9_7f4a_7c15;
     let mut next = || {
@@ -197,11 +245,7 @@ pub fn fit(data: &[Vec<f64>], dims: usize, k: usize, iterations: usize, floor: f
         };
         // E step.
         for (i, x) in data.iter().enumerate() {
-            let logs: Vec<f64> = components
-                .iter()
-                .zip(&gmm.log_norm)
-                .map(|(c, norm)| norm - 0.5 * mahalanobis_sq(&c.cov_chol, &c.mean, x, dims))
-                .collect();
+            let logs: Vec<f64> = gmm.terms(x).collect();
             let best = logs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
             let sum: f64 = logs.iter().map(|l| (l - best).exp()).sum();
             for (j, l) in logs.iter().enumerate() {
@@ -247,14 +291,13 @@ pub fn fit(data: &[Vec<f64>], dims: usize, k: usize, iterations: usize, floor: f
     components.retain(|c| c.weight > 1e-9);
     let total: f64 = components.iter().map(|c| c.weight).sum();
     components.iter_mut().for_each(|c| c.weight /= total);
-    Gmm::new(dims, components).unwrap_or_else(|_| Gmm {
-        dims,
-        components: vec![Component {
+    Gmm::new(dims, components).or_else(|_| {
+        let standard = Component {
             weight: 1.0,
             mean: vec![0.0; dims],
             cov_chol: identity(1.0),
-        }],
-        log_norm: vec![-0.5 * dims as f64 * (2.0 * std::f64::consts::PI).ln()],
+        };
+        Gmm::new(dims, vec![standard])
     })
 }
 
@@ -288,7 +331,7 @@ mod tests {
             data.push(vec![-2.0 + e, 1.0 - e]);
             data.push(vec![3.0 - e, -1.0 + e]);
         }
-        let g = fit(&data, 2, 2, 30, 1e-4);
+        let g = fit(&data, 2, 2, 30, 1e-4).unwrap();
         let mut means: Vec<f64> = g.components.iter().map(|c| c.mean[0]).collect();
         means.sort_by(f64::total_cmp);
         assert!((means[0] + 2.0).abs() < 0.05 && (means[1] - 3.0).abs() < 0.05);
