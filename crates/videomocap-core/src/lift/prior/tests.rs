@@ -48,8 +48,14 @@ fn a_prior_learned_from_walking_prefers_knees_bent_backwards() {
     // fixed number of nats more: these 400 near-identical learned poses put the leg's ceiling
     // at its least, 2 nats, and every cost stays under it.)
     let model = &prior.models[leg.model()];
-    let (a, b) = (prior.cost(leg, &ordinary, &key), prior.cost(leg, &odd, &key));
-    assert!(a < model.unusual && model.unusual < b && a + 1.0 < b, "{a} {b}");
+    let (a, b) = (
+        prior.cost(leg, &ordinary, &key),
+        prior.cost(leg, &odd, &key),
+    );
+    assert!(
+        a < model.unusual && model.unusual < b && a + 1.0 < b,
+        "{a} {b}"
+    );
     assert!(!prior.is_unusual(&ordinary, &up));
     // An arm raised straight up and a leg bent forwards: never seen, but still a finite cost.
     let mut contorted = walking(0.3, -1.2);
