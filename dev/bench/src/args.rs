@@ -70,9 +70,29 @@ pub enum Command {
         /// The ground truth (gt.json, written by `synth`).
         reference: PathBuf,
     },
+    /// Learn the lift's pose prior from motion-capture takes (gzip or plain BVH) and write its
+    /// parameter file (`assets/pose_prior/pose_prior.json`), listing the takes it used; the
+    /// suite's test takes are refused.
+    Prior(PriorArgs),
     /// Save a project and write its exports over and over until killed; the crash-safety test
     /// kills it at random moments and checks every file left behind.
     StressWrite(StressWriteArgs),
+}
+
+/// `prior`: where the takes are and where the parameters go.
+#[derive(Debug, Args)]
+pub struct PriorArgs {
+    /// The folder of takes (`*.bvh` or `*.bvh.gz`, read recursively).
+    pub mocap: PathBuf,
+    /// The parameter file to write.
+    #[arg(short, long, default_value = "assets/pose_prior/pose_prior.json")]
+    pub out: PathBuf,
+    /// Mixture components per group of bones.
+    #[arg(long, default_value_t = 12)]
+    pub components: usize,
+    /// Poses learned per second of motion (each take resampled).
+    #[arg(long, default_value_t = 15.0)]
+    pub per_second: f64,
 }
 
 /// `stress-write`: the writer the crash-safety test kills.

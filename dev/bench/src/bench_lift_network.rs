@@ -11,9 +11,10 @@
 use crate::args::{BenchArgs, GlobalArgs};
 use crate::bench_suite::{BenchClip, Merge, OpenedClip, Tally, bench_clips};
 use crate::{ExitError, say};
+use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
-use videomocap_core::formats::{Frame3d, Marks, Skeleton3d, Tracks2d};
+use videomocap_core::formats::{Frame3d, Marks, Skeleton3d, Tracks2d, UNUSUAL_POSE_FLAG};
 use videomocap_core::lift::{CameraChoice, LiftParams, SubjectChoice, reconstruct};
 use videomocap_core::network::PoseNetwork;
 use videomocap_core::skeleton::{Bone, DEFAULT_HEIGHT_M, Joint, PerJoint};
@@ -21,6 +22,7 @@ use videomocap_core::track::{NetworkFrames, TrackJob, TrackerParams, run_network
 use videomocap_core::video::Video;
 use videomocap_testkit::eval::doubt::{DoubtTally, tally_doubt};
 use videomocap_testkit::eval::pose3d::{Pose3dScore, cutout, score_skeleton, tracks_from_truth};
+use videomocap_testkit::eval::suite::Split;
 use videomocap_testkit::synth::GroundTruth;
 
 /// A bone's depth order counts when the reference's ends differ in depth by more than this,
@@ -62,8 +64,9 @@ impl Agreement {
 /// One column's scores: the 3D error and the depth order's agreement.
 type Column = (Pose3dScore, Agreement);
 
-/// A clip's columns per input: cut-out, lift alone, network alone, then the lift together with
-/// the network at each weight; `None` where the input was not run.
+/// A clip's columns per input: cut-out, the lift's geometry alone (no prior, no network), the
+/// geometry with the pose prior, the network alone, then the lift (with the prior) together
+/// with the network at each weight; `None` where the input was not run.
 /// And per input, whether the together lift's doubts point at its mistakes.
 type Scores = ([Vec<Column>; 2], [DoubtTally; 2]);
 
@@ -154,15 +157,19 @@ pub(crate) fn network_on_truth(
     Ok(net)
 }
 
-/// Scores one input of one clip: cut-out, lift alone, network alone, together per weight; the
-/// first together lift's doubts against its mistakes; and the seconds it took (one thread: the
-/// lift runs on the caller's).
+/// What one input of one clip gives: its columns, the first together lift's doubts, the seconds
+/// that lift took and its frames flagged as an unusual pose.
+type Input = (Vec<Column>, DoubtTally, f64, usize);
+
+/// Scores one input of one clip: cut-out, geometry alone, the prior, network alone, together per
+/// weight; the first together lift's doubts against its mistakes; the seconds it took (one
+/// thread: the lift runs on the caller's) and its frames flagged as an unusual pose.
 fn score_input(
     gt: &GroundTruth,
     tracks: &Tracks2d,
     params: &LiftParams,
     weights: &[f64],
-) -> Result<(Vec<Column>, DoubtTally, f64), ExitError> {
+) -> Result<Input, ExitError> {
     let camera = gt.camera();
     let subject = SubjectChoice::Height {
         height_m: gt.stated_height_m.unwrap_or(DEFAULT_HEIGHT_M),
@@ -188,12 +195,18 @@ fn score_input(
         ))
     };
     let flat = cutout(gt, tracks, camera);
+    let geometry = LiftParams {
+        pose_prior: 0.0,
+        ..*params
+    };
+    let alone = without_bodies(tracks);
     let mut out = vec![
         column(&flat)?,
-        column(&lift(&without_bodies(tracks), params)?.skeleton)?,
+        column(&lift(&alone, &geometry)?.skeleton)?,
+        column(&lift(&alone, params)?.skeleton)?,
         column(&network_alone(gt, tracks, &flat))?,
     ];
-    let mut first: Option<(DoubtTally, f64)> = None;
+    let mut first: Option<(DoubtTally, f64, usize)> = None;
     for &w in weights {
         let mut p = *params;
         p.image_depth = w;
@@ -203,12 +216,18 @@ fn score_input(
         if first.is_none() {
             let doubt =
                 tally_doubt(gt, &together.skeleton, &together.bones).map_err(ExitError::failed)?;
-            first = Some((doubt, seconds));
+            let unusual = together
+                .skeleton
+                .frames
+                .iter()
+                .filter(|f| f.flags.iter().any(|s| s == UNUSUAL_POSE_FLAG))
+                .count();
+            first = Some((doubt, seconds, unusual));
         }
         out.push(column(&together.skeleton)?);
     }
-    let (doubt, seconds) = first.unwrap_or_default();
-    Ok((out, doubt, seconds))
+    let (doubt, seconds, unusual) = first.unwrap_or_default();
+    Ok((out, doubt, seconds, unusual))
 }
 
 /// The clip's true 2D carrying the network's body (run from the clicked marks as the tracker
@@ -266,18 +285,18 @@ fn score_clip(
     weights: &[f64],
     a: &BenchArgs,
     threads: usize,
-) -> Result<(Scores, f64, usize), ExitError> {
+) -> Result<(Scores, f64, usize, usize), ExitError> {
     let mut opened = clip.open()?;
     let (exact, tracked) = inputs_with_network(clip, &mut opened, network, a, threads)?;
     let gt = &opened.gt;
     let mut scores: Scores = Default::default();
-    let (columns, doubt, seconds) = score_input(gt, &exact, params, weights)?;
+    let (columns, doubt, seconds, unusual) = score_input(gt, &exact, params, weights)?;
     (scores.0[0], scores.1[0]) = (columns, doubt);
     if let Some(tracked) = tracked {
-        let (columns, doubt, _) = score_input(gt, &tracked, params, weights)?;
+        let (columns, doubt, _, _) = score_input(gt, &tracked, params, weights)?;
         (scores.0[1], scores.1[1]) = (columns, doubt);
     }
-    Ok((scores, seconds, exact.frames.len()))
+    Ok((scores, seconds, exact.frames.len(), unusual))
 }
 
 fn cell(c: Option<&Column>) -> String {
@@ -295,6 +314,38 @@ fn cell(c: Option<&Column>) -> String {
     )
 }
 
+/// The camera's view a clip's name gives (`real` for the real clips).
+fn view_of(name: &str) -> &'static str {
+    ["frontal", "oblique", "side", "behind", "raised", "low"]
+        .into_iter()
+        .find(|v| name.contains(v))
+        .unwrap_or("real")
+}
+
+/// Per view and split, each column's MPJPE (mm) and its ratio to the cut-out's.
+fn view_lines(views: &BTreeMap<(Split, &'static str), Scores>, names: &[String]) -> Vec<String> {
+    let mut out = Vec::new();
+    for (i, input) in INPUT_NAMES.iter().enumerate() {
+        out.push(String::new());
+        out.push(format!(
+            "{input}, per view: MPJPE mm (÷ cut-out) — {}",
+            names.join(" | ")
+        ));
+        for ((split, view), s) in views {
+            let Some(cut) = s.0[i].first() else {
+                continue;
+            };
+            let cut = cut.0.mpjpe_mm();
+            let cells: Vec<String> = s.0[i]
+                .iter()
+                .map(|c| format!("{:>6.1} ({:.2})", c.0.mpjpe_mm(), c.0.mpjpe_mm() / cut))
+                .collect();
+            out.push(format!("{:<5} {view:<8} {}", split.name(), cells.join(" ")));
+        }
+    }
+    out
+}
+
 /// Runs the comparison and prints its tables.
 pub fn run(a: &BenchArgs, global: &GlobalArgs, weights: &[f64]) -> Result<(), ExitError> {
     let threads = crate::bench_suite::machine_threads();
@@ -302,23 +353,27 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs, weights: &[f64]) -> Result<(), Ex
     let network = crate::bench_suite::bundled_network(threads)?;
     let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;
     let mut tally: Tally<Scores> = Tally::default();
+    let mut views: BTreeMap<(Split, &'static str), Scores> = BTreeMap::new();
     let mut names = vec![
         "cut-out".to_owned(),
-        "lift alone".to_owned(),
+        "lift alone (geometry)".to_owned(),
+        "prior (geometry + pose prior)".to_owned(),
         "network alone".to_owned(),
     ];
     names.extend(weights.iter().map(|w| format!("together ({w})")));
     let mut per_clip = Vec::new();
-    let (mut seconds, mut frames) = (0.0, 0);
+    let (mut seconds, mut frames, mut unusual) = (0.0, 0, 0);
     for clip in &clips {
         say(global, &format!("lifting {} with the network …", clip.name));
-        let (s, t, n) = score_clip(clip, &network, &params, weights, a, threads)?;
+        let (s, t, n, u) = score_clip(clip, &network, &params, weights, a, threads)?;
         seconds += t;
         frames += n;
+        unusual += u;
         per_clip.push(format!(
-            "{:<26} {:<5} {}",
+            "{:<26} {:<5} {:>4} {}",
             clip.name,
             clip.split.name(),
+            u,
             s.0[0]
                 .iter()
                 .map(|c| format!("{:>7.1}", c.0.mpjpe_mm()))
@@ -326,6 +381,10 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs, weights: &[f64]) -> Result<(), Ex
                 .join(" ")
         ));
         tally.add(clip, &s);
+        views
+            .entry((clip.split, view_of(&clip.name)))
+            .or_default()
+            .merge_from(&s);
     }
     let mut out = vec![
         "lift alone / network alone / together (the network's 3D body as depth evidence), stated height, true focal: per column MPJPE, PA-MPJPE (mm), frames mirrored, bones in the reference's depth order (where its ends differ by > 5 cm)".to_owned(),
@@ -340,10 +399,10 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs, weights: &[f64]) -> Result<(), Ex
         }
     }
     out.push(String::new());
-    out.push(
-        "together: frames with a bone flagged too long; how often a flagged bone's depth choice is wrong against an unflagged one's; per margin, the share shown unsure and how often an unsure / a sure choice is wrong (the product's margin is 0.01)"
-            .to_owned(),
-    );
+    out.push(format!(
+        "together: frames with a bone flagged too long; how often a flagged bone's depth choice is wrong against an unflagged one's; per margin, the share shown unsure and how often an unsure / a sure choice is wrong (the product's margin is {})",
+        videomocap_core::lift::UNSURE_MARGIN
+    ));
     let doubt_columns = crate::bench_lift::doubt_columns();
     let doubt_width = doubt_columns.chars().count();
     for (i, input) in INPUT_NAMES.iter().enumerate() {
@@ -353,9 +412,16 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs, weights: &[f64]) -> Result<(), Ex
             crate::bench_lift::doubt_cell(&s.1[i])
         }));
     }
+    out.extend(view_lines(&views, &names));
     out.push(String::new());
-    out.push(format!("per clip, (a) MPJPE mm: {}", names.join(" | ")));
+    out.push(format!(
+        "per clip, (a): frames flagged {UNUSUAL_POSE_FLAG} (together), MPJPE mm: {}",
+        names.join(" | ")
+    ));
     out.extend(per_clip);
+    out.push(format!(
+        "(a) frames flagged {UNUSUAL_POSE_FLAG} (together): {unusual} of {frames}"
+    ));
     out.push(String::new());
     out.push(format!(
         "speed: the whole lift together with the network's body (reading the lengths, the per-frame solve with the facing steps, the refinement, the feet) on (a), one thread: {:.2} s per 1000 frames",

@@ -14,6 +14,7 @@ mod bench_scrub;
 mod bench_suite;
 mod bench_track;
 mod bench_volume;
+mod prior;
 mod score;
 mod stress_write;
 mod synth;
@@ -37,6 +38,7 @@ fn main() -> ExitCode {
         Command::Speed { what, args } => bench::run(what, args, global),
         Command::Synth(a) => synth::run(a, global),
         Command::Score { tracks, reference } => score::run(tracks, reference, global),
+        Command::Prior(a) => prior::run(a, global),
         Command::StressWrite(a) => stress_write::run(a),
     };
     match result {

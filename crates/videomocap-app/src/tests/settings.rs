@@ -138,10 +138,10 @@ fn the_global_refinement_is_switched_in_the_lift_settings() {
     assert!(lock(&h));
 }
 
-/// The lift's panel shows the eight settings a user may change, each by a name
+/// The lift's panel shows the nine settings a user may change, each by a name
 /// that says what it does.
 #[test]
-fn the_lift_panel_shows_the_eight_settings() {
+fn the_lift_panel_shows_the_nine_settings() {
     let dir = tempfile::tempdir().unwrap();
     let mut h = with_empty_project(dir.path());
     h.get_by_label("Lift").click();
@@ -159,6 +159,7 @@ fn the_lift_panel_shows_the_eight_settings() {
         "arm swing vs. legs",
         "hands outside the body",
         "image depth evidence",
+        "learned pose prior",
     ] {
         h.get_by_role_and_label(egui::accesskit::Role::Slider, label);
     }

@@ -74,6 +74,15 @@ pub fn lift_settings_ui(ui: &mut egui::Ui, l: &mut LiftParams) {
              and which way the body faces (0 = geometry alone; your flips always win); default {}",
         d.image_depth
     ));
+    fitted::slider(
+        ui,
+        egui::Slider::new(&mut l.pose_prior, 0.0..=3.0),
+        "learned pose prior",
+    )
+    .on_hover_text(format!(
+        "How much what bodies usually do (learned from motion capture) counts for which way              each bone points in depth (0 = off: the image and smooth motion alone; your flips              always win); default {}",
+        d.pose_prior
+    ));
     if ui.button("Defaults").clicked() {
         *l = d;
     }

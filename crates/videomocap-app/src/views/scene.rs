@@ -118,7 +118,9 @@ pub fn scene(state: &State) -> Scene {
 /// do about it. `marked` says which joints the user placed on this frame (their own marks are
 /// what to check, not the tracker). A planted foot is information, not a problem.
 pub fn flag_note(flag: &str, marked: &dyn Fn(Joint) -> bool) -> Note {
-    use videomocap_core::formats::{LOST_FLAG, NO_IMAGE_DEPTH_FLAG, OFF_FRAME_FLAG};
+    use videomocap_core::formats::{
+        LOST_FLAG, NO_IMAGE_DEPTH_FLAG, OFF_FRAME_FLAG, UNUSUAL_POSE_FLAG,
+    };
     let joint = |prefix: &str| flag.strip_prefix(prefix).and_then(Joint::from_name);
     if let Some(bone) = flag.strip_prefix("too_long:").and_then(Bone::from_key) {
         let (a, b) = (joint_words(bone.parent), joint_words(bone.child));
@@ -165,6 +167,10 @@ pub fn flag_note(flag: &str, marked: &dyn Fn(Joint) -> bool) -> Note {
             .to_owned(),
         f if f == NO_IMAGE_DEPTH_FLAG => "The pose network saw no body on this frame: which \
             way each limb points in depth rests on the geometry alone. Check the limbs; click \
+            one to flip it"
+            .to_owned(),
+        f if f == UNUSUAL_POSE_FLAG => "A pose the prior has seldom or never seen: which way \
+            each limb points in depth rests on the image and the motion. Check the limbs; click \
             one to flip it"
             .to_owned(),
         other => format!("flagged: {other}"),
@@ -359,6 +365,11 @@ mod tests {
             flag_note("no_image_depth", &none)
                 .text
                 .contains("pose network saw no body")
+        );
+        assert!(
+            flag_note("unusual_pose", &none)
+                .text
+                .contains("prior has seldom or never seen")
         );
         assert_eq!(
             flag_note("a_later_flag", &none).text,

@@ -19,7 +19,7 @@ pub use lengths::{KnownLengths, LENGTH_RANGE_M, LENGTHS_FORMAT, SHOULDER_WIDTH_K
 pub use marks::{MARKS_FORMAT, Marks};
 pub use skeleton3d::{
     CONTACT_FLAG, Frame3d, LOST_FLAG, NO_IMAGE_DEPTH_FLAG, OFF_FRAME_FLAG, SKELETON3D_FORMAT,
-    Skeleton3d,
+    Skeleton3d, UNUSUAL_POSE_FLAG,
 };
 pub use tracks2d::{
     FrameTracks, NetworkBody, PointSource, SourceInfo, TRACKS2D_FORMAT, TRACKS2D_VERSION,

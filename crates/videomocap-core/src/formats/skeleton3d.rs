@@ -23,6 +23,11 @@ pub const OFF_FRAME_FLAG: &str = "off_frame:";
 /// depth choices there rest on the geometry alone).
 pub const NO_IMAGE_DEPTH_FLAG: &str = "no_image_depth";
 
+/// The frame flag for a pose the learned pose prior has (almost) never seen (a contortionist,
+/// a fall): the depth choices there rest on the image and smooth motion, not on what bodies
+/// usually do.
+pub const UNUSUAL_POSE_FLAG: &str = "unusual_pose";
+
 /// The prefix of the frame flag that marks a joint whose 2D track was lost (in a weak run too
 /// long to interpolate, `lost:left_wrist`): its 3D position rests on the tracker's guess.
 pub const LOST_FLAG: &str = "lost:";

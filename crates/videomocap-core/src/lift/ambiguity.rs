@@ -20,6 +20,7 @@
 //! bone on a frame ([`DepthOverrides`]) is a hard constraint.
 mod gait;
 mod margins;
+mod memo;
 mod priors;
 mod viterbi;
 mod weights;
@@ -27,31 +28,25 @@ mod weights;
 pub use priors::image_facing_cost;
 pub use weights::AmbiguityWeights;
 
+pub(crate) use memo::PriorMemo;
+
 use super::backproject::{Root, bone_roots};
+use super::prior::{PosePrior, PriorGroup, Side, TrunkFrame};
 use crate::formats::{FrameIndex, NetworkBody};
 use crate::skeleton::{BONE_COUNT, Bone, Joint, PerJoint, SubjectModel};
 use nalgebra::{Point3, Vector3};
-use priors::{TrunkFrame, hanging_cost, image_depth_cost, posture_cost, swing_cost};
+use priors::{hanging_cost, image_depth_cost, inside_body, swing_cost};
 use std::collections::BTreeMap;
 use viterbi::viterbi;
 
 /// Forced root choices: `(frame index, bone) → root`, set by a user flipping a limb.
 pub type DepthOverrides = BTreeMap<(FrameIndex, Bone), Root>;
 
-/// Which prior scores a group.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Prior {
-    Head,
-    Spine,
-    Hips,
-    Arm,
-    Leg,
-}
-
 /// Bones whose roots are chosen together.
 struct Group {
     bones: &'static [Bone],
-    prior: Prior,
+    /// The pose prior's group that scores them.
+    prior: PriorGroup,
 }
 
 use Joint::*;
@@ -64,40 +59,40 @@ pub const GROUP_COUNT: usize = 7;
 const GROUPS: [Group; GROUP_COUNT] = [
     Group {
         bones: &[Bone::new(Chest, Neck), Bone::new(Neck, HeadTop)],
-        prior: Prior::Head,
+        prior: PriorGroup::Head,
     },
     Group {
         bones: &[Bone::new(Pelvis, Chest)],
-        prior: Prior::Spine,
+        prior: PriorGroup::Spine,
     },
     Group {
         bones: &[Bone::new(Pelvis, LeftHip), Bone::new(Pelvis, RightHip)],
-        prior: Prior::Hips,
+        prior: PriorGroup::Hips,
     },
     Group {
         bones: &[Bone::new(LeftHip, LeftKnee), Bone::new(LeftKnee, LeftAnkle)],
-        prior: Prior::Leg,
+        prior: PriorGroup::Leg(Side::Left),
     },
     Group {
         bones: &[
             Bone::new(RightHip, RightKnee),
             Bone::new(RightKnee, RightAnkle),
         ],
-        prior: Prior::Leg,
+        prior: PriorGroup::Leg(Side::Right),
     },
     Group {
         bones: &[
             Bone::new(LeftShoulder, LeftElbow),
             Bone::new(LeftElbow, LeftWrist),
         ],
-        prior: Prior::Arm,
+        prior: PriorGroup::Arm(Side::Left),
     },
     Group {
         bones: &[
             Bone::new(RightShoulder, RightElbow),
             Bone::new(RightElbow, RightWrist),
         ],
-        prior: Prior::Arm,
+        prior: PriorGroup::Arm(Side::Right),
     },
 ];
 
@@ -122,8 +117,9 @@ pub struct Resolved {
     /// Whether each bone was too long for its 2D image (flagged, placed off its ray).
     pub too_long: Vec<[bool; BONE_COUNT]>,
     /// How much the clip-wide cost of the bone's group would rise, at best, were the bone to
-    /// take its other root on that frame (`margins`): small where the choice was close,
-    /// infinite where the user forced it.
+    /// take its other root on that frame (`margins`), in nats of the pose prior (the log of
+    /// the likelihood ratio of the two roots, smooth motion counted at the prior's weight):
+    /// small where the choice was close, infinite where the user forced it.
     pub margins: Vec<[f64; BONE_COUNT]>,
     /// The minimised total of each group of bones, priors (but the arms' swing and gait
     /// symmetry and the spine's look ahead, which only steer their roots) plus squared
@@ -157,6 +153,32 @@ pub fn resolve(
     weights: &AmbiguityWeights,
     overrides: &DepthOverrides,
 ) -> Resolved {
+    let memo = PriorMemo::new(key.len());
+    resolve_with(
+        key,
+        rays,
+        frame_index,
+        bodies,
+        subject,
+        weights,
+        overrides,
+        &memo,
+    )
+}
+
+/// [`resolve`] keeping the pose prior's costs in `memo` for the next solve of the same lift
+/// (the same rays, subject and weights).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn resolve_with(
+    key: &[[Point3<f64>; 3]],
+    rays: &[PerJoint<Vector3<f64>>],
+    frame_index: &[FrameIndex],
+    bodies: &[Option<NetworkBody>],
+    subject: &SubjectModel,
+    weights: &AmbiguityWeights,
+    overrides: &DepthOverrides,
+    memo: &PriorMemo,
+) -> Resolved {
     let n = key.len();
     let points: Vec<PerJoint<Point3<f64>>> = key
         .iter()
@@ -177,6 +199,10 @@ pub fn resolve(
         weights,
         overrides,
         trunks: &trunks,
+        prior: PosePrior::bundled()
+            .ok()
+            .filter(|_| weights.pose_prior > 0.0),
+        memo,
     };
     let mut resolved = Resolved {
         points,
@@ -221,6 +247,10 @@ struct Inputs<'a> {
     weights: &'a AmbiguityWeights,
     overrides: &'a DepthOverrides,
     trunks: &'a [TrunkFrame],
+    /// The learned pose prior (`None`: unreadable, checked before the lift runs).
+    prior: Option<&'a PosePrior>,
+    /// The prior's costs already computed in this lift.
+    memo: &'a PriorMemo,
 }
 
 /// Chooses the roots of group `g` over the whole sequence on the trajectories already chosen
@@ -240,11 +270,13 @@ fn solve_group(
         weights,
         overrides,
         trunks,
+        ..
     } = *inputs;
     let group = &GROUPS[g];
     let combos = 1usize << group.bones.len();
     let candidates: Vec<Vec<Candidate>> = (0..resolved.points.len())
         .map(|t| {
+            let nats = prior_costs(g, t, inputs, &resolved.points[t]);
             (0..combos)
                 .map(|combo| {
                     let mut p = resolved.points[t];
@@ -278,10 +310,7 @@ fn solve_group(
                     }
                     if c.unary.is_finite() {
                         c.steer = swing_cost(group, &p, &trunks[t], weights);
-                        if group.prior == Prior::Spine && weights.lookahead > 0.0 {
-                            c.steer += weights.lookahead
-                                * hanging_cost(&p, &rays[t], &trunks[t], subject, weights);
-                        }
+                        c.steer += weights.lookahead * weights.pose_prior * nats[combo].1;
                         if let Some(symmetry) = symmetry {
                             c.steer += weights.gait_symmetry * symmetry.cost(group, &p, t);
                         }
@@ -290,7 +319,11 @@ fn solve_group(
                         {
                             c.steer += weights.image_depth * image_depth_cost(group, &p, body);
                         }
-                        c.unary += posture_cost(group, &p, &trunks[t], subject, weights) + c.steer;
+                        if matches!(group.prior, PriorGroup::Arm(_)) {
+                            let end = group.bones[1].child;
+                            c.unary += weights.contact * inside_body(&p[end], &p, subject);
+                        }
+                        c.unary += weights.pose_prior * nats[combo].0 + c.steer;
                     }
                     c
                 })
@@ -308,6 +341,9 @@ fn solve_group(
         .sum();
     resolved.group_costs[g] = cost - steer;
     let marginals = margins::min_marginals(&candidates);
+    // Margins in nats of the prior: the clip's cost at the prior's default exchange rate, so a
+    // margin is the log-likelihood ratio of the bone's two roots (acceleration included).
+    let per_nat = AmbiguityWeights::default().pose_prior;
     for (t, &combo) in path.iter().enumerate() {
         let c = &candidates[t][combo];
         for (k, bone) in group.bones.iter().enumerate() {
@@ -320,9 +356,37 @@ fn solve_group(
                 .filter(|&o| root_of(o, k) != root_of(combo, k))
                 .map(|o| marginals[t][o])
                 .fold(f64::INFINITY, f64::min);
-            resolved.margins[t][b] = (other - cost).max(0.0);
+            resolved.margins[t][b] = (other - cost).max(0.0) / per_nat;
         }
     }
+}
+
+/// Group `g`'s candidates' pose prior on frame `t` (their joints placed from `p`): per
+/// combination of roots, its cost and, for the spine, the look ahead's (both nats; zeros
+/// without the prior). Read from the lift's memo where the joints they hang from are unchanged.
+fn prior_costs(
+    g: usize,
+    t: usize,
+    inputs: &Inputs<'_>,
+    p: &PerJoint<Point3<f64>>,
+) -> [(f64, f64); 4] {
+    let Some(prior) = inputs.prior else {
+        return [(0.0, 0.0); 4];
+    };
+    let group = &GROUPS[g];
+    let (rays, trunk, subject) = (&inputs.rays[t], &inputs.trunks[t], inputs.subject);
+    let look = group.prior == PriorGroup::Spine && inputs.weights.lookahead > 0.0;
+    inputs.memo.costs(t, g, group.prior, p, || {
+        let mut costs = [(0.0, 0.0); 4];
+        for (combo, c) in costs.iter_mut().enumerate().take(1 << group.bones.len()) {
+            let q = placed(g, combo, p, rays, subject);
+            c.0 = prior.cost(group.prior, &q, trunk);
+            if look {
+                c.1 = hanging_cost(&q, rays, trunk, subject, prior);
+            }
+        }
+        costs
+    })
 }
 
 /// The root a group's `combo` gives its `k`-th bone (bit `k`: 0 near, 1 far).

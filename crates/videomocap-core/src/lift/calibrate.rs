@@ -237,7 +237,9 @@ pub fn calibrate_from(
 
 /// Plausible starting poses: the triangle turned by yaws of 0° (facing the camera), ±45°, ±135°
 /// and 180° (turned away), each pitched by 0° and ±30°, at the depth implied by the least
-/// foreshortened side of the image triangle, its centroid on the centroid's ray.
+/// foreshortened side of the image triangle, its centroid on the centroid's ray. The yaws turn
+/// about the body's own up as the image shows it ([`image_roll`]), not the camera's: a body
+/// upside down or lying in the image starts from the same poses, turned with it, as upright.
 pub fn starting_poses(
     cam: &PinholeCamera,
     triangle: &KeyTriangle,
@@ -263,10 +265,12 @@ pub fn starting_poses(
     );
     let centroid_model =
         (triangle.points[0].coords + triangle.points[1].coords + triangle.points[2].coords) / 3.0;
+    let roll = Rotation3::from_axis_angle(&Vector3::z_axis(), image_roll(image));
     let mut poses = Vec::new();
     for yaw in [0.0f64, 45.0, -45.0, 135.0, -135.0, 180.0] {
         for pitch in [0.0f64, 30.0, -30.0] {
-            let rotation = Rotation3::from_axis_angle(&Vector3::y_axis(), yaw.to_radians())
+            let rotation = roll
+                * Rotation3::from_axis_angle(&Vector3::y_axis(), yaw.to_radians())
                 * Rotation3::from_axis_angle(&Vector3::x_axis(), pitch.to_radians());
             poses.push(Pose {
                 rotation,
@@ -275,6 +279,20 @@ pub fn starting_poses(
         }
     }
     poses
+}
+
+/// How far the body's up is turned in the image from the camera's up (radians about the
+/// optical axis), to the nearest quarter turn: the direction from the chest to the shoulders'
+/// midpoint against the image's up (−y). An upright body gives 0 (the starts already cover a
+/// lean: pitches of ±30°, yaws 45° apart), a body upside down half a turn, one lying a quarter.
+fn image_roll(image: &[Point2<f64>; 3]) -> f64 {
+    let up = nalgebra::center(&image[0], &image[1]) - image[2];
+    if up.norm() < 1e-9 {
+        return 0.0;
+    }
+    // The angle that turns the image's up (0, −1) onto `up`.
+    let angle = up.y.atan2(up.x) + std::f64::consts::FRAC_PI_2;
+    (angle / std::f64::consts::FRAC_PI_2).round() * std::f64::consts::FRAC_PI_2
 }
 
 /// Every distinct pose that fits the image within `tolerance_px`, best fit first. A three-point

@@ -43,6 +43,8 @@ pub enum LiftError {
         given_m: f64,
         seen_m: f64,
     },
+    #[error(transparent)]
+    Prior(#[from] super::prior::PriorError),
     #[error("cancelled")]
     Cancelled,
 }

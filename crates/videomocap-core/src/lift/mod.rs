@@ -32,6 +32,7 @@ mod least_squares;
 mod newton;
 mod params;
 mod pipeline;
+mod prior;
 mod propagate;
 mod refine;
 mod report;
@@ -49,6 +50,9 @@ pub use focal::{DEFAULT_FOV_LONG_SIDE_DEG, default_focal};
 pub use params::{LiftParams, retired_lift_settings};
 pub use pipeline::{
     CameraChoice, FocalSource, LiftStage, Reconstruction, SubjectChoice, reconstruct,
+};
+pub use prior::{
+    BUNDLED_PRIOR, Component, GroupFile, PosePrior, PriorError, PriorFile, PriorGroup, Side, learn,
 };
 pub use refine::RefineParams;
 pub use report::{BoneDepth, FrameFlag, FrameReport, UNSURE_MARGIN};

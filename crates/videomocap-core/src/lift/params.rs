@@ -41,6 +41,9 @@ pub struct LiftParams {
     /// where the tracks carry it (default 1; 0 = geometry alone, which also turns off the
     /// refinement's pull towards the network's bone directions).
     pub image_depth: f64,
+    /// How much the pose prior learned from motion capture counts in each bone's depth choice
+    /// (default 1; 0 = the geometry alone: the 2D miss and smooth motion).
+    pub pose_prior: f64,
 }
 
 impl Default for LiftParams {
@@ -55,6 +58,7 @@ impl Default for LiftParams {
             arm_swing: fitted.arm_swing,
             hands_outside_body: fitted.contact,
             image_depth: fitted.image_depth,
+            pose_prior: 1.0,
         }
     }
 }
@@ -73,7 +77,9 @@ impl LiftParams {
             arm_swing,
             hands_outside_body,
             image_depth,
+            pose_prior,
         } = *self;
+        check_setting("pose_prior", pose_prior, false)?;
         check_setting("smoothing_s", smoothing_s, false)?;
         check_setting("arm_swing", arm_swing, false)?;
         check_setting("hands_outside_body", hands_outside_body, false)?;
@@ -86,6 +92,7 @@ impl LiftParams {
             arm_swing: self.arm_swing,
             contact: self.hands_outside_body,
             image_depth: self.image_depth,
+            pose_prior: self.pose_prior * AmbiguityWeights::default().pose_prior,
             // The facing's evidence comes from the same network body: off with it.
             image_facing: if self.image_depth > 0.0 {
                 AmbiguityWeights::default().image_facing
@@ -143,6 +150,7 @@ struct StoredLiftParams {
     arm_swing: Option<f64>,
     hands_outside_body: Option<f64>,
     image_depth: Option<f64>,
+    pose_prior: Option<f64>,
     // Renamed.
     key_path_smoothing: Option<bool>,
     ambiguity: Option<OldAmbiguity>,
@@ -180,6 +188,7 @@ impl Default for StoredLiftParams {
             arm_swing: None,
             hands_outside_body: None,
             image_depth: None,
+            pose_prior: None,
             key_path_smoothing: None,
             ambiguity: None,
             calibration_tolerance_px: None,
@@ -211,6 +220,7 @@ impl From<StoredLiftParams> for LiftParams {
                 .or(old.contact)
                 .unwrap_or(d.hands_outside_body),
             image_depth: s.image_depth.or(old.image_depth).unwrap_or(d.image_depth),
+            pose_prior: s.pose_prior.unwrap_or(d.pose_prior),
         }
     }
 }

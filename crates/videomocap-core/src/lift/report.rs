@@ -25,6 +25,9 @@ pub enum FrameFlag {
     /// The pose network saw no body on this frame while it did on others: the depth choices
     /// here rest on the geometry alone.
     NoImageDepth,
+    /// The pose learned from motion capture ([`super::PosePrior`]) finds this frame's pose
+    /// unusual: its summed cost is beyond what 999 in 1000 learned poses reach.
+    UnusualPose,
 }
 
 impl fmt::Display for FrameFlag {
@@ -35,6 +38,7 @@ impl fmt::Display for FrameFlag {
             FrameFlag::OffFrame(j) => write!(f, "{}{}", crate::formats::OFF_FRAME_FLAG, j.name()),
             FrameFlag::Lost(j) => write!(f, "{}{}", crate::formats::LOST_FLAG, j.name()),
             FrameFlag::NoImageDepth => f.write_str(crate::formats::NO_IMAGE_DEPTH_FLAG),
+            FrameFlag::UnusualPose => f.write_str(crate::formats::UNUSUAL_POSE_FLAG),
         }
     }
 }
@@ -50,9 +54,10 @@ pub struct FrameReport {
     pub flags: Vec<FrameFlag>,
 }
 
-/// The clip-wide cost margin under which a bone's depth choice is shown unsure
-/// ([`BoneDepth::unsure`]), in the units of the ambiguity's costs (squared metres).
-pub const UNSURE_MARGIN: f64 = 0.01;
+/// The clip-wide margin under which a bone's depth choice is shown unsure
+/// ([`BoneDepth::unsure`]), nats: the log of the likelihood ratio of its two roots under the
+/// pose prior and smooth motion. Chosen on the suite's dev split (`docs/method.md`, issue 94).
+pub const UNSURE_MARGIN: f64 = 5.0;
 
 /// One bone's depth choice on one frame.
 #[derive(Debug, Clone, Copy, PartialEq)]

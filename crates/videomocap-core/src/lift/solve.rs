@@ -3,7 +3,7 @@
 //! (`facing`), the depth roots (`ambiguity`), the optional global refinement (`refine`), the
 //! per-frame report and the planted feet (`contact`). Its settings are in `params`.
 
-use super::ambiguity::{DepthOverrides, Resolved, resolve};
+use super::ambiguity::{DepthOverrides, PriorMemo, Resolved, resolve_with};
 use super::facing::facing_by_segments;
 use super::key_candidates::{deepest_trunk, key_candidates, plausible_key, smoothest_key_path};
 use super::params::LiftParams;
@@ -86,6 +86,9 @@ pub struct LiftOutput {
 /// Checks the job's inputs.
 fn check(job: &LiftJob<'_>) -> Result<(), LiftError> {
     job.params.validate()?;
+    if job.params.pose_prior > 0.0 {
+        super::prior::PosePrior::bundled()?;
+    }
     let f = job.camera.focal_px;
     if !(f.is_finite() && f > 0.0) {
         return Err(LiftError::BadFocal(f));
@@ -225,6 +228,8 @@ fn per_frame_solve(
     let noise_px = median_noise_px(tracks, &KEY_JOINTS);
     let mut best: Option<(f64, Vec<FrameReport>, Resolved)> = None;
     let weights = job.params.ambiguity();
+    // The prior's costs, kept between the whole-clip solves below (same rays and subject).
+    let memo = PriorMemo::new(n);
     // Every frame's candidate poses, computed once.
     let per_frame: Vec<(Vec<[Point3<f64>; 3]>, bool)> = (0..n)
         .map(|t| {
@@ -260,7 +265,7 @@ fn per_frame_solve(
         }
         // The whole body built on a key path, and how well it explains the clip.
         let build = |key: &[[Point3<f64>; 3]]| {
-            let resolved = resolve(
+            let resolved = resolve_with(
                 key,
                 &rays,
                 &frame_index,
@@ -268,6 +273,7 @@ fn per_frame_solve(
                 &job.subject,
                 &weights,
                 &job.overrides,
+                &memo,
             );
             let miss: f64 = (0..n)
                 .map(|t| miss_m(cam, &resolved.points[t], &images[t]))
@@ -319,6 +325,7 @@ fn per_frame_solve(
             let lengths = &job.subject.bone_length_m;
             let solved = (&resolved.points[..], &images[..], lengths);
             flag_too_long(job, &mut reports, solved, doubt, shortened);
+            flag_unusual(job, &mut reports, &resolved);
             best = Some((score, reports, resolved));
         }
     }
@@ -356,6 +363,23 @@ pub fn fit_score(miss_m: f64, group_costs: &[f64]) -> f64 {
         .chain(group_costs.iter().copied())
         .map(|c| c.max(FIT_FLOOR).ln())
         .sum()
+}
+
+/// Flags the frames whose pose the learned prior finds unusual ([`FrameFlag::UnusualPose`]),
+/// the camera's up (−Y) standing in for the world's.
+fn flag_unusual(job: &LiftJob<'_>, reports: &mut [FrameReport], resolved: &Resolved) {
+    let Some(prior) = super::prior::PosePrior::bundled()
+        .ok()
+        .filter(|_| job.params.pose_prior > 0.0)
+    else {
+        return;
+    };
+    let up = -nalgebra::Vector3::y();
+    for (report, p) in reports.iter_mut().zip(&resolved.points) {
+        if prior.is_unusual(p, &up) {
+            report.flags.push(FrameFlag::UnusualPose);
+        }
+    }
 }
 
 /// Each frame's 3D body from the pose network, where the tracks carry one.

@@ -161,6 +161,15 @@ pub fn report(out: &LiftOutput, foot_lock: bool, global: &GlobalArgs) {
             ),
         );
     }
+    let unusual = count(&|f| matches!(f, FrameFlag::UnusualPose));
+    if unusual > 0 {
+        say(
+            global,
+            &format!(
+                "frames whose pose the learned prior has seen seldom or never (depth from the image and motion): {unusual}"
+            ),
+        );
+    }
     if let Some(r) = &out.refinement {
         say(
             global,

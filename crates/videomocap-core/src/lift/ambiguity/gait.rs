@@ -2,7 +2,7 @@
 //! and running each arm repeats the other's swing half a stride later, mirrored left to right.
 //! The lag is read from the thighs (solved before the arms), whose forward swing alternates.
 
-use super::priors::TrunkFrame;
+use super::super::prior::TrunkFrame;
 use super::{Group, LeftElbow, LeftShoulder, LeftWrist, RightElbow, RightShoulder, RightWrist};
 use super::{Joint, LeftHip, LeftKnee, RightHip, RightKnee};
 use crate::skeleton::PerJoint;

@@ -41,10 +41,18 @@ fn standing(
     )
 }
 
-/// The prior of group `g` on pose `p`, with the default weights.
+/// The bundled pose prior's cost of group `g` on pose `p` (nats) with the arms' swing and
+/// contact terms at their default weights over the prior's.
 fn group_prior(g: usize, p: &PerJoint<Point3<f64>>, subject: &SubjectModel) -> f64 {
     let (trunk, w) = (TrunkFrame::of(p), AmbiguityWeights::default());
-    posture_cost(&GROUPS[g], p, &trunk, subject, &w) + swing_cost(&GROUPS[g], p, &trunk, &w)
+    let prior = PosePrior::bundled().unwrap();
+    let mut cost = prior.cost(GROUPS[g].prior, p, &trunk)
+        + swing_cost(&GROUPS[g], p, &trunk, &w) / w.pose_prior;
+    if matches!(GROUPS[g].prior, PriorGroup::Arm(_)) {
+        let end = GROUPS[g].bones[1].child;
+        cost += w.contact * inside_body(&p[end], p, subject) / w.pose_prior;
+    }
+    cost
 }
 
 /// The prior of group `g` on a standing body with its limbs along the given directions.
@@ -74,19 +82,10 @@ fn the_priors_prefer_the_anatomical_of_two_mirror_images() {
     let hinge = prior_of(left_leg(), |_| [down, down, down, dir(0.0, -1.0, -0.6)]);
     let sideways = prior_of(left_leg(), |s| [down, down, down, dir(0.6 * s, -1.0, 0.0)]);
     assert!(hinge < sideways, "{hinge} {sideways}");
-    // Of two forearms bent forwards, the straighter.
-    let slight = prior_of(left_arm(), |_| [down, dir(0.0, -1.0, 0.3), down, down]);
-    let strong = prior_of(left_arm(), |_| [down, dir(0.0, -1.0, 1.5), down, down]);
-    assert!(slight < strong, "{slight} {strong}");
-    // Of an arm raised sideways in the frontal plane and the same arm tilted forwards, the
-    // frontal one.
-    let frontal = prior_of(left_arm(), |s| {
-        [dir(s, 0.5, 0.0), dir(s, 0.5, 0.0), down, down]
-    });
-    let tilted = prior_of(left_arm(), |s| {
-        [dir(s, 0.5, 0.4), dir(s, 0.5, 0.4), down, down]
-    });
-    assert!(frontal < tilted, "{frontal} {tilted}");
+    // A hanging elbow bent forwards, or as far backwards.
+    let forwards = prior_of(left_arm(), |_| [down, dir(0.0, -1.0, 0.6), down, down]);
+    let backwards = prior_of(left_arm(), |_| [down, dir(0.0, -1.0, -0.6), down, down]);
+    assert!(forwards < backwards, "{forwards} {backwards}");
 }
 
 #[test]
@@ -130,16 +129,12 @@ fn a_hanging_hand_stays_out_of_the_thigh() {
     let (outside, inside) = (pose(1.0), pose(-1.0));
     assert!(inside_body(&inside[LeftWrist], &inside, &subject) > 0.0);
     assert_eq!(inside_body(&outside[LeftWrist], &outside, &subject), 0.0);
-    let cost = |p: &PerJoint<Point3<f64>>, contact: f64| {
-        let w = AmbiguityWeights {
-            contact,
-            ..AmbiguityWeights::default()
-        };
-        posture_cost(&GROUPS[left_arm()], p, &TrunkFrame::of(p), &subject, &w)
-    };
-    // Without the contact term nothing else tells the two apart; with it, the hand outside.
-    assert!((cost(&outside, 0.0) - cost(&inside, 0.0)).abs() < 1e-12);
-    assert!(cost(&outside, 10.0) < cost(&inside, 10.0));
+    // With the contact term the hand outside costs less.
+    let (o, i) = (
+        group_prior(left_arm(), &outside, &subject),
+        group_prior(left_arm(), &inside, &subject),
+    );
+    assert!(o < i, "{o} {i}");
 }
 
 #[test]
@@ -160,24 +155,6 @@ fn a_head_looking_down_leans_forwards_not_sideways() {
     };
     let (forwards, sideways) = (head(-0.14, 0.64, 0.75), head(-0.42, 0.73, 0.53));
     assert!(forwards < sideways, "{forwards} {sideways}");
-}
-
-#[test]
-fn a_hanging_arm_swung_back_rests_nearer_the_body() {
-    // The left arm straight, swung 0.4 back (the same forward tilt both times, so the
-    // frontal prior cannot tell them apart), 0.04 or 0.22 outwards. Without REST_SWING the
-    // nearest to the rest pose at this tilt lies 0.137 out, nearer the second; swung back
-    // the rest pose comes in (walk_across_side's arm hangs 0.14 inwards) and the first wins.
-    let arm = |out: f64| {
-        let forward: f64 = -0.4;
-        let down = (1.0 - out * out - forward * forward).sqrt();
-        prior_of(left_arm(), |s| {
-            let d = Vector3::new(out * s, -down, forward);
-            [d, d, -Vector3::y(), -Vector3::y()]
-        })
-    };
-    let (near, far) = (arm(0.04), arm(0.22));
-    assert!(near < far, "{near} {far}");
 }
 
 /// The group holding `bone`.
@@ -202,12 +179,16 @@ fn left_leg() -> usize {
 fn in_a_stride_each_arm_swings_against_its_own_thigh() {
     let dir = |x: f64, y: f64, z: f64| Vector3::new(x, y, z).normalize();
     // The left arm 0.3 forwards or backwards, the left thigh `thigh` forwards and the right
-    // one as far backwards (a stride), or both thighs straight down (standing).
+    // one as far backwards (a stride), or both thighs straight down (standing): the swing
+    // term alone (the learned prior has its own view of the arm, weighed against it).
     let arm = |z: f64, thigh: f64| {
-        prior_of(left_arm(), |s| {
+        let subject = SubjectModel::default();
+        let p = standing(&subject, |s| {
             let t = dir(0.0, -1.0, s * thigh);
             [dir(0.2 * s, -1.0, z), dir(0.2 * s, -1.0, z), t, t]
-        })
+        });
+        let w = AmbiguityWeights::default();
+        swing_cost(&GROUPS[left_arm()], &p, &TrunkFrame::of(&p), &w)
     };
     // Left leg back: the left arm forwards.
     let (against, with) = (arm(0.3, -0.4), arm(-0.3, -0.4));
@@ -215,8 +196,8 @@ fn in_a_stride_each_arm_swings_against_its_own_thigh() {
     // Left leg forwards: the left arm backwards.
     let (against, with) = (arm(-0.3, 0.4), arm(0.3, 0.4));
     assert!(against < with, "{against} {with}");
-    // Standing: the swing term costs forwards and backwards the same (nothing: the rest of
-    // the prior, REST_SWING, still tells them apart).
+    // Standing: the swing term costs forwards and backwards the same (nothing: the pose
+    // prior still tells them apart).
     let swing = |z: f64| {
         let subject = SubjectModel::default();
         let p = standing(&subject, |s| {
@@ -312,7 +293,9 @@ fn the_arms_swing_stays_out_of_the_reported_cost() {
     let with = solve(1.0, &DepthOverrides::new());
     assert!(wrong(&with).is_empty(), "{:?}", wrong(&with));
     // The same roots without the swing: every group reports the same cost.
-    let arms = GROUPS.iter().filter(|g| g.prior == Prior::Arm);
+    let arms = GROUPS
+        .iter()
+        .filter(|g| matches!(g.prior, PriorGroup::Arm(_)));
     let forced: DepthOverrides = arms
         .flat_map(|g| g.bones.iter())
         .flat_map(|&bone| (0..frames.len()).map(move |t| (t, bone)))
@@ -327,9 +310,17 @@ fn the_arms_swing_stays_out_of_the_reported_cost() {
 
 #[test]
 fn the_groups_named_for_the_look_ahead_and_the_gait_are_the_hips_legs_and_arms() {
-    assert!(GROUPS[HIPS_GROUP].prior == Prior::Hips);
-    assert!(LEG_GROUPS.iter().all(|&g| GROUPS[g].prior == Prior::Leg));
-    assert!(ARM_GROUPS.iter().all(|&g| GROUPS[g].prior == Prior::Arm));
+    assert!(GROUPS[HIPS_GROUP].prior == PriorGroup::Hips);
+    let legs = LEG_GROUPS.map(|g| GROUPS[g].prior);
+    assert_eq!(
+        legs,
+        [PriorGroup::Leg(Side::Left), PriorGroup::Leg(Side::Right)]
+    );
+    let arms = ARM_GROUPS.map(|g| GROUPS[g].prior);
+    assert_eq!(
+        arms,
+        [PriorGroup::Arm(Side::Left), PriorGroup::Arm(Side::Right)]
+    );
     // Left first: the gait's symmetry pairs each arm with the other.
     assert_eq!(GROUPS[ARM_GROUPS[0]].bones[0].parent, LeftShoulder);
     assert_eq!(GROUPS[ARM_GROUPS[1]].bones[0].parent, RightShoulder);
@@ -355,10 +346,7 @@ fn the_spine_looks_ahead_at_the_legs_hanging_from_it() {
     );
     let (key, rays, index) = seen(&frames);
     let solve = |lookahead: f64| {
-        // The spine's own prior blind: only the look ahead tells its roots apart.
         let w = AmbiguityWeights {
-            trunk_up: 0.0,
-            extension: 0.0,
             lookahead,
             ..AmbiguityWeights::default()
         };
@@ -377,9 +365,27 @@ fn the_spine_looks_ahead_at_the_legs_hanging_from_it() {
             .filter(|&t| (r.points[t][Pelvis] - frames[t][Pelvis]).norm() > 1e-6)
             .count()
     };
-    assert_eq!(pelvis_wrong(&solve(0.3)), 0);
-    // Without it the tie takes the mirror root on every frame.
-    assert_eq!(pelvis_wrong(&solve(0.0)), frames.len());
+    assert_eq!(
+        pelvis_wrong(&solve(AmbiguityWeights::default().lookahead)),
+        0
+    );
+    // On every frame the look ahead alone (the least prior of the hips and legs hung from
+    // each pelvis root) prefers the true root: its legs need not bend or splay.
+    let prior = PosePrior::bundled().unwrap();
+    let spine = group_of(Bone::new(Pelvis, Chest));
+    for (t, truth) in frames.iter().enumerate() {
+        let costs = [0, 1].map(|combo| {
+            let q = placed(spine, combo, truth, &rays[t], &subject);
+            let cost = hanging_cost(&q, &rays[t], &TrunkFrame::of(truth), &subject, prior);
+            ((q[Pelvis] - truth[Pelvis]).norm() < 1e-6, cost)
+        });
+        let (right, wrong) = if costs[0].0 {
+            (costs[0], costs[1])
+        } else {
+            (costs[1], costs[0])
+        };
+        assert!(right.0 && right.1 < wrong.1, "frame {t}: {costs:?}");
+    }
 }
 
 /// The prior of group `g` on a standing body facing +Z whose `bone` points along `dir`

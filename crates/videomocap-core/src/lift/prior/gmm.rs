@@ -1,0 +1,355 @@
+//! A Gaussian mixture with full covariances: its density (through each component's Cholesky
+//! factor) and its fit by expectation–maximisation from k-means++ seeds.
+
+use serde::{Deserialize, Serialize};
+
+/// One component: weight, mean and the lower Cholesky factor of its covariance (row-major,
+/// `dims × dims`, upper part zero).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Component {
+    /// Mixing weight (the components' sum to 1).
+    pub weight: f64,
+    /// Mean.
+    pub mean: Vec<f64>,
+    /// Lower Cholesky factor `L` of the covariance `L Lᵀ`, row-major.
+    pub cov_chol: Vec<f64>,
+}
+
+/// A Gaussian mixture over `dims`-vectors, with what its density needs precomputed per
+/// component and packed in one slice (no allocation when it is evaluated): the normalising
+/// constant's log, the mean, and the inverse of the covariance's Cholesky factor.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Gmm {
+    pub(crate) dims: usize,
+    pub(crate) components: Vec<Component>,
+    /// Per component [`Gmm::stride`] numbers: ln weight − ½ d ln 2π − Σ ln Lᵢᵢ (the log of the
+    /// weight over the normalising constant, the log-determinant taken from the factor's
+    /// diagonal), the mean (`dims`), then `L⁻¹` (lower triangular, row by row, `dims (dims + 1)
+    /// / 2`), so that (x − μ)ᵀ Σ⁻¹ (x − μ) = |L⁻¹ (x − μ)|².
+    packed: Vec<f64>,
+}
+
+/// The most dimensions a mixture may have (the pose prior's largest group has 9).
+pub const MAX_DIMS: usize = 16;
+
+impl Gmm {
+    /// A mixture from its components; `Err` names what is wrong (dimensions, weights, a factor
+    /// that is not positive definite, a number that is not finite).
+    pub fn new(dims: usize, components: Vec<Component>) -> Result<Gmm, String> {
+        if components.is_empty() {
+            return Err("a mixture without components".to_owned());
+        }
+        if dims == 0 || dims > MAX_DIMS {
+            return Err(format!("{dims} dimensions (1 to {MAX_DIMS})"));
+        }
+        let mut packed = Vec::with_capacity(components.len() * stride(dims));
+        let mut total = 0.0;
+        for (k, c) in components.iter().enumerate() {
+            if c.mean.len() != dims || c.cov_chol.len() != dims * dims {
+                return Err(format!("component {k}: not {dims} dimensions"));
+            }
+            if !(c.weight.is_finite() && c.weight > 0.0) {
+                return Err(format!(
+                    "component {k}: weight {} is not positive",
+                    c.weight
+                ));
+            }
+            if c.mean.iter().chain(&c.cov_chol).any(|v| !v.is_finite()) {
+                return Err(format!("component {k}: a number that is not finite"));
+            }
+            let mut log_det = 0.0;
+            for i in 0..dims {
+                let d = c.cov_chol[i * dims + i];
+                if d <= 0.0 {
+                    return Err(format!("component {k}: covariance not positive definite"));
+                }
+                log_det += d.ln();
+            }
+            let inverse = lower_inverse(&c.cov_chol, dims);
+            if inverse.iter().any(|v| !v.is_finite()) {
+                return Err(format!("component {k}: covariance not invertible"));
+            }
+            total += c.weight;
+            packed.push(
+                c.weight.ln() - 0.5 * dims as f64 * (2.0 * std::f64::consts::PI).ln() - log_det,
+            );
+            packed.extend_from_slice(&c.mean);
+            for i in 0..dims {
+                packed.extend_from_slice(&inverse[i * dims..i * dims + i + 1]);
+            }
+        }
+        if (total - 1.0).abs() > 1e-3 {
+            return Err(format!("weights sum to {total}, not 1"));
+        }
+        Ok(Gmm {
+            dims,
+            components,
+            packed,
+        })
+    }
+
+    /// Each component's log term at `x`: ln(weight · N(x; μ, Σ)), in order.
+    fn terms<'a>(&'a self, x: &'a [f64]) -> impl Iterator<Item = f64> + 'a {
+        let dims = self.dims;
+        self.packed.chunks_exact(stride(dims)).map(move |c| {
+            let (mean, inverse) = c[1..].split_at(dims);
+            let mut d = [0.0f64; MAX_DIMS];
+            for i in 0..dims {
+                d[i] = x[i] - mean[i];
+            }
+            let mut sum = 0.0;
+            let mut row = 0;
+            for i in 0..dims {
+                let y: f64 = inverse[row..row + i + 1]
+                    .iter()
+                    .zip(&d[..=i])
+                    .map(|(a, b)| a * b)
+                    .sum();
+                sum += y * y;
+                row += i + 1;
+            }
+            c[0] - 0.5 * sum
+        })
+    }
+
+    /// The log density at `x` (`x.len() == dims`): the components' terms summed by a running
+    /// log-sum-exp.
+    pub fn log_density(&self, x: &[f64]) -> f64 {
+        let (mut best, mut sum) = (f64::NEG_INFINITY, 0.0);
+        for t in self.terms(x) {
+            if t > best {
+                sum = sum * (best - t).exp() + 1.0;
+                best = t;
+            } else {
+                sum += (t - best).exp();
+            }
+        }
+        if best.is_finite() {
+            best + sum.ln()
+        } else {
+            best
+        }
+    }
+
+    /// The highest log density over the components' means (about the mixture's mode).
+    pub fn peak(&self) -> f64 {
+        self.components
+            .iter()
+            .map(|c| self.log_density(&c.mean))
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+}
+
+/// How many numbers one component takes in [`Gmm::packed`].
+fn stride(dims: usize) -> usize {
+    1 + dims + dims * (dims + 1) / 2
+}
+
+/// The inverse of a lower triangular `dims × dims` matrix with a positive diagonal (row-major;
+/// lower triangular too), by forward substitution column by column.
+fn lower_inverse(l: &[f64], dims: usize) -> Vec<f64> {
+    let mut inv = vec![0.0; dims * dims];
+    for col in 0..dims {
+        for i in col..dims {
+            let mut v = if i == col { 1.0 } else { 0.0 };
+            for j in col..i {
+                v -= l[i * dims + j] * inv[j * dims + col];
+            }
+            inv[i * dims + col] = v / l[i * dims + i];
+        }
+    }
+    inv
+}
+
+/// The lower Cholesky factor of a symmetric `dims × dims` matrix (row-major); `None` if it is
+/// not positive definite.
+fn cholesky(a: &[f64], dims: usize) -> Option<Vec<f64>> {
+    let mut l = vec![0.0; dims * dims];
+    for i in 0..dims {
+        for j in 0..=i {
+            let mut s = a[i * dims + j];
+            for k in 0..j {
+                s -= l[i * dims + k] * l[j * dims + k];
+            }
+            if i == j {
+                if s <= 0.0 {
+                    return None;
+                }
+                l[i * dims + i] = s.sqrt();
+            } else {
+                l[i * dims + j] = s / l[j * dims + j];
+            }
+        }
+    }
+    Some(l)
+}
+
+/// Fits a `k`-component mixture to `data` (each `dims` long) by expectation–maximisation,
+/// `iterations` rounds from k-means++ seeds drawn by a fixed linear congruential sequence (so
+/// the same data give the same file). `floor` is added to every covariance's diagonal (the
+/// directions of unit vectors and of mirrored pairs lie on lower-dimensional sets). `Err` where
+/// `dims` is beyond [`MAX_DIMS`].
+pub fn fit(
+    data: &[Vec<f64>],
+    dims: usize,
+    k: usize,
+    iterations: usize,
+    floor: f64,
+) -> Result<Gmm, String> {
+    let n = data.len();
+    let mut state: u64 = 0x9e37_79b9_7f4a_7c15;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let dist = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>();
+    // k-means++ seeds.
+    let mut means: Vec<Vec<f64>> = vec![data[(next() * n as f64) as usize % n].clone()];
+    let mut nearest: Vec<f64> = data.iter().map(|x| dist(x, &means[0])).collect();
+    while means.len() < k {
+        let total: f64 = nearest.iter().sum();
+        let mut pick = next() * total;
+        let mut chosen = n - 1;
+        for (i, d) in nearest.iter().enumerate() {
+            pick -= d;
+            if pick <= 0.0 {
+                chosen = i;
+                break;
+            }
+        }
+        means.push(data[chosen].clone());
+        for (d, x) in nearest.iter_mut().zip(data) {
+            *d = d.min(dist(x, &data[chosen]));
+        }
+    }
+    let spread = data.iter().map(|x| dist(x, &means[0])).sum::<f64>() / (n * dims) as f64;
+    let identity = |s: f64| -> Vec<f64> {
+        (0..dims * dims)
+            .map(|i| if i % (dims + 1) == 0 { s } else { 0.0 })
+            .collect()
+    };
+    let mut components: Vec<Component> = means
+        .into_iter()
+        .map(|mean| Component {
+            weight: 1.0 / k as f64,
+            mean,
+            cov_chol: identity(spread.max(floor).sqrt()),
+        })
+        .collect();
+    let mut resp = vec![0.0; n * k];
+    for _ in 0..iterations {
+        let Ok(gmm) = Gmm::new(dims, components.clone()) else {
+            break;
+        };
+        // E step.
+        for (i, x) in data.iter().enumerate() {
+            let logs: Vec<f64> = gmm.terms(x).collect();
+            let best = logs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let sum: f64 = logs.iter().map(|l| (l - best).exp()).sum();
+            for (j, l) in logs.iter().enumerate() {
+                resp[i * k + j] = (l - best).exp() / sum;
+            }
+        }
+        // M step.
+        for (j, c) in components.iter_mut().enumerate() {
+            let weight: f64 = (0..n).map(|i| resp[i * k + j]).sum();
+            if weight < 1e-6 {
+                continue;
+            }
+            let mut mean = vec![0.0; dims];
+            for (i, x) in data.iter().enumerate() {
+                for (m, v) in mean.iter_mut().zip(x) {
+                    *m += resp[i * k + j] * v;
+                }
+            }
+            mean.iter_mut().for_each(|m| *m /= weight);
+            let mut cov = identity(floor);
+            for (i, x) in data.iter().enumerate() {
+                let r = resp[i * k + j] / weight;
+                for a in 0..dims {
+                    for b in 0..=a {
+                        cov[a * dims + b] += r * (x[a] - mean[a]) * (x[b] - mean[b]);
+                    }
+                }
+            }
+            for a in 0..dims {
+                for b in 0..a {
+                    cov[b * dims + a] = cov[a * dims + b];
+                }
+            }
+            if let Some(l) = cholesky(&cov, dims) {
+                c.weight = weight / n as f64;
+                c.mean = mean;
+                c.cov_chol = l;
+            }
+        }
+        let total: f64 = components.iter().map(|c| c.weight).sum();
+        components.iter_mut().for_each(|c| c.weight /= total);
+    }
+    components.retain(|c| c.weight > 1e-9);
+    let total: f64 = components.iter().map(|c| c.weight).sum();
+    components.iter_mut().for_each(|c| c.weight /= total);
+    Gmm::new(dims, components).or_else(|_| {
+        let standard = Component {
+            weight: 1.0,
+            mean: vec![0.0; dims],
+            cov_chol: identity(1.0),
+        };
+        Gmm::new(dims, vec![standard])
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One standard normal component: the log density is the textbook one.
+    #[test]
+    fn a_single_standard_normal_has_the_textbook_density() {
+        let g = Gmm::new(
+            2,
+            vec![Component {
+                weight: 1.0,
+                mean: vec![0.0, 0.0],
+                cov_chol: vec![1.0, 0.0, 0.0, 1.0],
+            }],
+        )
+        .unwrap();
+        let want = -(2.0 * std::f64::consts::PI).ln() - 0.5 * (1.0 + 4.0);
+        assert!((g.log_density(&[1.0, 2.0]) - want).abs() < 1e-12);
+    }
+
+    /// Two clusters far apart: the fit finds both means and gives points between them a lower
+    /// density than points at either.
+    #[test]
+    fn the_fit_finds_two_separate_clusters() {
+        let mut data = Vec::new();
+        for i in 0..200 {
+            let e = (i as f64 * 0.37).sin() * 0.1;
+            data.push(vec![-2.0 + e, 1.0 - e]);
+            data.push(vec![3.0 - e, -1.0 + e]);
+        }
+        let g = fit(&data, 2, 2, 30, 1e-4).unwrap();
+        let mut means: Vec<f64> = g.components.iter().map(|c| c.mean[0]).collect();
+        means.sort_by(f64::total_cmp);
+        assert!((means[0] + 2.0).abs() < 0.05 && (means[1] - 3.0).abs() < 0.05);
+        assert!(g.log_density(&[0.5, 0.0]) < g.log_density(&[-2.0, 1.0]) - 10.0);
+    }
+
+    /// What a file may hold wrongly is refused with the reason.
+    #[test]
+    fn a_component_that_is_not_positive_definite_is_refused() {
+        let bad = Component {
+            weight: 1.0,
+            mean: vec![0.0],
+            cov_chol: vec![0.0],
+        };
+        assert!(
+            Gmm::new(1, vec![bad])
+                .unwrap_err()
+                .contains("positive definite")
+        );
+    }
+}
