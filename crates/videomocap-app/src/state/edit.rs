@@ -389,7 +389,7 @@ mod tests {
         let near = BoneDepth {
             root: Root::Near,
             single_root: false,
-            margin: 1.0,
+            margin: 2.0 * videomocap_core::lift::UNSURE_MARGIN,
         };
         let mut bones = vec![[near; BONE_COUNT]; frames];
         bones[0][4].single_root = true;
@@ -524,7 +524,7 @@ mod tests {
         let sure = BoneDepth {
             root: Root::Near,
             single_root: false,
-            margin: 1.0,
+            margin: 2.0 * videomocap_core::lift::UNSURE_MARGIN,
         };
         let mut bones = vec![[sure; BONE_COUNT]; 2];
         let forearm = Bone::new(Joint::LeftElbow, Joint::LeftWrist);

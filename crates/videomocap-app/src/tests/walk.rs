@@ -29,7 +29,7 @@ fn with_lifted(dir: &Path, flags: &[&str]) -> Harness<'static, App> {
     let sure = BoneDepth {
         root: Root::Near,
         single_root: false,
-        margin: 1.0,
+        margin: 2.0 * videomocap_core::lift::UNSURE_MARGIN,
     };
     let mut bones = vec![[sure; BONE_COUNT]; 3];
     bones[0][Bone::new(Joint::LeftElbow, Joint::LeftWrist).index()].margin = 0.0;
