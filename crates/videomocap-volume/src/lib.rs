@@ -312,8 +312,8 @@ fn coarsen(points: &[Point3<f64>], spacing_m: f64, max_points: usize) -> Vec<Poi
 
 /// The second pass over the clip and the articulated fit: assembles the curve's `results`
 /// (labels, sides, skeleton) and fits the subject's body to `points` started from it; the
-/// returned [`Assembled`] holds the fitted skeleton (and both stages' warnings) when the fit
-/// could run, and the curve's skeleton is returned beside it.
+/// returned [`Assembled`] holds the fitted skeleton and its warnings, then the curve's (named
+/// as the curve's), when the fit could run, and the curve's skeleton is returned beside it.
 pub fn assemble_and_fit(
     results: &[Result<FrameResult, FrameProblem>],
     points: &[FitPoints],
@@ -334,7 +334,15 @@ pub fn assemble_and_fit(
     let fitted = articulated::fit_clip(points, &assembled, &clean, names, &params.articulated);
     if let Some(f) = &fitted {
         assembled.skeleton = f.skeleton.clone();
-        assembled.warnings.extend(f.warnings.iter().cloned());
+        // The fitted body poses every frame with points, so the curve's own warnings (what it
+        // interpolated or left out) are said to be the curve's, after the fit's.
+        let curve_said = std::mem::take(&mut assembled.warnings);
+        assembled.warnings = f.warnings.clone();
+        assembled.warnings.extend(
+            curve_said
+                .into_iter()
+                .map(|w| format!("skeleton curve (the fitted body's start), {w}")),
+        );
     }
     (assembled, curve, fitted)
 }
