@@ -147,6 +147,31 @@ pub(crate) fn shank_dir(angle: f64) -> Vector3<f64> {
     Vector3::new(0.0, -angle.cos(), -angle.sin())
 }
 
+/// Which side's joints of a limb part: shoulder, elbow, wrist, hip, knee, ankle of the left
+/// (`k` = 0) or right side.
+pub(crate) fn side_joints(k: usize) -> [Joint; 6] {
+    use Joint::*;
+    if k == 0 {
+        [
+            LeftShoulder,
+            LeftElbow,
+            LeftWrist,
+            LeftHip,
+            LeftKnee,
+            LeftAnkle,
+        ]
+    } else {
+        [
+            RightShoulder,
+            RightElbow,
+            RightWrist,
+            RightHip,
+            RightKnee,
+            RightAnkle,
+        ]
+    }
+}
+
 impl Pose {
     /// Forward kinematics.
     pub(crate) fn posed(&self, body: &SubjectBody) -> Posed {
@@ -163,25 +188,7 @@ impl Pose {
         let ua = [0, 1].map(|k| rc * self.upper_arm[k].matrix());
         let th = [0, 1].map(|k| rp * self.thigh[k].matrix());
         for k in 0..2 {
-            let [sh, el, wr, hp, kn, an] = if k == 0 {
-                [
-                    LeftShoulder,
-                    LeftElbow,
-                    LeftWrist,
-                    LeftHip,
-                    LeftKnee,
-                    LeftAnkle,
-                ]
-            } else {
-                [
-                    RightShoulder,
-                    RightElbow,
-                    RightWrist,
-                    RightHip,
-                    RightKnee,
-                    RightAnkle,
-                ]
-            };
+            let [sh, el, wr, hp, kn, an] = side_joints(k);
             j[sh] = j[Chest] + rc * mirror(&body.shoulder, k);
             j[el] = j[sh] - ua[k] * up * body.limb_m[0];
             j[wr] = j[el] + ua[k] * forearm_dir(self.elbow[k]) * body.limb_m[1];

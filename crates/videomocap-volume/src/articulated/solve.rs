@@ -7,7 +7,7 @@
 //! `−((c − o) × n)`, by a hinge about axis `a` that dotted with `a`, by the root's translation
 //! `−n` (`c` the point on the axis, `n` the unit direction from it to the data point).
 
-use super::model::{Part, Pose, Posed, RADII, SEGMENTS, SubjectBody};
+use super::model::{Part, Pose, Posed, RADII, SEGMENTS, SubjectBody, side_joints};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use nalgebra::{DMatrix, DVector, Point3, Rotation3, Vector3};
 use videomocap_core::skeleton::Joint;
@@ -124,30 +124,6 @@ impl Row {
         for k in 0..3 {
             self.push(first + k, g[k]);
         }
-    }
-}
-
-/// Which side's joints of a limb part.
-fn side_joints(k: usize) -> [Joint; 6] {
-    use Joint::*;
-    if k == 0 {
-        [
-            LeftShoulder,
-            LeftElbow,
-            LeftWrist,
-            LeftHip,
-            LeftKnee,
-            LeftAnkle,
-        ]
-    } else {
-        [
-            RightShoulder,
-            RightElbow,
-            RightWrist,
-            RightHip,
-            RightKnee,
-            RightAnkle,
-        ]
     }
 }
 
