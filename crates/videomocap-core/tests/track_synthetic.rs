@@ -219,8 +219,6 @@ fn walk_with_a_correction(
         Joint::LeftAnkle,
         gt.frames[corrected].points2d()[Joint::LeftAnkle],
     );
-    j.from = Some(corrected);
-    j.previous = Some(first.tracks.clone());
     (gt, video, first, j)
 }
 
@@ -234,24 +232,6 @@ fn a_correction_on_a_later_frame_is_kept_and_anchors_the_track() {
     let p = again.tracks.frames[10].points[Joint::LeftAnkle];
     assert!((p.pos - truth).norm() < 1e-9);
     assert_eq!(p.confidence, 1.0);
-    // The re-track starts from what the user saw on frame 10, with the correction put in: the
-    // joints not dragged keep their confidence, and the reliable ones stay where they were
-    // tracked (they do not go back to where they were marked on frame 0; weak ones may be
-    // interpolated anew between the new neighbours).
-    let weak = TrackerParams::default().weak_reliability;
-    let mut kept = 0;
-    for j in Joint::ALL.into_iter().filter(|&j| j != Joint::LeftAnkle) {
-        let (now, before) = (
-            again.tracks.frames[10].points[j],
-            first.tracks.frames[10].points[j],
-        );
-        assert_eq!(now.confidence, before.confidence, "{}", j.name());
-        if before.confidence >= weak {
-            assert!((now.pos - before.pos).norm() < 1e-6, "{}", j.name());
-            kept += 1;
-        }
-    }
-    assert!(kept >= 5, "only {kept} reliable joints on frame 10");
     // The correction is tracked backwards too: the frames before it take the backward pass
     // where it holds better, so the ankle just before frame 10 is no further from the truth
     // than it was, and the head, reliable in both passes, stays where it was.
@@ -282,37 +262,17 @@ fn a_correction_on_a_later_frame_is_kept_and_anchors_the_track() {
     }
 }
 
-/// After a correction on the last key frame, the re-tracked frames on both sides of it arrive
-/// first (the app draws frames as they arrive), and a re-track that reuses the first run's
-/// background (as the app does) gives the same tracks as one that reads the clip again.
+/// A re-track that reuses the first run's background (as the app does) gives the same tracks
+/// as one that reads the clip again.
 #[test]
-fn a_correction_redraws_both_sides_of_it_first() {
+fn a_retrack_reusing_the_background_is_a_fresh_run() {
     let dir = tempfile::tempdir().unwrap();
-    let corrected = 30;
-    let (_, mut video, first, mut j) = walk_with_a_correction(dir.path(), 48, corrected);
+    let (_, mut video, first, mut j) = walk_with_a_correction(dir.path(), 48, 30);
     assert!(
         first.background.is_some(),
         "the default settings use a background"
     );
-    let mut arrived = Vec::new();
-    let fresh = track_video(
-        &mut video,
-        &j,
-        &mut |p| arrived.extend(p.frame.as_ref().map(|f| f.index.get())),
-        &AtomicBool::new(false),
-    )
-    .unwrap();
-    let near = |f: usize| f.abs_diff(corrected) <= 10;
-    let last_near = arrived.iter().rposition(|&f| near(f)).unwrap();
-    let first_far = arrived.iter().position(|&f| !near(f)).unwrap();
-    assert!(
-        (0..=10).all(|d| arrived.contains(&(corrected - d)) && arrived.contains(&(corrected + d))),
-        "frames next to the correction missing: {arrived:?}"
-    );
-    assert!(
-        last_near < first_far,
-        "a frame far from the correction came before one next to it: {arrived:?}"
-    );
+    let fresh = track_video(&mut video, &j, &mut |_| {}, &AtomicBool::new(false)).unwrap();
     j.background = first.background.clone();
     let reused = track_video(&mut video, &j, &mut |_| {}, &AtomicBool::new(false)).unwrap();
     assert_eq!(fresh.tracks, reused.tracks);

@@ -10,6 +10,9 @@
 //! - `head`: image-difference head prediction (eqs. 1–5)
 //! - `search`: the spiral search path (Fig. 6) and the anchored angular search
 //! - `body`: the top-down tracker (head → trunk → limbs)
+//! - `evidence`: the pose network's evidence weighed in
+//! - `doubt`: the evidence of each joint-frame's doubt, for calibrating it (`bench learned
+//!   --doubt-dump`)
 //! - `occlusion`: interpolation over weak runs, the weak-span report
 //! - `smooth`: the finished tracks smoothed over time, weighted by reliability
 //! - `run`: tracking a video from its key frames, the order of the steps, re-tracking
@@ -19,6 +22,7 @@
 mod background;
 mod block;
 mod body;
+mod doubt;
 mod evidence;
 mod fuse;
 mod head;
@@ -30,6 +34,7 @@ mod search;
 mod similarity;
 pub(crate) mod smooth;
 
+pub use doubt::{DOUBT_FEATURES, FEATURE_COUNT, doubt_features};
 pub use evidence::{EvidenceParams, NetFrame, NetworkFrames, run_network, weigh};
 pub use occlusion::{SpanKind, WeakSpan, weak_spans};
 pub use params::TrackerParams;

@@ -58,9 +58,6 @@ pub(crate) struct PassOutput {
     /// Per key frame the pass went through (not its first), where it arrived before the
     /// hand-placed joints re-started it: how well it agrees with that key.
     pub(crate) arrivals: BTreeMap<usize, PerJoint<JointResult>>,
-    /// The body tracker as it stands after the pass's last frame (to go on with the frames
-    /// after it: [`PassContext::pass`]'s `resume`).
-    pub(crate) tracker: Option<BodyTracker>,
 }
 
 pub(crate) struct PassContext<'a, 'p> {
@@ -122,13 +119,10 @@ impl PassContext<'_, '_> {
     /// its first frame and re-started with the hand-placed joints at every key frame on the way;
     /// returns the results in video pixels, one per frame of `order` (the first is the starting
     /// pose), and where the pass arrived on each key frame before it was re-started there.
-    /// With `resume` (a tracker another call left after the frame before `order`'s first), the
-    /// pass goes on from it instead, and `pose` is not used.
     pub(crate) fn pass(
         &mut self,
         order: &[usize],
         pose: &PerJoint<Point2<f64>>,
-        resume: Option<BodyTracker>,
     ) -> Result<PassOutput, TrackError> {
         let scale = self.scale;
         let params = self.params;
@@ -144,7 +138,7 @@ impl PassContext<'_, '_> {
         };
         let mut out = Vec::with_capacity(order.len());
         let mut arrivals = BTreeMap::new();
-        let mut tracker: Option<BodyTracker> = resume;
+        let mut tracker: Option<BodyTracker> = None;
         let proportions = Proportions::default();
         let check = |index: usize, image: &RgbImage| {
             if image.width() != width || image.height() != height {
@@ -323,7 +317,6 @@ impl PassContext<'_, '_> {
         Ok(PassOutput {
             results: out,
             arrivals,
-            tracker,
         })
     }
 }

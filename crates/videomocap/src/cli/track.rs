@@ -86,8 +86,6 @@ pub fn track_with_progress(
         keys: keys.clone(),
         params,
         threads,
-        from: None,
-        previous: None,
         background: None,
         network,
         previous_network: None,
