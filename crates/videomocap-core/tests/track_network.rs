@@ -111,7 +111,7 @@ fn an_edit_history_replayed_gives_the_tracks_of_a_fresh_run() {
         (&corrected, on),
     ];
     let (mut background, mut seen) = (None, None);
-    let mut last = None;
+    let mut runs = Vec::new();
     for (keys, params) in history {
         let job = TrackJob {
             keys: keys.clone(),
@@ -126,9 +126,15 @@ fn an_edit_history_replayed_gives_the_tracks_of_a_fresh_run() {
         if out.network.is_some() {
             seen = out.network.clone();
         }
-        last = Some(out);
+        runs.push(out);
     }
-    let replayed = last.unwrap();
+    let text = |t: &videomocap_core::formats::Tracks2d| t.to_json_value().to_string();
+    // The network on, off, on again: the first and the last of these give the same tracks.
+    assert_eq!(text(&runs[1].tracks), text(&runs[3].tracks));
+    assert_eq!(runs[1].spans, runs[3].spans);
+    // The network off changes them (so the comparison above can fail).
+    assert_ne!(text(&runs[1].tracks), text(&runs[2].tracks));
+    let replayed = runs.pop().unwrap();
     let mut fresh_video = Video::open(&clip.video, &OpenOptions::default()).unwrap();
     let fresh = track_video(
         &mut fresh_video,
@@ -144,7 +150,6 @@ fn an_edit_history_replayed_gives_the_tracks_of_a_fresh_run() {
         &AtomicBool::new(false),
     )
     .unwrap();
-    let text = |t: &videomocap_core::formats::Tracks2d| t.to_json_value().to_string();
     assert_eq!(text(&replayed.tracks), text(&fresh.tracks));
     assert_eq!(replayed.spans, fresh.spans);
     assert_eq!(replayed.tracks.frames[3].points[Joint::Neck].pos, neck);

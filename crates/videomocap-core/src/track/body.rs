@@ -302,6 +302,44 @@ impl BodyTracker {
         }
     }
 
+    /// Re-starts on a key frame from `pose`, as [`BodyTracker::new`], except that every part
+    /// none of whose two joints the key `placed` goes on as it was (its block, colour models
+    /// and reliability; its length limit carried over to the re-started head's zoom): a
+    /// correction of one joint re-learns no other part at a place the user did not confirm
+    /// (issue 90). With every joint placed it is `new`.
+    pub(crate) fn restart(
+        &mut self,
+        image: &RgbImage,
+        pose: &PerJoint<Point2<f64>>,
+        placed: &PerJoint<bool>,
+        proportions: &Proportions,
+    ) {
+        let fresh = BodyTracker::new(
+            image,
+            pose,
+            proportions,
+            self.params,
+            self.background.clone(),
+        );
+        let old = std::mem::replace(self, fresh);
+        let keep = |new: &mut Part, old_part: &Part, (a, b): (Joint, Joint)| {
+            if !placed[a] && !placed[b] {
+                *new = old_part.clone();
+                new.max_len *= old.zoom;
+            }
+        };
+        keep(&mut self.head, &old.head, BodyPart::Head.ends());
+        keep(&mut self.trunk, &old.trunk, BodyPart::Trunk.ends());
+        keep(&mut self.hips, &old.hips, (Joint::Pelvis, Joint::Pelvis));
+        for (c, [a, b, e]) in CHAINS.iter().enumerate() {
+            let [upper, lower] = &mut self.limbs[c];
+            keep(upper, &old.limbs[c][0], (*a, *b));
+            keep(lower, &old.limbs[c][1], (*b, *e));
+        }
+        // The shoulders and hips where `pose` has them, on the trunk block kept or made.
+        self.trunk_points = TRUNK_JOINTS.map(|j| self.trunk.block.to_block(pose[j]));
+    }
+
     /// The current pose (after the last step, or the starting pose).
     pub fn pose(&self) -> PerJoint<JointResult> {
         let mut out = PerJoint::from_fn(|_| JointResult {
@@ -803,6 +841,65 @@ fn hold(part: &mut Part, anchor: Point2<f64>, parent: [f64; 3]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A figure standing in a 200 × 300 image of noise (the image shifted by `dx` pixels).
+    fn figure(dx: u32) -> (RgbImage, PerJoint<Point2<f64>>) {
+        let image = RgbImage::from_fn(200, 300, |x, y| {
+            let v = ((x + dx) * 7919 + y * 104_729) % 251;
+            image::Rgb([v as u8, (v * 3 % 251) as u8, (v * 5 % 251) as u8])
+        });
+        let at = |x: f64, y: f64| Point2::new(x, y);
+        let pose = PerJoint::from_fn(|j| match j {
+            Joint::HeadTop => at(100.0, 40.0),
+            Joint::Neck => at(100.0, 80.0),
+            Joint::Chest => at(100.0, 110.0),
+            Joint::Pelvis => at(100.0, 160.0),
+            Joint::LeftShoulder => at(120.0, 85.0),
+            Joint::LeftElbow => at(130.0, 120.0),
+            Joint::LeftWrist => at(135.0, 155.0),
+            Joint::RightShoulder => at(80.0, 85.0),
+            Joint::RightElbow => at(70.0, 120.0),
+            Joint::RightWrist => at(65.0, 155.0),
+            Joint::LeftHip => at(112.0, 160.0),
+            Joint::LeftKnee => at(115.0, 210.0),
+            Joint::LeftAnkle => at(117.0, 260.0),
+            Joint::RightHip => at(88.0, 160.0),
+            Joint::RightKnee => at(85.0, 210.0),
+            Joint::RightAnkle => at(83.0, 260.0),
+        });
+        (image, pose)
+    }
+
+    #[test]
+    fn a_restart_placing_one_joint_leaves_the_parts_away_from_it_as_they_were() {
+        let (first, pose) = figure(0);
+        let params = TrackerParams::default();
+        let proportions = Proportions::default();
+        let mut t = BodyTracker::new(&first, &pose, &proportions, params, None);
+        let (next, _) = figure(3);
+        t.step(&next);
+        let before = t.pose();
+        // Some part lost confidence on the changed image (else the test could not fail).
+        assert!(Joint::ALL.iter().any(|&j| before[j].reliability < 1.0));
+        let mut fixed = before.map(|_, r| r.pos);
+        fixed[Joint::LeftWrist] += nalgebra::Vector2::new(5.0, -4.0);
+        let placed = PerJoint::from_fn(|j| j == Joint::LeftWrist);
+        t.restart(&next, &fixed, &placed, &proportions);
+        let after = t.pose();
+        assert!((after[Joint::LeftWrist].pos - fixed[Joint::LeftWrist]).norm() < 1e-6);
+        // Every joint but the wrist keeps its place and its reliability (a fresh tracker
+        // would make each 1).
+        for j in Joint::ALL {
+            if j == Joint::LeftWrist {
+                continue;
+            }
+            assert!((after[j].pos - before[j].pos).norm() < 1e-6, "{}", j.name());
+            assert_eq!(after[j].reliability, before[j].reliability, "{}", j.name());
+        }
+        // With every joint placed it is a fresh start.
+        t.restart(&next, &fixed, &PerJoint::from_fn(|_| true), &proportions);
+        assert!(Joint::ALL.iter().all(|&j| t.pose()[j].reliability == 1.0));
+    }
 
     #[test]
     fn each_chain_root_index_names_that_chains_root_joint() {

@@ -212,17 +212,14 @@ pub fn weigh(
     params: &EvidenceParams,
 ) -> Tracks2d {
     let n = tracks.frames.len();
-    // Frames to the nearest key, for the key's fading certainty.
-    let key_frames: Vec<FrameIndex> = tracks
-        .frames
-        .iter()
-        .filter(|f| keys.frames.contains_key(&f.index))
-        .map(|f| f.index)
-        .collect();
-    let to_key = |index: FrameIndex| {
-        key_frames
+    // Frames to the nearest key of joint `j`, for the key's fading certainty: a key that places
+    // other joints leaves this one's VBA track as it was (a correction of one joint moves no
+    // other, issue 90).
+    let to_key = |index: FrameIndex, j: Joint| {
+        keys.frames
             .iter()
-            .map(|&k| k.get().abs_diff(index.get()))
+            .filter(|(_, k)| k[j].is_some())
+            .map(|(k, _)| k.get().abs_diff(index.get()))
             .min()
             .map_or(f64::INFINITY, |d| d as f64)
     };
@@ -259,7 +256,7 @@ pub fn weigh(
                     };
                     params.vba_doubt
                         * (1.0 - r)
-                        * (1.0 - (-to_key(f.index) / params.key_fade_frames).exp())
+                        * (1.0 - (-to_key(f.index, j) / params.key_fade_frames).exp())
                 };
                 let mut c = vec![Candidate {
                     pos: p.pos,

@@ -116,8 +116,8 @@ impl PassContext<'_, '_> {
         Ok(Background::estimate(&refs, tau))
     }
     /// Tracks over `order` (consecutive frames, forwards or backwards), starting from `pose` on
-    /// its first frame and re-started with the hand-placed joints at every key frame on the way;
-    /// returns the results in video pixels, one per frame of `order` (the first is the starting
+    /// its first frame and re-started with the hand-placed joints at every key frame on the way
+    /// (the parts they touch; the others go on as they were, `BodyTracker::restart`); returns the results in video pixels, one per frame of `order` (the first is the starting
     /// pose), and where the pass arrived on each key frame before it was re-started there.
     pub(crate) fn pass(
         &mut self,
@@ -195,13 +195,8 @@ impl PassContext<'_, '_> {
                         let work_keys =
                             keys.frames[&FrameIndex(index)].map(|_, k| k.map(|p| scale.to_work(p)));
                         let fixed = tracked.map(|j, p| work_keys[j].unwrap_or(*p));
-                        *t = BodyTracker::new(
-                            &image,
-                            &fixed,
-                            &proportions,
-                            params,
-                            background.clone(),
-                        );
+                        let placed = work_keys.map(|_, k| k.is_some());
+                        t.restart(&image, &fixed, &placed, &proportions);
                         for j in Joint::ALL {
                             if work_keys[j].is_some() {
                                 r[j] = JointResult {
