@@ -5,7 +5,7 @@
 //! other-side point (its left/right swaps), by dynamic programming: each candidate's own
 //! confidence, the continuity of the motion, and keys that always win.
 
-use super::run::TrackError;
+use super::shared::TrackError;
 use crate::camera::point_in_frame;
 use crate::formats::{
     FrameIndex, FrameTracks, KeyFrames, NetworkBody, PointSource, TrackedPoint, Tracks2d,

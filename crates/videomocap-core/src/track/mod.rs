@@ -18,6 +18,7 @@
 //! - `run`: tracking a video from its key frames, the order of the steps, re-tracking
 //! - `pass`: one pass over consecutive frames, forwards or backwards, re-started at key frames
 //! - `fuse`: the forward and backward passes made one, per joint between its key frames
+//! - `shared`: the errors and progress every step uses (below them all)
 
 mod background;
 mod block;
@@ -31,6 +32,7 @@ mod params;
 mod pass;
 mod run;
 mod search;
+mod shared;
 mod similarity;
 pub(crate) mod smooth;
 
@@ -38,7 +40,8 @@ pub use doubt::{DOUBT_FEATURES, FEATURE_COUNT, doubt_features};
 pub use evidence::{EvidenceParams, NetFrame, NetworkFrames, run_network, weigh};
 pub use occlusion::{SpanKind, WeakSpan, weak_spans};
 pub use params::TrackerParams;
-pub use run::{KeyFrames, TrackError, TrackJob, TrackOutput, TrackProgress, track_video};
+pub use run::{KeyFrames, TrackJob, TrackOutput, track_video};
+pub use shared::{TrackError, TrackProgress};
 // Inner facts the app and the scoring need, exported by name.
 pub use background::KnownBackground;
 pub use body::stature_px;

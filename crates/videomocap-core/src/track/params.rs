@@ -1,7 +1,7 @@
 //! The tracker's settings, each with its default and what it does (the GUI shows these as
 //! tooltips).
 
-use super::run::TrackError;
+use super::shared::TrackError;
 use super::similarity::SimilarityWeights;
 use crate::setting_range::Range;
 use serde::{Deserialize, Serialize};

@@ -2,11 +2,10 @@
 //! shrunk to the working scale) on a second thread while the body tracker steps through them,
 //! re-started with the hand-placed joints at every key frame on the way.
 
-use super::TrackError;
 use super::background::{self, Background};
 use super::body::{BodyTracker, JointResult};
 use super::params::TrackerParams;
-use super::run::TrackProgress;
+use super::shared::{TrackError, TrackProgress};
 use crate::formats::{FrameIndex, FrameTracks, KeyFrames, PointSource, TrackedPoint};
 use crate::skeleton::{Joint, PerJoint, Proportions};
 use crate::video::{Video, VideoError};

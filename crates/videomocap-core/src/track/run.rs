@@ -23,53 +23,17 @@ use super::occlusion::{WeakSpan, fill_weak_runs, weak_spans};
 use super::params::TrackerParams;
 use super::pass::{PassContext, Scale};
 use super::smooth::smooth_tracks;
+use super::shared::{TrackError, TrackProgress};
 use crate::camera::point_in_frame;
 pub use crate::formats::KeyFrames;
 use crate::formats::{FrameIndex, FrameTracks, PointSource, SourceInfo, TrackedPoint, Tracks2d};
 use crate::network::PoseNetwork;
 use crate::skeleton::{Joint, PerJoint, Proportions};
-use crate::video::{Video, VideoError, VideoInfo};
+use crate::video::{Video, VideoInfo};
 use nalgebra::Point2;
 use std::collections::BTreeMap;
-use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
-
-/// Tracking could not run.
-#[derive(Debug, thiserror::Error)]
-pub enum TrackError {
-    #[error(transparent)]
-    Video(#[from] VideoError),
-    #[error("{path}: has {frames} frame(s); tracking needs at least 2")]
-    TooShort { path: PathBuf, frames: usize },
-    #[error("no key frame with all 16 joints placed (mark the first frame fully)")]
-    NoFullKeyFrame,
-    #[error("key frame {frame} is past the end of {path} ({frames} frames)")]
-    KeyFrameOutOfRange {
-        path: PathBuf,
-        frame: usize,
-        frames: usize,
-    },
-    #[error("{path}: frame {frame} is {got_w}×{got_h} but the video is {width}×{height}")]
-    FrameSize {
-        path: PathBuf,
-        frame: usize,
-        got_w: u32,
-        got_h: u32,
-        width: u32,
-        height: u32,
-    },
-    #[error("{path}: frame {frame}, where tracking starts, could not be decoded (damaged file?)")]
-    StartFrameDamaged { path: PathBuf, frame: usize },
-    #[error("tracker setting \"{name}\" must be {want}, got {value}")]
-    BadSetting {
-        name: &'static str,
-        value: f64,
-        want: &'static str,
-    },
-    #[error("cancelled")]
-    Cancelled,
-}
 
 /// What to track.
 #[derive(Debug, Clone)]
@@ -114,17 +78,6 @@ impl TrackJob {
         self.network = network;
         self
     }
-}
-
-/// Progress of a tracking run.
-#[derive(Debug, Clone)]
-pub struct TrackProgress {
-    /// Frames processed so far (over all passes).
-    pub done: usize,
-    /// Frames to process in all (an estimate: backward gap passes are added as found).
-    pub total: usize,
-    /// The frame just tracked (for drawing results as they arrive).
-    pub frame: Option<FrameTracks>,
 }
 
 /// The result: tracks and the report of weak spans.
