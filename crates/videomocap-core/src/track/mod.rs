@@ -9,6 +9,8 @@
 //! - `background`: a static camera's background, foreground evidence for the arms
 //! - `head`: image-difference head prediction (eqs. 1–5)
 //! - `search`: the spiral search path (Fig. 6) and the anchored angular search
+//! - `part`: a tracked body part and what each part does per frame (predict, search prior, learn, hold)
+//! - `limb`: one limb chain per frame, upper then lower segment, refined as one figure
 //! - `body`: the top-down tracker (head → trunk → limbs)
 //! - `evidence`: the pose network's evidence weighed in
 //! - `doubt`: the evidence of each joint-frame's doubt, for calibrating it (`bench learned
@@ -27,8 +29,10 @@ mod doubt;
 mod evidence;
 mod fuse;
 mod head;
+mod limb;
 mod occlusion;
 mod params;
+mod part;
 mod pass;
 mod run;
 mod search;
