@@ -5,6 +5,7 @@
 //! [`KeyFrames`]). Out: [`crate::formats::Tracks2d`] and a list of weak spans.
 //!
 //! - `block`: the morph-block `A = {(x, y), m, n, θ}` (Fig. 7)
+//! - `frame`: a frame as four `f32` lanes per pixel, sampled bilinearly
 //! - `similarity`: the sub-pixel morph-block similarity (eqs. 3–5), the hot loop
 //! - `background`: a static camera's background, foreground evidence for the arms
 //! - `head`: image-difference head prediction (eqs. 1–5)
@@ -27,6 +28,7 @@ mod block;
 mod body;
 mod doubt;
 mod evidence;
+mod frame;
 mod fuse;
 mod head;
 mod limb;
