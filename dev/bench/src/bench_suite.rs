@@ -121,13 +121,12 @@ pub fn lift_settings(
     }
 }
 
-/// The bundled pose network on `threads` threads, shareable between jobs.
+/// The bundled pose network on `threads` threads (the product's loader), shareable between
+/// jobs.
 pub fn bundled_network(
     threads: usize,
 ) -> Result<std::sync::Arc<videomocap_core::network::PoseNetwork>, ExitError> {
-    videomocap_core::network::PoseNetwork::bundled()
-        .map(|n| std::sync::Arc::new(n.with_threads(threads)))
-        .map_err(ExitError::failed)
+    videomocap_core::network::PoseNetwork::shared(threads).map_err(ExitError::failed)
 }
 
 /// `--split`: all (`None`), dev or test.

@@ -439,12 +439,8 @@ impl TrackTimer {
         params: TrackerParams,
     ) -> Result<Self, ExitError> {
         let marks = Marks::load(&dir.join("marks.json")).map_err(ExitError::failed)?;
-        // Frames in memory are full size: the tracker shrinks them itself (FFmpeg's scaling
-        // while decoding would empty the cache).
-        let params = TrackerParams {
-            decoder_scaling: decoding,
-            ..params
-        };
+        // Frames in memory are full size: the tracker shrinks them itself (it leaves a video
+        // whose frames are in its cache at full size, as FFmpeg's scaling would empty it).
         Ok(TrackTimer {
             dir: dir.to_owned(),
             job: TrackJob::from_marks(&marks, params, threads),

@@ -135,6 +135,9 @@ pub struct State {
     /// What the pose network saw in the last tracking run of this video (a re-track runs it
     /// again only where a crop moved).
     network_seen: Option<videomocap_core::track::NetworkFrames>,
+    /// Why the pose network could not be loaded, once a tracking job found it could not (shown
+    /// in the status bar and the Tracker panel).
+    network_problem: Option<String>,
     spans: Vec<WeakSpan>,
     strips: Option<Strips>,
     choices: Vec<LiftChoices>,
@@ -206,6 +209,7 @@ impl State {
             partial: BTreeMap::new(),
             background: None,
             network_seen: None,
+            network_problem: None,
             spans: Vec::new(),
             strips: None,
             choices: Vec::new(),
@@ -294,6 +298,12 @@ impl State {
         if let Some(a) = &mut self.autosaver {
             a.flush();
         }
+    }
+
+    /// As a tracking job does when the pose network cannot load (tests of the Tracker panel).
+    #[cfg(test)]
+    pub fn report_network_problem_for_test(&mut self, why: String) {
+        self.network_problem = Some(why);
     }
 
     /// Gives the project's 3D skeleton the lift's depth choices `bones` (tests of the 3D view).

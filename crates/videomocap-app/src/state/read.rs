@@ -241,4 +241,9 @@ impl State {
             Some((t.pos, PointState::of(&t, weak)))
         })
     }
+
+    /// Why the pose network could not be loaded, when a tracking run found so.
+    pub fn network_problem(&self) -> Option<&str> {
+        self.network_problem.as_deref()
+    }
 }

@@ -109,6 +109,9 @@ impl State {
                     self.partial.insert(f.index.get(), f);
                 }
                 JobEvent::Progress { .. } => {}
+                JobEvent::NetworkUnavailable(why) => {
+                    self.network_problem = Some(why);
+                }
                 JobEvent::Tracked(result) => self.tracked(result),
                 JobEvent::Lifted(result) => self.lifted(result),
                 JobEvent::Volume(result) => {
@@ -239,6 +242,10 @@ impl State {
                 self.autosave();
                 self.results_changed();
                 self.status = format!("Tracked {} frames", self.frame_count());
+                if let Some(why) = &self.network_problem {
+                    self.status +=
+                        &format!(" with VBA alone (the pose network could not load: {why})");
+                }
                 if let Some(w) = self.weak_share() {
                     self.status += &format!(
                         "; {} weak joint-frames ({:.1} % of the clip)",

@@ -12,7 +12,7 @@ use super::background::Background;
 use super::block::MorphBlock;
 use super::head::HeadPredictor;
 use super::limb::{shoulder_spring, track_limb};
-use super::params::TrackerParams;
+use super::params::Tuning;
 use super::part::{LENGTH_SLACK, Part, accept, extent, is_arm, predict_anchored, prior};
 use super::search::{AngularParams, ChainRoot, Found, SpiralParams, angular, spiral};
 use super::similarity::{Extent, FloatFrame, FrameView, Template};
@@ -100,7 +100,7 @@ pub fn stature_px(pose: &PerJoint<Point2<f64>>, proportions: &Proportions) -> f6
 /// Tracks the body frame by frame.
 #[derive(Debug, Clone)]
 pub struct BodyTracker {
-    params: TrackerParams,
+    params: Tuning,
     head: Part,
     trunk: Part,
     /// Per chain: the upper and lower part.
@@ -135,7 +135,7 @@ impl BodyTracker {
         image: &RgbImage,
         pose: &PerJoint<Point2<f64>>,
         proportions: &Proportions,
-        params: TrackerParams,
+        params: Tuning,
         background: Option<Arc<Background>>,
     ) -> BodyTracker {
         let width = widths(pose, proportions, params.block_width_scale);
@@ -499,7 +499,7 @@ fn hip_patch(pelvis: Point2<f64>, theta: f64, trunk_m: f64, trunk_n: f64) -> Mor
 
 impl BodyTracker {
     /// The hip patch searched by the head's spiral from where it was (for [`Self::hips_hold`]).
-    fn hips_spiral(&self, frame: FrameView, p: &TrackerParams) -> Found {
+    fn hips_spiral(&self, frame: FrameView, p: &Tuning) -> Found {
         spiral(
             &self.hips.template,
             frame,
@@ -520,7 +520,7 @@ impl BodyTracker {
     /// by the head's spiral from where it was (`found`, from [`Self::hips_spiral`]); when it
     /// matches clearly better there than where the trunk put the pelvis, the trunk is re-hung
     /// from the neck to the patch's centre.
-    fn hips_hold(&mut self, frame: FrameView, neck: Point2<f64>, found: Found, p: &TrackerParams) {
+    fn hips_hold(&mut self, frame: FrameView, neck: Point2<f64>, found: Found, p: &Tuning) {
         let t = self.trunk.block;
         let at_trunk = hip_patch(t.end(), t.theta, t.m, t.n);
         let c_trunk = self
@@ -592,7 +592,7 @@ mod tests {
     #[test]
     fn a_restart_placing_one_joint_leaves_the_parts_away_from_it_as_they_were() {
         let (first, pose) = figure(0);
-        let params = TrackerParams::default();
+        let params = crate::track::TrackerParams::default().tuning(30.0, 1);
         let proportions = Proportions::default();
         let mut t = BodyTracker::new(&first, &pose, &proportions, params, None);
         let (next, _) = figure(3);

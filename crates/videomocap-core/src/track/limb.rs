@@ -3,7 +3,7 @@
 //! fast limbs, held off the image or when folded back; then the chain refined as one figure.
 
 use super::block::{MorphBlock, wrap_angle};
-use super::params::TrackerParams;
+use super::params::Tuning;
 use super::part::{Part, hold, learn, move_to, off_image, predict_anchored, prior, reliability};
 use super::search::{AngularParams, ChainRoot, ChainSegment, Prior, angular, refine_chain};
 use super::similarity::FrameView;
@@ -17,7 +17,7 @@ pub(super) const CHAIN_LEVELS: usize = 3;
 
 /// A limb segment's search around its prediction: `limb_range_deg` in coarse steps, the length
 /// within `limb_range_m`.
-pub(super) fn limb_search(p: &TrackerParams) -> AngularParams {
+pub(super) fn limb_search(p: &Tuning) -> AngularParams {
     AngularParams {
         range_theta: p.limb_range_deg.to_radians(),
         step_theta: p.coarse_step_deg.to_radians(),
@@ -28,7 +28,7 @@ pub(super) fn limb_search(p: &TrackerParams) -> AngularParams {
 }
 
 /// `search` widened for fast limbs: `wide_range_deg` in steps twice the coarse step.
-pub(super) fn widened(search: AngularParams, p: &TrackerParams) -> AngularParams {
+pub(super) fn widened(search: AngularParams, p: &Tuning) -> AngularParams {
     AngularParams {
         range_theta: p.wide_range_deg.to_radians(),
         step_theta: 2.0 * p.coarse_step_deg.to_radians(),
@@ -47,7 +47,7 @@ pub(super) fn track_limb(
     root: ChainRoot,
     trunk_angles: [f64; 3],
     frame: FrameView,
-    p: &TrackerParams,
+    p: &Tuning,
     zoom: f64,
 ) -> Point2<f64> {
     let mut parent = trunk_angles;
@@ -138,13 +138,13 @@ pub(super) fn track_limb(
 
 /// Whether a lower segment at image angle `lower` is folded back onto its upper segment at
 /// `upper` further than `fold_limit_deg` (elbows and knees flex to about 150°).
-pub(super) fn folded_back(upper: f64, lower: f64, p: &TrackerParams) -> bool {
+pub(super) fn folded_back(upper: f64, lower: f64, p: &Tuning) -> bool {
     wrap_angle(lower - upper).abs() > p.fold_limit_deg.to_radians()
 }
 
 /// The spring that ties chain `chain`'s root to the rigid trunk in its joint refinement: the
 /// shoulders' (`shoulder_spring`, when above 0); the hips stay on the trunk (letting them move
 /// measured worse on the side views, where the far leg pulls its hip onto the near one).
-pub(super) fn shoulder_spring(chain: usize, p: &TrackerParams) -> Option<f32> {
+pub(super) fn shoulder_spring(chain: usize, p: &Tuning) -> Option<f32> {
     (chain < 2 && p.shoulder_spring > 0.0).then_some(p.shoulder_spring)
 }

@@ -4,7 +4,7 @@
 //! (`body`) and the limb chains (`limb`).
 
 use super::block::{MorphBlock, wrap_angle};
-use super::params::TrackerParams;
+use super::params::Tuning;
 use super::search::{Found, Prior};
 use super::similarity::{Extent, FrameView, Template};
 use crate::camera::point_in_frame;
@@ -26,8 +26,8 @@ pub(super) struct Part {
     /// How far along its bone the part is sampled.
     pub(super) extent: Extent,
     /// What the block pays per unit of ln(full length / length) when shorter than its full
-    /// length: [`TrackerParams::short_penalty`] for the legs and upper arms, the forearms' own
-    /// [`TrackerParams::forearm_short_penalty`], 0 for the head, trunk and hip patch.
+    /// length: [`Tuning::short_penalty`] for the legs and upper arms, the forearms' own
+    /// [`Tuning::forearm_short_penalty`], 0 for the head, trunk and hip patch.
     pub(super) short_penalty: f32,
 }
 
@@ -36,7 +36,7 @@ pub(super) struct Part {
 pub(super) const LENGTH_SLACK: f64 = 1.2;
 
 /// Whether a part is an upper arm or a forearm: the parts whose blocks weigh the foreground
-/// lane ([`TrackerParams::arm_foreground`]).
+/// lane ([`Tuning::arm_foreground`]).
 pub(super) fn is_arm(part: BodyPart) -> bool {
     matches!(
         part,
@@ -99,7 +99,7 @@ pub(super) fn predict_anchored(
 /// The motion prior of an anchored part around its prediction; its length limits are the
 /// marked ones times the head's `zoom`, and a block shorter than the part's full length pays
 /// the part's `short_penalty` per unit of log ratio.
-pub(super) fn prior(part: &Part, pred: &MorphBlock, p: &TrackerParams, zoom: f64) -> Prior {
+pub(super) fn prior(part: &Part, pred: &MorphBlock, p: &Tuning, zoom: f64) -> Prior {
     Prior {
         theta: pred.theta,
         m: pred.m,
@@ -114,7 +114,7 @@ pub(super) fn prior(part: &Part, pred: &MorphBlock, p: &TrackerParams, zoom: f64
 
 /// Takes a search result: the block moves, the angle history shifts, the reliability is the
 /// mapped similarity, and the adaptive colour model learns the new appearance when reliable.
-pub(super) fn accept(part: &mut Part, found: Found, frame: FrameView, p: &TrackerParams) {
+pub(super) fn accept(part: &mut Part, found: Found, frame: FrameView, p: &Tuning) {
     move_to(part, found.block);
     learn(part, frame, p);
 }
@@ -127,7 +127,7 @@ pub(super) fn move_to(part: &mut Part, block: MorphBlock) {
 
 /// The part learns from its block in the new frame: its reliability is the mapped similarity,
 /// and the adaptive colour model learns the new appearance when reliable.
-pub(super) fn learn(part: &mut Part, frame: FrameView, p: &TrackerParams) {
+pub(super) fn learn(part: &mut Part, frame: FrameView, p: &Tuning) {
     // The reliability comes from the colours alone, without the prior's penalty or the
     // foreground lane.
     let cost = part.template.appearance_cost(frame, &part.block);

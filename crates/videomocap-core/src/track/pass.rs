@@ -4,7 +4,7 @@
 
 use super::background::{self, Background};
 use super::body::{BodyTracker, JointResult};
-use super::params::TrackerParams;
+use super::params::Tuning;
 use super::shared::{TrackError, TrackProgress};
 use crate::formats::{FrameIndex, FrameTracks, KeyFrames, PointSource, TrackedPoint};
 use crate::skeleton::{Joint, PerJoint, Proportions};
@@ -62,7 +62,7 @@ pub(crate) struct PassOutput {
 pub(crate) struct PassContext<'a, 'p> {
     pub(crate) video: &'a mut Video,
     pub(crate) scale: Scale,
-    pub(crate) params: TrackerParams,
+    pub(crate) params: Tuning,
     pub(crate) keys: &'a KeyFrames,
     pub(crate) path: PathBuf,
     /// The size frames arrive at from the video (full or, when it scales, working size).

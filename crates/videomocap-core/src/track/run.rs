@@ -238,15 +238,16 @@ fn track_at_working_scale(
         width: ww,
         height: wh,
     };
-    // Frames come out at the working size if the backend can make them so.
-    let decoded = if shrink > 1.0 && job.params.decoder_scaling && video.output_size(Some((ww, wh)))
+    // Frames come out at the working size if the backend can make them so (at 1080×1920
+    // converting at that size is cheaper than converting at full size and shrinking); not when
+    // the video's frames are already decoded in its cache, which the change would empty.
+    let decoded = if shrink > 1.0 && video.cached_bytes() == 0 && video.output_size(Some((ww, wh)))
     {
         (ww, wh)
     } else {
         (info.width, info.height)
     };
-    let mut params = job.params.at_frame_rate(info.fps);
-    params.parallel = params.parallel && job.threads > 1;
+    let params = job.params.tuning(info.fps, job.threads);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(job.threads.max(1))
         .build()
@@ -283,7 +284,7 @@ fn track_at_working_scale(
         cancel,
         background: None,
     };
-    let tau = job.params.foreground_tau;
+    let tau = params.foreground_tau;
     let known = job.background.as_ref().and_then(|k| k.get((ww, wh), tau));
     ctx.background = match known {
         _ if job.params.arm_foreground <= 0.0 => None,
