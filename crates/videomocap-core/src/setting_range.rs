@@ -8,12 +8,8 @@ pub(crate) enum Range {
     Positive,
     /// Finite, 0 or more.
     NonNegative,
-    /// Finite, 0 or more, below 1 (a fraction taken off a length, which must stay positive).
-    Fraction,
     /// Between 0 and 1, both included.
     Unit,
-    /// Above 0 and at most 180 (an angle between two directions, degrees).
-    HalfTurn,
 }
 
 impl Range {
@@ -23,9 +19,7 @@ impl Range {
             && match self {
                 Range::Positive => v > 0.0,
                 Range::NonNegative => v >= 0.0,
-                Range::Fraction => (0.0..1.0).contains(&v),
                 Range::Unit => (0.0..=1.0).contains(&v),
-                Range::HalfTurn => v > 0.0 && v <= 180.0,
             }
     }
 
@@ -44,9 +38,7 @@ impl Range {
         match self {
             Range::Positive => "a finite number above 0",
             Range::NonNegative => "a finite number, 0 or more",
-            Range::Fraction => "0 or more and below 1",
             Range::Unit => "between 0 and 1",
-            Range::HalfTurn => "above 0 and at most 180",
         }
     }
 }

@@ -1,6 +1,8 @@
 //! Tracking with the pose network's evidence (`track_video` with a network): every frame has
 //! what the network saw, the user's joints stay where they were placed, and a re-track after a
-//! correction that reuses the earlier network output gives what a fresh run gives.
+//! correction that reuses the earlier network output gives what a fresh run gives, and an edit
+//! history replayed (corrections, the network turned off and on, an undo) ends where a fresh
+//! run with the same keys and settings does, byte for byte.
 
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
@@ -43,15 +45,14 @@ fn tracking_with_the_network_keeps_the_keys_and_a_retrack_reuses_what_it_saw() {
         );
     }
 
-    // A correction on frame 6.
+    // A correction on frame 6 moves the left wrist 3 px: every crop stays where it was, so the
+    // network's output is reused as it was, and is what a fresh run sees.
     let mut keys = KeyFrames::from_marks(&marks);
     let moved =
         first.tracks.frames[6].points[Joint::LeftWrist].pos + nalgebra::Vector2::new(3.0, 0.0);
     keys.set(FrameIndex(6), Joint::LeftWrist, moved);
     let retrack = TrackJob {
         keys: keys.clone(),
-        from: Some(6),
-        previous: Some(first.tracks.clone()),
         previous_network: first.network.clone(),
         ..job.clone()
     };
@@ -62,10 +63,9 @@ fn tracking_with_the_network_keeps_the_keys_and_a_retrack_reuses_what_it_saw() {
         ..job.clone()
     };
     let fresh = track_video(&mut video, &fresh, &mut |_| {}, &AtomicBool::new(false)).unwrap();
-    // A wrist moved leaves every crop where it was: the network's output is reused as it was,
-    // and is what a fresh run sees.
     assert_eq!(again.network, first.network);
     assert_eq!(fresh.network, first.network);
+    assert_eq!(again.tracks, fresh.tracks);
 
     // Turned off by the setting: VBA alone, nothing from the network.
     let off = TrackJob {
@@ -77,4 +77,80 @@ fn tracking_with_the_network_keeps_the_keys_and_a_retrack_reuses_what_it_saw() {
     };
     let alone = track_video(&mut video, &off, &mut |_| {}, &AtomicBool::new(false)).unwrap();
     assert!(alone.network.is_none());
+}
+
+/// Tracking is a function of the video, the keys and the settings (issue 90): an app's edit
+/// history, each step re-tracked with what the step before left (its background and the
+/// network's output as caches), ends with the tracks of one fresh run, byte for byte.
+#[test]
+fn an_edit_history_replayed_gives_the_tracks_of_a_fresh_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let clip = render_small_clip(dir.path(), ProceduralMotion::Walk, 12, View::Side).unwrap();
+    let marks = Marks::load(&clip.marks).unwrap();
+    let network = Arc::new(PoseNetwork::bundled().unwrap());
+    let mut video = Video::open(&clip.video, &OpenOptions::default()).unwrap();
+    let on = TrackerParams::default();
+    let off = TrackerParams {
+        network: false,
+        ..on
+    };
+    let marked = KeyFrames::from_marks(&marks);
+    let mut corrected = marked.clone();
+    let neck = marks.points[Joint::Neck] + nalgebra::Vector2::new(4.0, -3.0);
+    corrected.set(FrameIndex(3), Joint::Neck, neck);
+    let mut pelvis_moved = corrected.clone();
+    let pelvis = marks.points[Joint::Pelvis] + nalgebra::Vector2::new(-5.0, 2.0);
+    pelvis_moved.set(FrameIndex(8), Joint::Pelvis, pelvis);
+    // Track, correct the neck, turn the network off, on, move the pelvis, undo it.
+    let history = [
+        (&marked, on),
+        (&corrected, on),
+        (&corrected, off),
+        (&corrected, on),
+        (&pelvis_moved, on),
+        (&corrected, on),
+    ];
+    let (mut background, mut seen) = (None, None);
+    let mut runs = Vec::new();
+    for (keys, params) in history {
+        let job = TrackJob {
+            keys: keys.clone(),
+            params,
+            threads: 2,
+            background: background.clone(),
+            network: Some(network.clone()),
+            previous_network: seen.clone(),
+        };
+        let out = track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false)).unwrap();
+        background = out.background.clone();
+        if out.network.is_some() {
+            seen = out.network.clone();
+        }
+        runs.push(out);
+    }
+    let text = |t: &videomocap_core::formats::Tracks2d| t.to_json_value().to_string();
+    // The network on, off, on again: the first and the last of these give the same tracks.
+    assert_eq!(text(&runs[1].tracks), text(&runs[3].tracks));
+    assert_eq!(runs[1].spans, runs[3].spans);
+    // The network off changes them (so the comparison above can fail).
+    assert_ne!(text(&runs[1].tracks), text(&runs[2].tracks));
+    let replayed = runs.pop().unwrap();
+    let mut fresh_video = Video::open(&clip.video, &OpenOptions::default()).unwrap();
+    let fresh = track_video(
+        &mut fresh_video,
+        &TrackJob {
+            keys: corrected.clone(),
+            params: on,
+            threads: 2,
+            background: None,
+            network: Some(network),
+            previous_network: None,
+        },
+        &mut |_| {},
+        &AtomicBool::new(false),
+    )
+    .unwrap();
+    assert_eq!(text(&replayed.tracks), text(&fresh.tracks));
+    assert_eq!(replayed.spans, fresh.spans);
+    assert_eq!(replayed.tracks.frames[3].points[Joint::Neck].pos, neck);
 }

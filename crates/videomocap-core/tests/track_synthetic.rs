@@ -219,8 +219,6 @@ fn walk_with_a_correction(
         Joint::LeftAnkle,
         gt.frames[corrected].points2d()[Joint::LeftAnkle],
     );
-    j.from = Some(corrected);
-    j.previous = Some(first.tracks.clone());
     (gt, video, first, j)
 }
 
@@ -234,24 +232,6 @@ fn a_correction_on_a_later_frame_is_kept_and_anchors_the_track() {
     let p = again.tracks.frames[10].points[Joint::LeftAnkle];
     assert!((p.pos - truth).norm() < 1e-9);
     assert_eq!(p.confidence, 1.0);
-    // The re-track starts from what the user saw on frame 10, with the correction put in: the
-    // joints not dragged keep their confidence, and the reliable ones stay where they were
-    // tracked (they do not go back to where they were marked on frame 0; weak ones may be
-    // interpolated anew between the new neighbours).
-    let weak = TrackerParams::default().weak_reliability;
-    let mut kept = 0;
-    for j in Joint::ALL.into_iter().filter(|&j| j != Joint::LeftAnkle) {
-        let (now, before) = (
-            again.tracks.frames[10].points[j],
-            first.tracks.frames[10].points[j],
-        );
-        assert_eq!(now.confidence, before.confidence, "{}", j.name());
-        if before.confidence >= weak {
-            assert!((now.pos - before.pos).norm() < 1e-6, "{}", j.name());
-            kept += 1;
-        }
-    }
-    assert!(kept >= 5, "only {kept} reliable joints on frame 10");
     // The correction is tracked backwards too: the frames before it take the backward pass
     // where it holds better, so the ankle just before frame 10 is no further from the truth
     // than it was, and the head, reliable in both passes, stays where it was.
@@ -282,37 +262,17 @@ fn a_correction_on_a_later_frame_is_kept_and_anchors_the_track() {
     }
 }
 
-/// After a correction on the last key frame, the re-tracked frames on both sides of it arrive
-/// first (the app draws frames as they arrive), and a re-track that reuses the first run's
-/// background (as the app does) gives the same tracks as one that reads the clip again.
+/// A re-track that reuses the first run's background (as the app does) gives the same tracks
+/// as one that reads the clip again.
 #[test]
-fn a_correction_redraws_both_sides_of_it_first() {
+fn a_retrack_reusing_the_background_is_a_fresh_run() {
     let dir = tempfile::tempdir().unwrap();
-    let corrected = 30;
-    let (_, mut video, first, mut j) = walk_with_a_correction(dir.path(), 48, corrected);
+    let (_, mut video, first, mut j) = walk_with_a_correction(dir.path(), 48, 30);
     assert!(
         first.background.is_some(),
         "the default settings use a background"
     );
-    let mut arrived = Vec::new();
-    let fresh = track_video(
-        &mut video,
-        &j,
-        &mut |p| arrived.extend(p.frame.as_ref().map(|f| f.index.get())),
-        &AtomicBool::new(false),
-    )
-    .unwrap();
-    let near = |f: usize| f.abs_diff(corrected) <= 10;
-    let last_near = arrived.iter().rposition(|&f| near(f)).unwrap();
-    let first_far = arrived.iter().position(|&f| !near(f)).unwrap();
-    assert!(
-        (0..=10).all(|d| arrived.contains(&(corrected - d)) && arrived.contains(&(corrected + d))),
-        "frames next to the correction missing: {arrived:?}"
-    );
-    assert!(
-        last_near < first_far,
-        "a frame far from the correction came before one next to it: {arrived:?}"
-    );
+    let fresh = track_video(&mut video, &j, &mut |_| {}, &AtomicBool::new(false)).unwrap();
     j.background = first.background.clone();
     let reused = track_video(&mut video, &j, &mut |_| {}, &AtomicBool::new(false)).unwrap();
     assert_eq!(fresh.tracks, reused.tracks);
@@ -423,8 +383,9 @@ fn a_bow_from_the_side_keeps_the_pelvis_where_the_hips_are() {
 /// Running seen from the side (CMU 02_03): the swinging shank locked onto the other leg, folded
 /// back over its thigh, and stayed there. Knees cannot fold that far, so the match is refused
 /// and the shank held until it is found again (measured without the chain refinement: left
-/// ankle 18.2 → 4.4 px). The chain refinement alone also keeps the shank on its leg (18.2 →
-/// 1.3 px), so the fold check is measured without it.
+/// ankle 18.2 px without the fold check, 4.4 px with it; the check is a fitted constant since
+/// issue 92, so this asserts half the figure without it). The chain refinement alone also keeps
+/// the shank on its leg (1.3 px), so the fold check is measured without it.
 #[test]
 fn a_running_shank_never_folds_back_onto_its_thigh() {
     let dir = tempfile::tempdir().unwrap();
@@ -440,29 +401,18 @@ fn a_running_shank_never_folds_back_onto_its_thigh() {
         ..SynthParams::default()
     };
     render_clip(&params, dir.path(), &mut |_, _| {}, &AtomicBool::new(false)).unwrap();
-    let run = |fold_limit_deg: f64, chain_refine: bool| {
-        let params = TrackerParams {
-            fold_limit_deg,
-            chain_refine,
-            ..TrackerParams::default()
-        };
-        joint_and_pck(dir.path(), Joint::LeftAnkle, params)
+    let params = TrackerParams {
+        chain_refine: false,
+        ..TrackerParams::default()
     };
-    let (ankle_off, pck_off) = run(180.0, false);
-    let (ankle_on, pck_on) = run(165.0, false);
+    let (ankle, pck) = joint_and_pck(dir.path(), Joint::LeftAnkle, params);
+    println!("left ankle {ankle:.1} px, PCK@0.2 {pck:.3}");
     assert!(
-        ankle_on < 0.5 * ankle_off,
-        "left ankle {ankle_on:.1} px with the check, {ankle_off:.1} px without"
+        ankle < 9.1,
+        "left ankle {ankle:.1} px (18.2 without the fold check)"
     );
-    assert!(
-        pck_on >= pck_off,
-        "PCK@0.2 {pck_on:.3} with, {pck_off:.3} without"
-    );
-    let (ankle_chain, _) = run(180.0, true);
-    assert!(
-        ankle_chain < 0.5 * ankle_off,
-        "left ankle {ankle_chain:.1} px with the chain refinement, {ankle_off:.1} px without"
-    );
+    // Measured 0.775 with the check (2026-12-06).
+    assert!(pck >= 0.75, "PCK@0.2 {pck:.3}");
 }
 
 /// Walking across the view (CMU 02_01, side view): where the legs cross, a thigh and shank

@@ -216,8 +216,8 @@ fn a_tracker_setting_out_of_its_range_is_named_with_its_file() {
         ss,
     ];
     assert_bad(&args, &[ss, "short_penalty", "0 or more", "-3"]);
-    std::fs::write(&settings, r#"{"weights": {"key": 1.5}}"#).unwrap();
-    assert_bad(&args, &[ss, "weights.key", "between 0 and 1"]);
+    std::fs::write(&settings, r#"{"weak_reliability": 1.5}"#).unwrap();
+    assert_bad(&args, &[ss, "weak_reliability", "between 0 and 1"]);
     assert!(!out.exists());
 }
 

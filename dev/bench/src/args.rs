@@ -248,4 +248,9 @@ pub struct BenchArgs {
     /// bench's time; for quick looks at the lift from true and noisy 2D).
     #[arg(long)]
     pub no_tracker: bool,
+    /// `learned` only: write every non-key joint-frame's doubt features and whether it is more
+    /// than 0.2 torso off (CSV) to this file, to calibrate the doubt on dev
+    /// (`scripts/fit_doubt.py`).
+    #[arg(long)]
+    pub doubt_dump: Option<PathBuf>,
 }

@@ -228,14 +228,13 @@ pub fn opencv(
 /// The learned comparison per split and family, and per clip (name, scores).
 pub type LearnedScores = (Tally<Learned>, Vec<(String, Learned)>);
 
-/// Runs MediaPipe Pose on `clips` and scores it beside VBA's limb joints (`vba_limbs`, one per
-/// clip); `None` when MediaPipe is not there.
-pub fn mediapipe(
+/// Runs MediaPipe Pose on `clips` (outputs kept and reused) and scores it, one score per clip;
+/// `None` when MediaPipe is not there.
+pub fn mediapipe_scores(
     clips: &[BenchClip],
-    vba_limbs: &[Accuracy],
     suite_dir: &Path,
     global: &GlobalArgs,
-) -> Result<Option<LearnedScores>, ExitError> {
+) -> Result<Option<Vec<ClipScore>>, ExitError> {
     if !python_has("cv2, mediapipe") {
         return Ok(None);
     }
@@ -258,15 +257,33 @@ pub fn mediapipe(
         jobs,
         global,
     )?;
+    let mut out = Vec::with_capacity(clips.len());
+    for (clip, file) in clips.iter().zip(&outputs) {
+        let gt = GroundTruth::load(&clip.dir.join("gt.json")).map_err(ExitError::failed)?;
+        out.push(score_output(&gt, file, "mediapipe")?.ok_or_else(|| {
+            ExitError::failed(anyhow!("{}: no mediapipe output", file.display()))
+        })?);
+    }
+    Ok(Some(out))
+}
+
+/// Runs MediaPipe Pose on `clips` and scores it beside VBA's limb joints (`vba_limbs`, one per
+/// clip); `None` when MediaPipe is not there. Also each clip's MediaPipe score.
+pub fn mediapipe(
+    clips: &[BenchClip],
+    vba_limbs: &[Accuracy],
+    suite_dir: &Path,
+    global: &GlobalArgs,
+) -> Result<Option<(LearnedScores, Vec<ClipScore>)>, ExitError> {
+    let Some(scores) = mediapipe_scores(clips, suite_dir, global)? else {
+        return Ok(None);
+    };
     let mut tally = Tally::default();
     let mut per_clip = Vec::new();
-    for ((clip, file), vba) in clips.iter().zip(&outputs).zip(vba_limbs) {
-        let gt = GroundTruth::load(&clip.dir.join("gt.json")).map_err(ExitError::failed)?;
-        let s = score_output(&gt, file, "mediapipe")?
-            .ok_or_else(|| ExitError::failed(anyhow!("{}: no mediapipe output", file.display())))?;
+    for ((clip, s), vba) in clips.iter().zip(&scores).zip(vba_limbs) {
         let scores = [*vba, s.limbs(), s.overall];
         tally.add(clip, &scores);
         per_clip.push((clip.name.clone(), scores));
     }
-    Ok(Some((tally, per_clip)))
+    Ok(Some(((tally, per_clip), scores)))
 }

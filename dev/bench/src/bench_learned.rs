@@ -167,17 +167,23 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         "clip", "split", "VBA", "net", "together"
     )];
     let (mut net_seconds, mut net_frames) = (0.0, 0usize);
+    let mut clip_scores = Vec::with_capacity(clips.len());
+    let mut dump = vec![format!(
+        "clip,frame,joint,{},off",
+        videomocap_core::track::DOUBT_FEATURES.join(",")
+    )];
     for clip in &clips {
         say(global, &format!("{} …", clip.name));
-        let s = score_clip(
+        let (s, full, seconds) = score_clip(
             clip,
             threads,
             params,
             network.clone(),
             &settings,
-            &mut net_seconds,
             a.reuse,
+            a.doubt_dump.is_some().then_some(&mut dump),
         )?;
+        net_seconds += seconds;
         net_frames += count_frames(clip)?;
         lines.push(format!(
             "{:<26} {:<5}               {:>6.3} {:>6.3} {:>9.3}",
@@ -188,6 +194,23 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             s.0[2][0].pck02()
         ));
         tally.add(clip, &s);
+        clip_scores.push(full);
+    }
+    if let Some(path) = &a.doubt_dump {
+        std::fs::write(path, dump.join("\n") + "\n").map_err(ExitError::failed)?;
+    }
+    let mediapipe = crate::bench_baselines::mediapipe_scores(&clips, &a.suite_dir, global)?;
+    let mut views = crate::bench_views::ViewTable::new(if mediapipe.is_some() {
+        &["VBA", "net", "together", "MediaPipe"]
+    } else {
+        &["VBA", "net", "together"]
+    });
+    for (k, (clip, full)) in clips.iter().zip(&clip_scores).enumerate() {
+        let mut row: Vec<&ClipScore> = full.iter().collect();
+        if let Some(mp) = &mediapipe {
+            row.push(&mp[k]);
+        }
+        views.add(clip, &row);
     }
     lines.push(String::new());
     lines.push(format!(
@@ -216,15 +239,22 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     lines.extend(tally.lines(WIDTH, |s| {
         format!("{}  {}   ", s.1[0].cell(), s.1[1].cell())
     }));
+    lines.push(String::new());
+    lines.push(format!(
+        "per view (clicked marks; MediaPipe Pose 0.10.21 with its own detector, no marks{})",
+        if mediapipe.is_some() {
+            ""
+        } else {
+            ": not found"
+        }
+    ));
+    lines.extend(views.lines());
     if settings.len() > 1 {
         lines.push(String::new());
         lines.push("together, each setting swept (13 limb joints, PCK@0.2 / lost)".to_owned());
         for (k, p) in settings.iter().enumerate() {
-            let line = tally.lines(WIDTH, |s| cell(&s.0, 0, 3 + k));
-            if let Some(overall) = line.last() {
-                lines.push(format!("{p:?}"));
-                lines.push(overall.clone());
-            }
+            lines.push(format!("{p:?}"));
+            lines.extend(tally.lines(WIDTH, |s| cell(&s.0, 0, 3 + k)));
         }
     }
     lines.push(String::new());
@@ -240,22 +270,25 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
 }
 
 /// Width of [`cell`].
-const WIDTH: usize = 38;
+const WIDTH: usize = 57;
 /// The columns of [`cell`].
-const COLUMNS: &str = "  VBA   lost    net   lost  together";
+const COLUMNS: &str = "  VBA   lost    net   lost together     @0.1 V/n/t";
 
 /// One split's column: VBA, the network and together (`k`-th setting), accuracy `which`
 /// (0 limbs, 1 all).
 fn cell(s: &[Pair], which: usize, together: usize) -> String {
     let t = s.get(together).map_or(Accuracy::default(), |p| p[which]);
     format!(
-        "{:>5.3} {:>5.1}% {:>6.3} {:>5.1}% {:>5.3} {:>3.0}%",
+        "{:>5.3} {:>5.1}% {:>6.3} {:>5.1}% {:>5.3} {:>3.0}%  {:.3}/{:.3}/{:.3}",
         s[0][which].pck02(),
         100.0 * s[0][which].lost(),
         s[1][which].pck02(),
         100.0 * s[1][which].lost(),
         t.pck02(),
-        100.0 * t.lost()
+        100.0 * t.lost(),
+        s[0][which].pck01(),
+        s[1][which].pck01(),
+        t.pck01()
     )
 }
 
@@ -280,9 +313,10 @@ fn score_clip(
     params: videomocap_core::track::TrackerParams,
     network: Arc<PoseNetwork>,
     settings: &[EvidenceParams],
-    net_seconds: &mut f64,
     reuse: bool,
-) -> Result<Scores, ExitError> {
+    dump: Option<&mut Vec<String>>,
+) -> Result<(Scores, [ClipScore; 3], f64), ExitError> {
+    let mut net_seconds = 0.0;
     let gt = GroundTruth::load(&clip.dir.join("gt.json")).map_err(ExitError::failed)?;
     let marks = Marks::load(&clip.dir.join("marks.json")).map_err(ExitError::failed)?;
     let clicked = clicked_marks(&marks, CLICK_NOISE_PX, &clip.name);
@@ -316,7 +350,7 @@ fn score_clip(
                 &AtomicBool::new(false),
             )
             .map_err(ExitError::failed)?;
-            *net_seconds += t0.elapsed().as_secs_f64();
+            net_seconds += t0.elapsed().as_secs_f64();
             let alone = network_alone(&mut video, &clicked, &network)?;
             let c = Cached { net, alone };
             if reuse {
@@ -339,16 +373,40 @@ fn score_clip(
             .map_err(ExitError::failed)?
             .tracks
     };
+    if let Some(dump) = dump {
+        let x = videomocap_core::track::doubt_features(&vba, &net, &keys, &product);
+        let derived = gt.derived();
+        for ((g, f), row) in gt.frames.iter().zip(&product.frames).zip(&x) {
+            let at = |j: Joint| Point2::new(g.points2d[j.index()][0], g.points2d[j.index()][1]);
+            let torso = (at(Joint::Neck) - at(Joint::Pelvis)).norm().max(1.0);
+            for j in Joint::ALL {
+                if keys.is_key(f.index, j) || derived.contains(&j) {
+                    continue;
+                }
+                let off = (f.points[j].pos - at(j)).norm() > 0.2 * torso;
+                let values: Vec<String> = row[j].iter().map(|v| format!("{v:.4}")).collect();
+                dump.push(format!(
+                    "{},{},{},{},{}",
+                    clip.name,
+                    f.index.get(),
+                    j.name(),
+                    values.join(","),
+                    u8::from(off)
+                ));
+            }
+        }
+    }
     let weak = params.weak_reliability;
     let pointing = [
         Pointing::of(&gt, &vba, &keys, weak),
         Pointing::of(&gt, &product, &keys, weak),
     ];
-    let mut scores = vec![
-        pair(&score_tracks(&gt, &vba).map_err(ExitError::failed)?),
-        pair(&score_positions(&gt, alone.into_iter()).map_err(ExitError::failed)?),
-        pair(&score_tracks(&gt, &product).map_err(ExitError::failed)?),
+    let full = [
+        score_tracks(&gt, &vba).map_err(ExitError::failed)?,
+        score_positions(&gt, alone).map_err(ExitError::failed)?,
+        score_tracks(&gt, &product).map_err(ExitError::failed)?,
     ];
+    let mut scores: Vec<Pair> = full.iter().map(pair).collect();
     for (k, p) in settings.iter().enumerate() {
         let together = weigh(&vba, &net, &keys, p);
         if reuse && k == 0 {
@@ -361,5 +419,5 @@ fn score_clip(
             &score_tracks(&gt, &together).map_err(ExitError::failed)?,
         ));
     }
-    Ok((scores, pointing))
+    Ok(((scores, pointing), full, net_seconds))
 }

@@ -21,6 +21,58 @@ pub struct BenchClip {
     pub split: Split,
     /// Its folder (video.mp4, gt.json, marks.json).
     pub dir: PathBuf,
+    /// Where the camera stands ([`ViewFamily::Real`] for the real clips).
+    pub view: ViewFamily,
+}
+
+/// The views the per-view tables report apart: the camera in front, at an angle (the
+/// suite's oblique, raised and low views, 30–45° to a side), in profile, behind; and the real
+/// clips.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum ViewFamily {
+    /// In front.
+    Frontal,
+    /// 30–45° to a side (oblique, raised, low).
+    Oblique,
+    /// In profile.
+    Side,
+    /// From behind.
+    Behind,
+    /// The real clips.
+    Real,
+}
+
+impl ViewFamily {
+    /// Every view family, in table order.
+    pub const ALL: [ViewFamily; 5] = [
+        ViewFamily::Frontal,
+        ViewFamily::Oblique,
+        ViewFamily::Side,
+        ViewFamily::Behind,
+        ViewFamily::Real,
+    ];
+
+    /// The family of a suite view.
+    pub fn of(view: videomocap_testkit::synth::View) -> ViewFamily {
+        use videomocap_testkit::synth::View;
+        match view {
+            View::Frontal => ViewFamily::Frontal,
+            View::Oblique | View::Raised | View::Low => ViewFamily::Oblique,
+            View::Side => ViewFamily::Side,
+            View::Behind => ViewFamily::Behind,
+        }
+    }
+
+    /// Its name in tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            ViewFamily::Frontal => "frontal",
+            ViewFamily::Oblique => "oblique",
+            ViewFamily::Side => "side",
+            ViewFamily::Behind => "behind",
+            ViewFamily::Real => "real",
+        }
+    }
 }
 
 /// A clip opened for scoring: its reference, the marks as a user clicks them, and its video.
@@ -69,13 +121,12 @@ pub fn lift_settings(
     }
 }
 
-/// The bundled pose network on `threads` threads, shareable between jobs.
+/// The bundled pose network on `threads` threads (the product's loader), shareable between
+/// jobs.
 pub fn bundled_network(
     threads: usize,
 ) -> Result<std::sync::Arc<videomocap_core::network::PoseNetwork>, ExitError> {
-    videomocap_core::network::PoseNetwork::bundled()
-        .map(|n| std::sync::Arc::new(n.with_threads(threads)))
-        .map_err(ExitError::failed)
+    videomocap_core::network::PoseNetwork::shared(threads).map_err(ExitError::failed)
 }
 
 /// `--split`: all (`None`), dev or test.
@@ -98,7 +149,11 @@ pub fn bench_clips(
     global: &GlobalArgs,
 ) -> Result<Vec<BenchClip>, ExitError> {
     let wanted = parse_split(split)?;
-    let suite = Suite::load(&repo_root()).map_err(ExitError::failed)?;
+    let mut suite = Suite::load(&repo_root()).map_err(ExitError::failed)?;
+    // Only the clips asked for are rendered (a short look at one clip renders one clip).
+    suite
+        .clips
+        .retain(|c| wanted.is_none_or(|w| c.split == w) && clip.is_none_or(|n| c.name.contains(n)));
     let dirs = suite
         .ensure_rendered(suite_dir, &mut |name| {
             say(global, &format!("rendering suite clip {name} …"))
@@ -113,6 +168,7 @@ pub fn bench_clips(
             family: c.family,
             split: c.split,
             dir,
+            view: ViewFamily::of(c.params.view),
         })
         .collect();
     out.extend(REAL_CLIPS.iter().map(|(name, dir)| BenchClip {
@@ -120,6 +176,7 @@ pub fn bench_clips(
         family: Family::Real,
         split: Split::Dev,
         dir: repo_root().join(dir),
+        view: ViewFamily::Real,
     }));
     out.retain(|c| wanted.is_none_or(|w| c.split == w) && clip.is_none_or(|n| c.name.contains(n)));
     Ok(out)
@@ -272,6 +329,7 @@ mod tests {
             family,
             split,
             dir: PathBuf::new(),
+            view: ViewFamily::Frontal,
         }
     }
 

@@ -171,7 +171,7 @@ fn score_clip(
     clip: &BenchClip,
     threads: usize,
     params: TrackerParams,
-) -> Result<(TrackScores, Accuracy, Marks), ExitError> {
+) -> Result<(TrackScores, ClipScore, Marks), ExitError> {
     let gt = GroundTruth::load(&clip.dir.join("gt.json")).map_err(ExitError::failed)?;
     let marks = Marks::load(&clip.dir.join("marks.json")).map_err(ExitError::failed)?;
     let clicked = clicked_marks(&marks, CLICK_NOISE_PX, &clip.name);
@@ -181,9 +181,8 @@ fn score_clip(
         let tracks = track_opened(&mut video, m, threads, params)?;
         score_tracks(&gt, &tracks).map_err(ExitError::failed)
     };
-    let (from_clicks, from_exact) = (vba(&clicked)?, vba(&marks)?);
-    let limbs = from_clicks.limbs();
-    let (from_clicks, from_exact) = (from_clicks.overall, from_exact.overall);
+    let (clicks_score, from_exact) = (vba(&clicked)?, vba(&marks)?);
+    let (from_clicks, from_exact) = (clicks_score.overall, from_exact.overall);
     let stature = videomocap_core::track::stature_px(
         &clicked.points,
         &videomocap_core::skeleton::Proportions::default(),
@@ -192,7 +191,7 @@ fn score_clip(
     let template = score_positions(&gt, base.into_iter().enumerate())
         .map_err(ExitError::failed)?
         .overall;
-    Ok(([from_clicks, from_exact, template], limbs, clicked))
+    Ok(([from_clicks, from_exact, template], clicks_score, clicked))
 }
 
 /// Runs the accuracy and speed benchmark and prints its tables.
@@ -221,9 +220,12 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let mut clicked = Vec::new();
     let mut real_limbs: Vec<(String, Accuracy)> = Vec::new();
     let mut vba_limbs = Vec::new();
+    let mut vba_scores = Vec::new();
     for clip in &clips {
         say(global, &format!("tracking {} …", clip.name));
-        let (s, limbs, marks) = score_clip(clip, threads, params)?;
+        let (s, score, marks) = score_clip(clip, threads, params)?;
+        let limbs = score.limbs();
+        vba_scores.push(score);
         if clip.family == Family::Real {
             real_limbs.push((clip.name.clone(), limbs));
         }
@@ -280,7 +282,19 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         lines.push("(OpenCV baselines: python3 with cv2 not found; `python3 -m pip install opencv-contrib-python-headless numpy` adds them)".to_owned());
     }
     let mediapipe = crate::bench_baselines::mediapipe(&clips, &vba_limbs, &a.suite_dir, global)?;
-    if let Some((t, per_clip)) = &mediapipe {
+    let mut views = crate::bench_views::ViewTable::new(&["VBA", "MediaPipe"]);
+    if let Some((_, mp)) = &mediapipe {
+        for ((clip, ours), theirs) in clips.iter().zip(&vba_scores).zip(mp) {
+            views.add(clip, &[ours, theirs]);
+        }
+        lines.push(String::new());
+        lines.push(
+            "per view: VBA from clicked marks against MediaPipe Pose (its own detector, no marks)"
+                .to_owned(),
+        );
+        lines.extend(views.lines());
+    }
+    if let Some(((t, per_clip), _)) = &mediapipe {
         lines.push(String::new());
         lines.push(
             "VBA alone (clicked marks) against the network alone (MediaPipe Pose 0.10.21, its own detector, no marks), PCK@0.2 of the 13 limb joints; MediaPipe's lost share and its 16 joints (neck, chest, pelvis and head top derived: scripts/mediapipe_baseline.py)".to_owned(),
@@ -382,7 +396,8 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
                     .iter()
                     .map(|(name, a)| serde_json::json!({"clip": name, "vba": accuracy_json(a)}))
                     .collect::<Vec<_>>(),
-                "mediapipe": mediapipe.as_ref().map(|(t, _)| t.json(|s| serde_json::json!({
+                "views": views.json(),
+                "mediapipe": mediapipe.as_ref().map(|((t, _), _)| t.json(|s| serde_json::json!({
                     "vba_limbs": accuracy_json(&s[0]),
                     "mediapipe_limbs": accuracy_json(&s[1]),
                     "mediapipe_all": accuracy_json(&s[2]),
@@ -402,9 +417,9 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     Ok(())
 }
 
-/// An accuracy as JSON: PCK@0.2, lost share, mean error in pixels, samples.
+/// An accuracy as JSON: PCK@0.1, PCK@0.2, lost share, mean error in pixels, samples.
 pub fn accuracy_json(a: &Accuracy) -> serde_json::Value {
-    serde_json::json!({"pck02": a.pck02(), "lost": a.lost(), "mean_px": a.mean_px(), "samples": a.count})
+    serde_json::json!({"pck01": a.pck01(), "pck02": a.pck02(), "lost": a.lost(), "mean_px": a.mean_px(), "samples": a.count})
 }
 
 /// A prepared speed measurement of tracking one clip: the job and, when decoding is excluded,
@@ -424,12 +439,8 @@ impl TrackTimer {
         params: TrackerParams,
     ) -> Result<Self, ExitError> {
         let marks = Marks::load(&dir.join("marks.json")).map_err(ExitError::failed)?;
-        // Frames in memory are full size: the tracker shrinks them itself (FFmpeg's scaling
-        // while decoding would empty the cache).
-        let params = TrackerParams {
-            decoder_scaling: decoding,
-            ..params
-        };
+        // Frames in memory are full size: the tracker shrinks them itself (it leaves a video
+        // whose frames are in its cache at full size, as FFmpeg's scaling would empty it).
         Ok(TrackTimer {
             dir: dir.to_owned(),
             job: TrackJob::from_marks(&marks, params, threads),

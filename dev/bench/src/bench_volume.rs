@@ -200,6 +200,7 @@ fn suite_takes(
             family: clip.family,
             split: clip.split,
             dir: Default::default(),
+            view: crate::bench_suite::ViewFamily::of(clip.params.view),
         };
         takes.push((clip.take.clone(), bench, motion, stature));
     }

@@ -13,6 +13,7 @@ mod bench_motion;
 mod bench_scrub;
 mod bench_suite;
 mod bench_track;
+mod bench_views;
 mod bench_volume;
 mod prior;
 mod score;

@@ -3,9 +3,9 @@
 //! when their cancel flag is set.
 
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, channel};
-use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 use videomocap_core::formats::{FrameTracks, Tracks2d};
 use videomocap_core::lift::{CameraChoice, SubjectChoice, reconstruct};
@@ -14,21 +14,6 @@ use videomocap_core::network::PoseNetwork;
 use videomocap_core::track::{TrackJob, TrackOutput, track_video};
 use videomocap_core::video::{OpenOptions, Video};
 use videomocap_volume::{Processed, VolumeParams, process_directory};
-
-/// The bundled pose network, loaded once on first use (about a second); `None`, with the
-/// reason on stderr, when it cannot be used: tracking goes on with VBA alone.
-fn pose_network(threads: usize) -> Option<Arc<PoseNetwork>> {
-    static NETWORK: OnceLock<Option<Arc<PoseNetwork>>> = OnceLock::new();
-    NETWORK
-        .get_or_init(|| match PoseNetwork::bundled() {
-            Ok(n) => Some(Arc::new(n.with_threads(threads))),
-            Err(e) => {
-                eprintln!("warning: {e}; tracking with VBA alone");
-                None
-            }
-        })
-        .clone()
-}
 
 /// What a job sends back.
 pub enum JobEvent {
@@ -45,6 +30,8 @@ pub enum JobEvent {
     Lifted(Result<(LiftOutput, Option<SubjectFit>), String>),
     /// A point-volume sequence was processed.
     Volume(Result<Processed, String>),
+    /// The pose network could not be loaded (why): tracking goes on with VBA alone.
+    NetworkUnavailable(String),
 }
 
 /// A running job.
@@ -72,7 +59,13 @@ impl Job {
         let flag = cancel.clone();
         std::thread::spawn(move || {
             if job.params.network && job.network.is_none() {
-                job.network = pose_network(job.threads);
+                // The product's one loader, shared with the command line and the benchmarks.
+                match PoseNetwork::shared(job.threads) {
+                    Ok(n) => job.network = Some(n),
+                    Err(e) => {
+                        let _ = tx.send(JobEvent::NetworkUnavailable(e.to_string()));
+                    }
+                }
             }
             let result = Video::open(&video, &OpenOptions::default())
                 .map_err(|e| e.to_string())

@@ -17,7 +17,8 @@ use videomocap_core::video::VideoInfo;
 const CHOICES_KEPT: usize = 16;
 
 impl State {
-    /// Tracks the whole video from the keys (`from = None`), or re-tracks from a corrected frame.
+    /// Tracks the whole video from the keys (`from = None`), or again after a correction on frame
+    /// `from` (the same: tracking is a function of the video, the keys and the settings).
     pub(super) fn start_tracking(&mut self, from: Option<usize>) {
         if self.running.is_some() && from.is_none() {
             return;
@@ -34,8 +35,6 @@ impl State {
             keys: p.keys.clone(),
             params: p.settings.tracker,
             threads: 2,
-            from: from.filter(|_| p.tracks.is_some()),
-            previous: p.tracks.as_deref().cloned(),
             background: self.background.clone(),
             // The network is loaded on the job's thread (see `Job::track`).
             network: None,
@@ -110,6 +109,9 @@ impl State {
                     self.partial.insert(f.index.get(), f);
                 }
                 JobEvent::Progress { .. } => {}
+                JobEvent::NetworkUnavailable(why) => {
+                    self.network_problem = Some(why);
+                }
                 JobEvent::Tracked(result) => self.tracked(result),
                 JobEvent::Lifted(result) => self.lifted(result),
                 JobEvent::Volume(result) => {
@@ -240,6 +242,10 @@ impl State {
                 self.autosave();
                 self.results_changed();
                 self.status = format!("Tracked {} frames", self.frame_count());
+                if let Some(why) = &self.network_problem {
+                    self.status +=
+                        &format!(" with VBA alone (the pose network could not load: {why})");
+                }
                 if let Some(w) = self.weak_share() {
                     self.status += &format!(
                         "; {} weak joint-frames ({:.1} % of the clip)",

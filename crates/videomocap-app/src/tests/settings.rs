@@ -252,3 +252,23 @@ fn a_settings_drag_is_one_undo_step() {
     h.state_mut().state_mut().apply(Intent::Undo);
     assert!((h.state().state().project().unwrap().settings.height_m - 1.70).abs() < 1e-9);
 }
+
+/// A pose network that could not load is named in the Tracker panel (tracking goes on with VBA
+/// alone), as a tracking job reports it.
+#[test]
+fn a_network_that_could_not_load_is_shown_in_the_tracker_panel() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = with_tracker_panel(dir.path());
+    let shown = |h: &Harness<'static, App>| h.query_by_label_contains("could not load").is_some();
+    assert!(!shown(&h));
+    h.state_mut()
+        .state_mut()
+        .report_network_problem_for_test("model checksum mismatch".to_owned());
+    h.run();
+    assert!(shown(&h));
+    assert!(
+        h.query_by_label_contains("model checksum mismatch")
+            .is_some(),
+        "the reason is named"
+    );
+}

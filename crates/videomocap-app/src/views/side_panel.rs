@@ -109,6 +109,12 @@ fn parameters(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
         });
     });
     ui.collapsing("Tracker", |ui| {
+        if let Some(why) = state.network_problem() {
+            ui.colored_label(
+                ui.visuals().warn_fg_color,
+                format!("The pose network could not load ({why}): tracking uses VBA alone."),
+            );
+        }
         tracker_settings::tracker_settings_ui(ui, &mut settings.tracker);
     });
     for o in state.outdated() {

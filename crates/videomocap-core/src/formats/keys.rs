@@ -63,23 +63,6 @@ impl KeyFrames {
             .or_insert_with(|| PerJoint([None; JOINT_COUNT]))[joint] = Some(pos);
     }
 
-    /// The earliest frame a re-track from a correction on frame `from` can change: the latest
-    /// key before `from` that every joint has had (each joint's last key before it, the
-    /// earliest of those; 0 when a joint has none).
-    pub fn earliest_changed_by(&self, from: FrameIndex) -> FrameIndex {
-        Joint::ALL
-            .iter()
-            .map(|&j| {
-                self.frames
-                    .range(..from)
-                    .rev()
-                    .find(|(_, k)| k[j].is_some())
-                    .map_or(FrameIndex(0), |(&f, _)| f)
-            })
-            .min()
-            .unwrap_or(FrameIndex(0))
-    }
-
     /// Whether a joint was placed by hand on a frame.
     pub fn is_key(&self, frame: FrameIndex, joint: Joint) -> bool {
         self.frames

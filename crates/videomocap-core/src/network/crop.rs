@@ -61,15 +61,6 @@ impl Crop {
         })
     }
 
-    /// Whether `other` frames the same region within a hundredth of the side (centre and
-    /// side) and a hundredth of a radian: the network would see the same picture.
-    pub fn same_as(&self, other: &Crop) -> bool {
-        let tol = 0.01 * self.side_px.max(other.side_px);
-        (self.centre - other.centre).norm() <= tol
-            && (self.side_px - other.side_px).abs() <= tol
-            && (self.angle_rad - other.angle_rad).abs() <= 0.01
-    }
-
     /// The image point at crop pixel `(u, v)` (0–256, pixel centres at half-integers as the
     /// network reports them).
     pub fn to_image(&self, u: f64, v: f64) -> Point2<f64> {

@@ -102,6 +102,25 @@ impl PoseNetwork {
         Self::from_reader(&mut std::io::Cursor::new(BUNDLED), Path::new("bundled"))
     }
 
+    /// The bundled network on `threads` threads, loaded once per process and thread count
+    /// (loading parses and optimises the model, about a second): the one loader the command
+    /// line, the app and the benchmarks share. An error says why it cannot be used; the
+    /// callers then track with VBA alone and say so.
+    pub fn shared(threads: usize) -> Result<std::sync::Arc<PoseNetwork>, NetworkError> {
+        type Loaded = Vec<(usize, std::sync::Arc<PoseNetwork>)>;
+        static LOADED: std::sync::Mutex<Loaded> = std::sync::Mutex::new(Vec::new());
+        // A panic while loading leaves the list as it was: nothing half-made is kept.
+        let mut loaded = LOADED
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        if let Some((_, n)) = loaded.iter().find(|(t, _)| *t == threads) {
+            return Ok(n.clone());
+        }
+        let n = std::sync::Arc::new(Self::bundled()?.with_threads(threads));
+        loaded.push((threads, n.clone()));
+        Ok(n)
+    }
+
     /// A network from an ONNX file (the same model, converted anew).
     pub fn load(path: &Path) -> Result<PoseNetwork, NetworkError> {
         let bytes = std::fs::read(path).map_err(|e| NetworkError::Model {

@@ -347,11 +347,11 @@ mod tests {
                 ),
                 "hands_outside_body",
             ),
-            // The tracker's settings are checked too (a length range of 1 or more would let a
-            // limb's block shrink to nothing).
+            // The tracker's settings are checked too (a reliability threshold above 1 would
+            // make every joint weak).
             (
-                base.replace("\"limb_range_m\": 0.3", "\"limb_range_m\": 1.5"),
-                "settings.tracker: tracker setting \"limb_range_m\"",
+                base.replace("\"weak_reliability\": 0.45", "\"weak_reliability\": 1.5"),
+                "settings.tracker: tracker setting \"weak_reliability\"",
             ),
         ];
         for (text, needle) in cases {

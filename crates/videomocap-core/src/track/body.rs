@@ -9,15 +9,13 @@
 //! Works in one image scale (the caller converts to and from video pixels).
 
 use super::background::Background;
-use super::block::{MorphBlock, wrap_angle};
+use super::block::MorphBlock;
 use super::head::HeadPredictor;
-use super::params::TrackerParams;
-use super::search::{
-    AngularParams, ChainRoot, ChainSegment, Found, Prior, SpiralParams, angular, refine_chain,
-    spiral,
-};
+use super::limb::{shoulder_spring, track_limb};
+use super::params::Tuning;
+use super::part::{LENGTH_SLACK, Part, accept, extent, is_arm, predict_anchored, prior};
+use super::search::{AngularParams, ChainRoot, Found, SpiralParams, angular, spiral};
 use super::similarity::{Extent, FloatFrame, FrameView, Template};
-use crate::camera::point_in_frame;
 use crate::skeleton::{BodyPart, Joint, PerJoint, Proportions};
 use image::RgbImage;
 use nalgebra::Point2;
@@ -51,57 +49,6 @@ pub struct JointResult {
     pub pos: Point2<f64>,
     /// Reliability in [0, 1]: the block's similarity mapped by `c0 / (c0 + cost)`.
     pub reliability: f32,
-}
-
-/// A tracked body part: its block, its angle one frame earlier and its colour model.
-#[derive(Debug, Clone)]
-struct Part {
-    block: MorphBlock,
-    /// θ of the previous frame (for the angular velocity).
-    prev_theta: f64,
-    /// The colour model.
-    template: Template,
-    reliability: f32,
-    /// Longest plausible image length of the bone on the marked frame, pixels (proportions ×
-    /// marked stature); it grows with the head's zoom (`BodyTracker::zoom`).
-    max_len: f64,
-    /// How far along its bone the part is sampled.
-    extent: Extent,
-    /// What the block pays per unit of ln(full length / length) when shorter than its full
-    /// length: [`TrackerParams::short_penalty`] for the legs and upper arms, the forearms' own
-    /// [`TrackerParams::forearm_short_penalty`], 0 for the head, trunk and hip patch.
-    short_penalty: f32,
-}
-
-/// A limb's longest plausible image length over its full length from the proportions (people
-/// differ from the table, and marks are not exact).
-const LENGTH_SLACK: f64 = 1.2;
-
-/// Whether a part is an upper arm or a forearm: the parts whose blocks weigh the foreground
-/// lane ([`TrackerParams::arm_foreground`]).
-fn is_arm(part: BodyPart) -> bool {
-    matches!(
-        part,
-        BodyPart::LeftUpperArm
-            | BodyPart::RightUpperArm
-            | BodyPart::LeftForearm
-            | BodyPart::RightForearm
-    )
-}
-
-/// The sampled extent of each part along its bone (see [`Extent`]): the head block reaches a
-/// little above the calvaria, limb blocks past their far joint (into the forearm, the hand,
-/// the shank, the foot).
-fn extent(part: BodyPart) -> Extent {
-    let (start, end) = match part {
-        BodyPart::Head => (0.0, 1.0),
-        BodyPart::Trunk => (0.0, 1.1),
-        BodyPart::LeftUpperArm | BodyPart::RightUpperArm => (0.0, 1.15),
-        BodyPart::LeftForearm | BodyPart::RightForearm => (0.0, 1.3),
-        BodyPart::LeftThigh | BodyPart::RightThigh => (0.0, 1.15),
-        BodyPart::LeftShank | BodyPart::RightShank => (0.0, 1.2),
-    };
-    Extent { start, end }
 }
 
 /// Block widths in pixels, from the proportions scaled to the marked body.
@@ -153,7 +100,7 @@ pub fn stature_px(pose: &PerJoint<Point2<f64>>, proportions: &Proportions) -> f6
 /// Tracks the body frame by frame.
 #[derive(Debug, Clone)]
 pub struct BodyTracker {
-    params: TrackerParams,
+    params: Tuning,
     head: Part,
     trunk: Part,
     /// Per chain: the upper and lower part.
@@ -181,14 +128,6 @@ pub struct BodyTracker {
     spare: FloatFrame,
 }
 
-fn reliability(cost: f32, c0: f32) -> f32 {
-    if cost.is_finite() {
-        c0 / (c0 + cost.max(0.0))
-    } else {
-        0.0
-    }
-}
-
 impl BodyTracker {
     /// Starts from a pose on `image` (a key frame): blocks from the pose, widths from the
     /// proportions scaled to it, colour models sampled from the image.
@@ -196,7 +135,7 @@ impl BodyTracker {
         image: &RgbImage,
         pose: &PerJoint<Point2<f64>>,
         proportions: &Proportions,
-        params: TrackerParams,
+        params: Tuning,
         background: Option<Arc<Background>>,
     ) -> BodyTracker {
         let width = widths(pose, proportions, params.block_width_scale);
@@ -300,6 +239,44 @@ impl BodyTracker {
             prev: floats,
             spare: FloatFrame::default(),
         }
+    }
+
+    /// Re-starts on a key frame from `pose`, as [`BodyTracker::new`], except that every part
+    /// none of whose two joints the key `placed` goes on as it was (its block, colour models
+    /// and reliability; its length limit carried over to the re-started head's zoom): a
+    /// correction of one joint re-learns no other part at a place the user did not confirm
+    /// (issue 90). With every joint placed it is `new`.
+    pub(crate) fn restart(
+        &mut self,
+        image: &RgbImage,
+        pose: &PerJoint<Point2<f64>>,
+        placed: &PerJoint<bool>,
+        proportions: &Proportions,
+    ) {
+        let fresh = BodyTracker::new(
+            image,
+            pose,
+            proportions,
+            self.params,
+            self.background.clone(),
+        );
+        let old = std::mem::replace(self, fresh);
+        let keep = |new: &mut Part, old_part: &Part, (a, b): (Joint, Joint)| {
+            if !placed[a] && !placed[b] {
+                *new = old_part.clone();
+                new.max_len *= old.zoom;
+            }
+        };
+        keep(&mut self.head, &old.head, BodyPart::Head.ends());
+        keep(&mut self.trunk, &old.trunk, BodyPart::Trunk.ends());
+        keep(&mut self.hips, &old.hips, (Joint::Pelvis, Joint::Pelvis));
+        for (c, [a, b, e]) in CHAINS.iter().enumerate() {
+            let [upper, lower] = &mut self.limbs[c];
+            keep(upper, &old.limbs[c][0], (*a, *b));
+            keep(lower, &old.limbs[c][1], (*b, *e));
+        }
+        // The shoulders and hips where `pose` has them, on the trunk block kept or made.
+        self.trunk_points = TRUNK_JOINTS.map(|j| self.trunk.block.to_block(pose[j]));
     }
 
     /// The current pose (after the last step, or the starting pose).
@@ -522,7 +499,7 @@ fn hip_patch(pelvis: Point2<f64>, theta: f64, trunk_m: f64, trunk_n: f64) -> Mor
 
 impl BodyTracker {
     /// The hip patch searched by the head's spiral from where it was (for [`Self::hips_hold`]).
-    fn hips_spiral(&self, frame: FrameView, p: &TrackerParams) -> Found {
+    fn hips_spiral(&self, frame: FrameView, p: &Tuning) -> Found {
         spiral(
             &self.hips.template,
             frame,
@@ -543,7 +520,7 @@ impl BodyTracker {
     /// by the head's spiral from where it was (`found`, from [`Self::hips_spiral`]); when it
     /// matches clearly better there than where the trunk put the pelvis, the trunk is re-hung
     /// from the neck to the patch's centre.
-    fn hips_hold(&mut self, frame: FrameView, neck: Point2<f64>, found: Found, p: &TrackerParams) {
+    fn hips_hold(&mut self, frame: FrameView, neck: Point2<f64>, found: Found, p: &Tuning) {
         let t = self.trunk.block;
         let at_trunk = hip_patch(t.end(), t.theta, t.m, t.n);
         let c_trunk = self
@@ -580,229 +557,68 @@ impl BodyTracker {
     }
 }
 
-/// The predicted block of a part anchored at `anchor`. Without a parent (the trunk) its angle
-/// advances by its own angular velocity; with one (`[θ now, θ one frame ago, θ two frames ago]`
-/// of the parent) its angle relative to the parent advances by its relative angular velocity,
-/// so a forearm follows its upper arm. Velocities are damped by `damping`; the length is kept.
-fn predict_anchored(
-    part: &Part,
-    anchor: Point2<f64>,
-    parent: Option<[f64; 3]>,
-    damping: f64,
-) -> MorphBlock {
-    let theta = match parent {
-        None => part.block.theta + damping * wrap_angle(part.block.theta - part.prev_theta),
-        Some([now, before, older]) => {
-            let rel = wrap_angle(part.block.theta - before);
-            let rel_prev = wrap_angle(part.prev_theta - older);
-            now + rel + damping * wrap_angle(rel - rel_prev)
-        }
-    };
-    MorphBlock {
-        origin: anchor,
-        theta,
-        ..part.block
-    }
-}
-
-/// The motion prior of an anchored part around its prediction; its length limits are the
-/// marked ones times the head's `zoom`, and a block shorter than the part's full length pays
-/// the part's `short_penalty` per unit of log ratio.
-fn prior(part: &Part, pred: &MorphBlock, p: &TrackerParams, zoom: f64) -> Prior {
-    Prior {
-        theta: pred.theta,
-        m: pred.m,
-        per_degree: p.angle_penalty,
-        per_log_length: p.length_penalty,
-        per_log_short: part.short_penalty,
-        m_full: part.max_len * zoom / LENGTH_SLACK,
-        m_min: 0.2 * part.max_len * zoom,
-        m_max: part.max_len * zoom,
-    }
-}
-
-/// Takes a search result: the block moves, the angle history shifts, the reliability is the
-/// mapped similarity, and the adaptive colour model learns the new appearance when reliable.
-fn accept(part: &mut Part, found: Found, frame: FrameView, p: &TrackerParams) {
-    move_to(part, found.block);
-    learn(part, frame, p);
-}
-
-/// Moves a part to a block found in a new frame: the angle history shifts.
-fn move_to(part: &mut Part, block: MorphBlock) {
-    part.prev_theta = part.block.theta;
-    part.block = block;
-}
-
-/// The part learns from its block in the new frame: its reliability is the mapped similarity,
-/// and the adaptive colour model learns the new appearance when reliable.
-fn learn(part: &mut Part, frame: FrameView, p: &TrackerParams) {
-    // The reliability comes from the colours alone, without the prior's penalty or the
-    // foreground lane.
-    let cost = part.template.appearance_cost(frame, &part.block);
-    part.reliability = reliability(cost, p.reliability_c0);
-    if part.reliability >= p.weak_reliability {
-        part.template.update(frame, &part.block, p.update_rate);
-    }
-}
-
-/// Whether a point lies off the image.
-fn off_image(q: Point2<f64>, frame: FrameView) -> bool {
-    // Frame sides come from u32 image sizes.
-    !point_in_frame(&q, frame.width() as u32, frame.height() as u32)
-}
-
-/// First step of a limb chain's joint refinement, tracker pixels (see [`refine_chain`]).
-const CHAIN_STEP_PX: f64 = 1.0;
-/// Steps of a limb chain's joint refinement: 1, ½ and ¼ px. Measured on the suite and the real
-/// sample: a first step of 0.5 or 2 px, or four levels, did no better.
-const CHAIN_LEVELS: usize = 3;
-
-/// A limb segment's search around its prediction: `limb_range_deg` in coarse steps, the length
-/// within `limb_range_m`.
-fn limb_search(p: &TrackerParams) -> AngularParams {
-    AngularParams {
-        range_theta: p.limb_range_deg.to_radians(),
-        step_theta: p.coarse_step_deg.to_radians(),
-        range_m: p.limb_range_m,
-        m_count: 5,
-        scale_width: false,
-    }
-}
-
-/// `search` widened for fast limbs: `wide_range_deg` in steps twice the coarse step.
-fn widened(search: AngularParams, p: &TrackerParams) -> AngularParams {
-    AngularParams {
-        range_theta: p.wide_range_deg.to_radians(),
-        step_theta: 2.0 * p.coarse_step_deg.to_radians(),
-        ..search
-    }
-}
-
-/// One limb chain: the upper block anchored at the root, the lower at the found middle joint.
-/// A weak result from the narrow search around the prediction is searched again over the wide
-/// range (fast limbs), unless the prediction has left the image: then the part is held at its
-/// angle to its parent, reliability 0, until its prediction comes back. An arm whose forearm
-/// When both segments moved, the chain is refined as one figure ([`refine_chain`], `chain_refine`) before either learns
-/// its new appearance. Returns the root joint, moved when it has a spring.
-fn track_limb(
-    parts: &mut [Part; 2],
-    root: ChainRoot,
-    trunk_angles: [f64; 3],
-    frame: FrameView,
-    p: &TrackerParams,
-    zoom: f64,
-) -> Point2<f64> {
-    let mut parent = trunk_angles;
-    let mut anchor = root.at;
-    // The segments moved this frame (not held), with their priors; they learn their new
-    // appearance once the chain is settled.
-    let mut moved: [Option<Prior>; 2] = [None, None];
-    for (k, part) in parts.iter_mut().enumerate() {
-        let before = (part.block.theta, part.prev_theta);
-        let pred = predict_anchored(part, anchor, Some(parent), p.velocity_damping);
-        let narrow = limb_search(p);
-        let prior = prior(part, &pred, p, zoom);
-        let predicted_off = off_image(pred.end(), frame);
-        let narrow = if off_image(pred.to_image(part.extent.end, 0.0), frame) {
-            // The far end of the sampled part is cut off by the image's edge, so its length
-            // cannot be seen: search the angle only.
-            AngularParams {
-                range_m: 0.0,
-                m_count: 1,
-                ..narrow
-            }
-        } else {
-            narrow
-        };
-        // Beyond the paper: a forearm or shank never folds back onto its upper segment (elbows
-        // and knees flex to about 150°; seen from the side, the image angle is the true one).
-        // A lower segment found folded further than `fold_limit_deg` is a lock on the wrong
-        // thing (the other leg, the floor); it is held like a joint off the image.
-        let folded = |b: &MorphBlock| k == 1 && folded_back(parent[0], b.theta, p);
-        let mut found = angular(&part.template, frame, &pred, &narrow, &prior);
-        let weak = reliability(found.cost, p.reliability_c0) < p.weak_reliability;
-        if weak && predicted_off {
-            // The joint left the frame: nothing to match until its prediction is back.
-            hold(part, anchor, parent);
-        } else {
-            if weak || folded(&found.block) {
-                let wide = widened(narrow, p);
-                let again = angular(&part.template, frame, &pred, &wide, &prior);
-                if again.cost < found.cost && !folded(&again.block) || folded(&found.block) {
-                    found = again;
-                }
-            }
-            if folded(&found.block) {
-                hold(part, anchor, parent);
-            } else {
-                move_to(part, found.block);
-                moved[k] = Some(prior);
-            }
-        }
-        parent = [part.block.theta, before.0, before.1];
-        anchor = part.block.end();
-    }
-    if let [Some(upper), Some(lower)] = &moved
-        && p.chain_refine
-    {
-        let ([u, l], _) = refine_chain(
-            frame,
-            root,
-            [
-                ChainSegment {
-                    template: &parts[0].template,
-                    n: parts[0].block.n,
-                    prior: upper,
-                },
-                ChainSegment {
-                    template: &parts[1].template,
-                    n: parts[1].block.n,
-                    prior: lower,
-                },
-            ],
-            [parts[0].block.end(), parts[1].block.end()],
-            CHAIN_STEP_PX,
-            CHAIN_LEVELS,
-            |u, l| !folded_back(u.theta, l.theta, p),
-        );
-        parts[0].block = u;
-        parts[1].block = l;
-    }
-    for (part, moved) in parts.iter_mut().zip(moved) {
-        if moved.is_some() {
-            learn(part, frame, p);
-        }
-    }
-    // The upper segment hangs from the root: where the chain refinement moved it, or where it
-    // was (a found or held upper segment keeps its anchor).
-    parts[0].block.origin
-}
-
-/// Whether a lower segment at image angle `lower` is folded back onto its upper segment at
-/// `upper` further than `fold_limit_deg` (elbows and knees flex to about 150°).
-fn folded_back(upper: f64, lower: f64, p: &TrackerParams) -> bool {
-    wrap_angle(lower - upper).abs() > p.fold_limit_deg.to_radians()
-}
-
-/// The spring that ties chain `chain`'s root to the rigid trunk in its joint refinement: the
-/// shoulders' (`shoulder_spring`, when above 0); the hips stay on the trunk (letting them move
-/// measured worse on the side views, where the far leg pulls its hip onto the near one).
-fn shoulder_spring(chain: usize, p: &TrackerParams) -> Option<f32> {
-    (chain < 2 && p.shoulder_spring > 0.0).then_some(p.shoulder_spring)
-}
-
-/// Holds a part at its angle to its parent (no angular velocity, which would spin it) with
-/// reliability 0: a joint off the image, or a match refused.
-fn hold(part: &mut Part, anchor: Point2<f64>, parent: [f64; 3]) {
-    part.prev_theta = part.block.theta;
-    part.block = predict_anchored(part, anchor, Some(parent), 0.0);
-    part.reliability = 0.0;
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A figure standing in a 200 × 300 image of noise (the image shifted by `dx` pixels).
+    fn figure(dx: u32) -> (RgbImage, PerJoint<Point2<f64>>) {
+        let image = RgbImage::from_fn(200, 300, |x, y| {
+            let v = ((x + dx) * 7919 + y * 104_729) % 251;
+            image::Rgb([v as u8, (v * 3 % 251) as u8, (v * 5 % 251) as u8])
+        });
+        let at = |x: f64, y: f64| Point2::new(x, y);
+        let pose = PerJoint::from_fn(|j| match j {
+            Joint::HeadTop => at(100.0, 40.0),
+            Joint::Neck => at(100.0, 80.0),
+            Joint::Chest => at(100.0, 110.0),
+            Joint::Pelvis => at(100.0, 160.0),
+            Joint::LeftShoulder => at(120.0, 85.0),
+            Joint::LeftElbow => at(130.0, 120.0),
+            Joint::LeftWrist => at(135.0, 155.0),
+            Joint::RightShoulder => at(80.0, 85.0),
+            Joint::RightElbow => at(70.0, 120.0),
+            Joint::RightWrist => at(65.0, 155.0),
+            Joint::LeftHip => at(112.0, 160.0),
+            Joint::LeftKnee => at(115.0, 210.0),
+            Joint::LeftAnkle => at(117.0, 260.0),
+            Joint::RightHip => at(88.0, 160.0),
+            Joint::RightKnee => at(85.0, 210.0),
+            Joint::RightAnkle => at(83.0, 260.0),
+        });
+        (image, pose)
+    }
+
+    #[test]
+    fn a_restart_placing_one_joint_leaves_the_parts_away_from_it_as_they_were() {
+        let (first, pose) = figure(0);
+        let params = crate::track::TrackerParams::default().tuning(30.0, 1);
+        let proportions = Proportions::default();
+        let mut t = BodyTracker::new(&first, &pose, &proportions, params, None);
+        let (next, _) = figure(3);
+        t.step(&next);
+        let before = t.pose();
+        // Some part lost confidence on the changed image (else the test could not fail).
+        assert!(Joint::ALL.iter().any(|&j| before[j].reliability < 1.0));
+        let mut fixed = before.map(|_, r| r.pos);
+        fixed[Joint::LeftWrist] += nalgebra::Vector2::new(5.0, -4.0);
+        let placed = PerJoint::from_fn(|j| j == Joint::LeftWrist);
+        t.restart(&next, &fixed, &placed, &proportions);
+        let after = t.pose();
+        assert!((after[Joint::LeftWrist].pos - fixed[Joint::LeftWrist]).norm() < 1e-6);
+        // Every joint but the wrist keeps its place and its reliability (a fresh tracker
+        // would make each 1).
+        for j in Joint::ALL {
+            if j == Joint::LeftWrist {
+                continue;
+            }
+            assert!((after[j].pos - before[j].pos).norm() < 1e-6, "{}", j.name());
+            assert_eq!(after[j].reliability, before[j].reliability, "{}", j.name());
+        }
+        // With every joint placed it is a fresh start.
+        t.restart(&next, &fixed, &PerJoint::from_fn(|_| true), &proportions);
+        assert!(Joint::ALL.iter().all(|&j| t.pose()[j].reliability == 1.0));
+    }
 
     #[test]
     fn each_chain_root_index_names_that_chains_root_joint() {

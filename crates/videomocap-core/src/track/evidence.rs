@@ -5,7 +5,7 @@
 //! other-side point (its left/right swaps), by dynamic programming: each candidate's own
 //! confidence, the continuity of the motion, and keys that always win.
 
-use super::run::TrackError;
+use super::shared::TrackError;
 use crate::camera::point_in_frame;
 use crate::formats::{
     FrameIndex, FrameTracks, KeyFrames, NetworkBody, PointSource, TrackedPoint, Tracks2d,
@@ -80,75 +80,102 @@ impl NetFrame {
 /// What the network saw on each frame of a clip, in order.
 pub type NetworkFrames = Vec<NetFrame>;
 
-/// Runs the network on frames `from..` of `video`, each crop the one the network proposed on
-/// the frame before (its own tracking region), so that it follows the person the user marked:
-/// on a key frame that places the pelvis or the head top, and after a frame where it found no
-/// person, the crop is made from VBA's body there (with the user's joints). Frames before `from` are taken from
-/// `previous`, and so is every later frame whose crop has not moved (a re-track after a
-/// correction runs the network only where the correction changed what it sees). `tick` is
+/// A key's pelvis or head top further than this (torso lengths) from the network's means the
+/// network follows someone else, or nobody: the frame is shown the marked body instead.
+const REFUSED_TORSO: f64 = 0.5;
+
+/// Runs the network on every frame of `video`, each crop the one the network proposed on the
+/// frame before (its own tracking region), so that it follows the person the user marked: on a
+/// key frame with every joint placed, after a frame where it found no person, and where a key's
+/// pelvis or head top is far from the network's (it followed someone else), the crop is made
+/// from VBA's body there (with the user's joints). A frame whose crop is exactly the one it had
+/// in `reuse` (an earlier run on this video) is taken from it instead of run again. `tick` is
 /// called once per frame.
 pub fn run_network(
     video: &mut Video,
     tracks: &Tracks2d,
     network: &PoseNetwork,
     keys: &KeyFrames,
-    reuse: Option<(&NetworkFrames, usize)>,
+    reuse: Option<&NetworkFrames>,
     tick: &mut dyn FnMut(),
     cancel: &AtomicBool,
 ) -> Result<NetworkFrames, TrackError> {
     let n = tracks.frames.len();
-    let (previous, from) = match reuse {
-        Some((p, from)) if p.len() == n => (Some(p), from.min(n)),
-        _ => (None, 0),
-    };
-    let mut out: NetworkFrames = previous.map_or_else(Vec::new, |p| p[..from].to_vec());
-    out.reserve(n - from);
-    let mut next: Option<Crop> = out.last().and_then(|f| f.next);
-    for (t, f) in tracks.frames.iter().enumerate().skip(from) {
+    let previous = reuse.filter(|p| p.len() == n);
+    let mut out: NetworkFrames = Vec::with_capacity(n);
+    let mut next: Option<Crop> = None;
+    for (t, f) in tracks.frames.iter().enumerate() {
         if cancel.load(Ordering::Relaxed) {
             return Err(TrackError::Cancelled);
         }
         tick();
-        // A key that places the joints the crop is made from re-starts it there.
-        let placed = keys
-            .frames
-            .get(&f.index)
-            .is_some_and(|k| k[Joint::Pelvis].is_some() || k[Joint::HeadTop].is_some());
+        let key = keys.frames.get(&f.index);
+        let full = key.is_some_and(|k| k.iter().all(|(_, p)| p.is_some()));
+        let marked = || Crop::around(&f.points.map(|_, p| p.pos));
         let crop = match next {
-            Some(c) if !placed => Some(c),
-            _ => Crop::around(&f.points.map(|_, p| p.pos)),
+            Some(c) if !full => Some(c),
+            _ => marked(),
         };
-        let before = previous.and_then(|p| p.get(t));
-        let frame = match (before, crop) {
-            (Some(b), Some(c)) if b.crop.is_some_and(|bc| bc.same_as(&c)) => b.clone(),
-            (_, Some(c)) => {
-                let pose = video
-                    .frame(f.index.get())
-                    .ok()
-                    .and_then(|image| network.run(&image.image, &c).ok())
-                    .filter(|p| p.presence >= MIN_PRESENCE);
-                NetFrame {
-                    crop: Some(c),
-                    next: pose.as_ref().and_then(|p| p.next_crop),
-                    world: pose.as_ref().map(|p| p.world),
-                    joints: pose.map(|p| p.joints),
-                }
+        let mut seen = |crop: Option<Crop>| -> NetFrame {
+            let Some(c) = crop else {
+                return NetFrame {
+                    crop: None,
+                    joints: None,
+                    next: None,
+                    world: None,
+                };
+            };
+            if let Some(b) = previous
+                .and_then(|p| p.get(t))
+                .filter(|b| b.crop == Some(c))
+            {
+                return b.clone();
             }
-            (_, None) => NetFrame {
-                crop: None,
-                joints: None,
-                next: None,
-                world: None,
-            },
+            let pose = video
+                .frame(f.index.get())
+                .ok()
+                .and_then(|image| network.run(&image.image, &c).ok())
+                .filter(|p| p.presence >= MIN_PRESENCE);
+            NetFrame {
+                crop: Some(c),
+                next: pose.as_ref().and_then(|p| p.next_crop),
+                world: pose.as_ref().map(|p| p.world),
+                joints: pose.map(|p| p.joints),
+            }
         };
+        let mut frame = seen(crop);
+        if key.is_some_and(|k| !full && refuses(k, &frame)) && crop != marked() {
+            frame = seen(marked());
+        }
         next = frame.next;
         out.push(frame);
     }
     Ok(out)
 }
 
+/// Whether a key's pelvis or head top lies far from where the network sees them (or the network
+/// saw nobody): the network's body is not the one the user marked.
+fn refuses(key: &PerJoint<Option<Point2<f64>>>, seen: &NetFrame) -> bool {
+    let placed = [Joint::Pelvis, Joint::HeadTop]
+        .into_iter()
+        .filter_map(|j| key[j].map(|p| (j, p)))
+        .collect::<Vec<_>>();
+    if placed.is_empty() {
+        return false;
+    }
+    let Some(joints) = seen.joints.as_ref() else {
+        return true;
+    };
+    let torso = (joints[Joint::Neck].pos - joints[Joint::Pelvis].pos)
+        .norm()
+        .max(1.0);
+    placed
+        .iter()
+        .any(|&(j, p)| (joints[j].pos - p).norm() > REFUSED_TORSO * torso)
+}
+
 /// The joint on the body's other side (itself for the trunk's).
-fn other_side(j: Joint) -> Joint {
+pub(crate) fn other_side(j: Joint) -> Joint {
     use Joint::*;
     match j {
         LeftShoulder => RightShoulder,
@@ -185,17 +212,14 @@ pub fn weigh(
     params: &EvidenceParams,
 ) -> Tracks2d {
     let n = tracks.frames.len();
-    // Frames to the nearest key, for the key's fading certainty.
-    let key_frames: Vec<FrameIndex> = tracks
-        .frames
-        .iter()
-        .filter(|f| keys.frames.contains_key(&f.index))
-        .map(|f| f.index)
-        .collect();
-    let to_key = |index: FrameIndex| {
-        key_frames
+    // Frames to the nearest key of joint `j`, for the key's fading certainty: a key that places
+    // other joints leaves this one's VBA track as it was (a correction of one joint moves no
+    // other, issue 90).
+    let to_key = |index: FrameIndex, j: Joint| {
+        keys.frames
             .iter()
-            .map(|&k| k.get().abs_diff(index.get()))
+            .filter(|(_, k)| k[j].is_some())
+            .map(|(k, _)| k.get().abs_diff(index.get()))
             .min()
             .map_or(f64::INFINITY, |d| d as f64)
     };
@@ -232,7 +256,7 @@ pub fn weigh(
                     };
                     params.vba_doubt
                         * (1.0 - r)
-                        * (1.0 - (-to_key(f.index) / params.key_fade_frames).exp())
+                        * (1.0 - (-to_key(f.index, j) / params.key_fade_frames).exp())
                 };
                 let mut c = vec![Candidate {
                     pos: p.pos,

@@ -5,35 +5,49 @@
 //! [`KeyFrames`]). Out: [`crate::formats::Tracks2d`] and a list of weak spans.
 //!
 //! - `block`: the morph-block `A = {(x, y), m, n, θ}` (Fig. 7)
+//! - `frame`: a frame as four `f32` lanes per pixel, sampled bilinearly
 //! - `similarity`: the sub-pixel morph-block similarity (eqs. 3–5), the hot loop
 //! - `background`: a static camera's background, foreground evidence for the arms
 //! - `head`: image-difference head prediction (eqs. 1–5)
 //! - `search`: the spiral search path (Fig. 6) and the anchored angular search
+//! - `part`: a tracked body part and what each part does per frame (predict, search prior, learn, hold)
+//! - `limb`: one limb chain per frame, upper then lower segment, refined as one figure
 //! - `body`: the top-down tracker (head → trunk → limbs)
+//! - `evidence`: the pose network's evidence weighed in
+//! - `doubt`: the evidence of each joint-frame's doubt, for calibrating it (`bench learned
+//!   --doubt-dump`)
 //! - `occlusion`: interpolation over weak runs, the weak-span report
 //! - `smooth`: the finished tracks smoothed over time, weighted by reliability
 //! - `run`: tracking a video from its key frames, the order of the steps, re-tracking
 //! - `pass`: one pass over consecutive frames, forwards or backwards, re-started at key frames
 //! - `fuse`: the forward and backward passes made one, per joint between its key frames
+//! - `shared`: the errors and progress every step uses (below them all)
 
 mod background;
 mod block;
 mod body;
+mod doubt;
 mod evidence;
+mod frame;
 mod fuse;
 mod head;
+mod limb;
 mod occlusion;
 mod params;
+mod part;
 mod pass;
 mod run;
 mod search;
+mod shared;
 mod similarity;
 pub(crate) mod smooth;
 
+pub use doubt::{DOUBT_FEATURES, FEATURE_COUNT, doubt_features};
 pub use evidence::{EvidenceParams, NetFrame, NetworkFrames, run_network, weigh};
 pub use occlusion::{SpanKind, WeakSpan, weak_spans};
 pub use params::TrackerParams;
-pub use run::{KeyFrames, TrackError, TrackJob, TrackOutput, TrackProgress, track_video};
+pub use run::{KeyFrames, TrackJob, TrackOutput, track_video};
+pub use shared::{TrackError, TrackProgress};
 // Inner facts the app and the scoring need, exported by name.
 pub use background::KnownBackground;
 pub use body::stature_px;

@@ -2,11 +2,10 @@
 //! shrunk to the working scale) on a second thread while the body tracker steps through them,
 //! re-started with the hand-placed joints at every key frame on the way.
 
-use super::TrackError;
 use super::background::{self, Background};
 use super::body::{BodyTracker, JointResult};
-use super::params::TrackerParams;
-use super::run::TrackProgress;
+use super::params::Tuning;
+use super::shared::{TrackError, TrackProgress};
 use crate::formats::{FrameIndex, FrameTracks, KeyFrames, PointSource, TrackedPoint};
 use crate::skeleton::{Joint, PerJoint, Proportions};
 use crate::video::{Video, VideoError};
@@ -58,15 +57,12 @@ pub(crate) struct PassOutput {
     /// Per key frame the pass went through (not its first), where it arrived before the
     /// hand-placed joints re-started it: how well it agrees with that key.
     pub(crate) arrivals: BTreeMap<usize, PerJoint<JointResult>>,
-    /// The body tracker as it stands after the pass's last frame (to go on with the frames
-    /// after it: [`PassContext::pass`]'s `resume`).
-    pub(crate) tracker: Option<BodyTracker>,
 }
 
 pub(crate) struct PassContext<'a, 'p> {
     pub(crate) video: &'a mut Video,
     pub(crate) scale: Scale,
-    pub(crate) params: TrackerParams,
+    pub(crate) params: Tuning,
     pub(crate) keys: &'a KeyFrames,
     pub(crate) path: PathBuf,
     /// The size frames arrive at from the video (full or, when it scales, working size).
@@ -119,16 +115,13 @@ impl PassContext<'_, '_> {
         Ok(Background::estimate(&refs, tau))
     }
     /// Tracks over `order` (consecutive frames, forwards or backwards), starting from `pose` on
-    /// its first frame and re-started with the hand-placed joints at every key frame on the way;
-    /// returns the results in video pixels, one per frame of `order` (the first is the starting
+    /// its first frame and re-started with the hand-placed joints at every key frame on the way
+    /// (the parts they touch; the others go on as they were, `BodyTracker::restart`); returns the results in video pixels, one per frame of `order` (the first is the starting
     /// pose), and where the pass arrived on each key frame before it was re-started there.
-    /// With `resume` (a tracker another call left after the frame before `order`'s first), the
-    /// pass goes on from it instead, and `pose` is not used.
     pub(crate) fn pass(
         &mut self,
         order: &[usize],
         pose: &PerJoint<Point2<f64>>,
-        resume: Option<BodyTracker>,
     ) -> Result<PassOutput, TrackError> {
         let scale = self.scale;
         let params = self.params;
@@ -144,7 +137,7 @@ impl PassContext<'_, '_> {
         };
         let mut out = Vec::with_capacity(order.len());
         let mut arrivals = BTreeMap::new();
-        let mut tracker: Option<BodyTracker> = resume;
+        let mut tracker: Option<BodyTracker> = None;
         let proportions = Proportions::default();
         let check = |index: usize, image: &RgbImage| {
             if image.width() != width || image.height() != height {
@@ -201,13 +194,8 @@ impl PassContext<'_, '_> {
                         let work_keys =
                             keys.frames[&FrameIndex(index)].map(|_, k| k.map(|p| scale.to_work(p)));
                         let fixed = tracked.map(|j, p| work_keys[j].unwrap_or(*p));
-                        *t = BodyTracker::new(
-                            &image,
-                            &fixed,
-                            &proportions,
-                            params,
-                            background.clone(),
-                        );
+                        let placed = work_keys.map(|_, k| k.is_some());
+                        t.restart(&image, &fixed, &placed, &proportions);
                         for j in Joint::ALL {
                             if work_keys[j].is_some() {
                                 r[j] = JointResult {
@@ -323,7 +311,6 @@ impl PassContext<'_, '_> {
         Ok(PassOutput {
             results: out,
             arrivals,
-            tracker,
         })
     }
 }

@@ -8,9 +8,12 @@
 //! frames as anchors ([`super::occlusion`]), never runs that leave the frame, and the tracks
 //! smoothed when asked. A
 //! joint that ends up outside the image is off the frame (confidence 0, its position the
-//! tracker's estimate). A re-track after a correction runs forwards from the corrected frame and
-//! backwards from the last key frame to the earliest frame the correction can change, keeping the
-//! earlier result elsewhere.
+//! tracker's estimate).
+//!
+//! Tracking is a function of the video, the keys and the settings (issue 90): nothing an
+//! earlier run left changes the result. What an earlier run of the same video computed is only
+//! a cache of values that depend on nothing else (the background; the network's output for a
+//! frame and a crop exactly as it was).
 
 use super::background::KnownBackground;
 use super::body::{JointResult, stature_px};
@@ -19,56 +22,18 @@ use super::fuse::fuse;
 use super::occlusion::{WeakSpan, fill_weak_runs, weak_spans};
 use super::params::TrackerParams;
 use super::pass::{PassContext, Scale};
+use super::shared::{TrackError, TrackProgress};
 use super::smooth::smooth_tracks;
 use crate::camera::point_in_frame;
 pub use crate::formats::KeyFrames;
 use crate::formats::{FrameIndex, FrameTracks, PointSource, SourceInfo, TrackedPoint, Tracks2d};
 use crate::network::PoseNetwork;
 use crate::skeleton::{Joint, PerJoint, Proportions};
-use crate::video::{Video, VideoError, VideoInfo};
+use crate::video::{Video, VideoInfo};
 use nalgebra::Point2;
 use std::collections::BTreeMap;
-use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
-
-/// Tracking could not run.
-#[derive(Debug, thiserror::Error)]
-pub enum TrackError {
-    #[error(transparent)]
-    Video(#[from] VideoError),
-    #[error("{path}: has {frames} frame(s); tracking needs at least 2")]
-    TooShort { path: PathBuf, frames: usize },
-    #[error("no key frame with all 16 joints placed (mark the first frame fully)")]
-    NoFullKeyFrame,
-    #[error("key frame {frame} is past the end of {path} ({frames} frames)")]
-    KeyFrameOutOfRange {
-        path: PathBuf,
-        frame: usize,
-        frames: usize,
-    },
-    #[error("{path}: frame {frame} is {got_w}×{got_h} but the video is {width}×{height}")]
-    FrameSize {
-        path: PathBuf,
-        frame: usize,
-        got_w: u32,
-        got_h: u32,
-        width: u32,
-        height: u32,
-    },
-    #[error("re-tracking from frame {frame} needs an earlier result that covers it")]
-    NoEarlierResult { frame: usize },
-    #[error("{path}: frame {frame}, where tracking starts, could not be decoded (damaged file?)")]
-    StartFrameDamaged { path: PathBuf, frame: usize },
-    #[error("tracker setting \"{name}\" must be {want}, got {value}")]
-    BadSetting {
-        name: &'static str,
-        value: f64,
-        want: &'static str,
-    },
-    #[error("cancelled")]
-    Cancelled,
-}
 
 /// What to track.
 #[derive(Debug, Clone)]
@@ -79,18 +44,15 @@ pub struct TrackJob {
     pub params: TrackerParams,
     /// Worker threads (1 = decode and track on the calling thread, limbs in sequence).
     pub threads: usize,
-    /// Re-track from this frame on, keeping an earlier result before it (`None` = everything).
-    pub from: Option<usize>,
-    /// The earlier result (needed with `from`).
-    pub previous: Option<Tracks2d>,
     /// The background an earlier run of this video found ([`TrackOutput::background`]): used
     /// when it fits (same working size and threshold) instead of reading the clip again.
     pub background: Option<KnownBackground>,
     /// The pose network whose evidence is weighed in (`None`, or the setting `network` off:
     /// VBA alone).
     pub network: Option<Arc<PoseNetwork>>,
-    /// What the network saw in the earlier result ([`TrackOutput::network`]): a re-track runs
-    /// it again only where a crop moved.
+    /// What the network saw in an earlier run of this video ([`TrackOutput::network`]): a
+    /// frame whose crop is exactly the one it had then is not run again (a cache: the result is
+    /// the same with or without it).
     pub previous_network: Option<NetworkFrames>,
 }
 
@@ -105,8 +67,6 @@ impl TrackJob {
             keys: KeyFrames::from_marks(marks),
             params,
             threads,
-            from: None,
-            previous: None,
             background: None,
             network: None,
             previous_network: None,
@@ -118,17 +78,6 @@ impl TrackJob {
         self.network = network;
         self
     }
-}
-
-/// Progress of a tracking run.
-#[derive(Debug, Clone)]
-pub struct TrackProgress {
-    /// Frames processed so far (over all passes).
-    pub done: usize,
-    /// Frames to process in all (an estimate: backward gap passes are added as found).
-    pub total: usize,
-    /// The frame just tracked (for drawing results as they arrive).
-    pub frame: Option<FrameTracks>,
 }
 
 /// The result: tracks and the report of weak spans.
@@ -150,10 +99,6 @@ pub struct TrackOutput {
     /// the next job on this video ([`TrackJob::previous_network`]).
     pub network: Option<NetworkFrames>,
 }
-
-/// Frames of a re-track's backward pass (the corrected frame and the ten before it) tracked
-/// before its forward pass, so that the app draws both sides of a correction at once.
-const DRAWN_FIRST: usize = 11;
 
 /// Tracks the video from its key frames.
 ///
@@ -177,7 +122,6 @@ pub fn track_video(
     }
     let Passes {
         mut tracks,
-        low,
         mut done,
         total,
         shrink,
@@ -187,7 +131,7 @@ pub fn track_video(
     // 2. The network's evidence weighed in, the user's marks deciding whose body it is.
     let net = match network {
         Some(network) => {
-            let reuse = job.previous_network.as_ref().map(|p| (p, low));
+            let reuse = job.previous_network.as_ref();
             let mut tick = || {
                 done += 1;
                 progress(&TrackProgress {
@@ -207,10 +151,8 @@ pub fn track_video(
     let max_gap = (job.params.max_gap_s * info.fps).round().max(1.0) as usize;
     let is_key = |f: FrameIndex, j: Joint| job.keys.is_key(f, j);
     let spans = fill_weak_runs(&mut frames, job.params.weak_reliability, max_gap, &is_key);
-    // 4. Smoothed (when asked for): the filled runs with the rest. A re-track smooths what it
-    // tracked; the earlier result before it was smoothed already.
-    let first = job.from.map_or(0, |f| f + 1);
-    smooth_tracks(&mut frames, job.params.smooth_s * info.fps, first, &is_key);
+    // 4. Smoothed (when asked for): the filled runs with the rest.
+    smooth_tracks(&mut frames, job.params.smooth_s * info.fps, 0, &is_key);
     // 5. With the network: a joint that jumps is shown weak where it is (for review).
     let spans = if net.is_some() {
         flag_jumps(&mut frames, &job.keys);
@@ -218,18 +160,6 @@ pub fn track_video(
     } else {
         spans
     };
-    // 6. The corrected frame's reliable joints stay as the user saw them. (The earlier result
-    // covers every frame and `from` lies in it: checked before tracking.)
-    if let (Some(from), Some(prev)) = (job.from, job.previous.as_ref()) {
-        for j in Joint::ALL {
-            let was = prev.frames[from].points[j];
-            if !job.keys.is_key(FrameIndex(from), j)
-                && was.confidence >= job.params.weak_reliability
-            {
-                frames[from].points[j] = was;
-            }
-        }
-    }
     Ok(TrackOutput {
         damaged,
         background,
@@ -247,8 +177,6 @@ pub fn track_video(
 struct Passes {
     /// Every frame's joints in video pixels (key frames' joints as placed).
     tracks: Tracks2d,
-    /// The earliest frame the job can change.
-    low: usize,
     /// Progress so far, and in all (the network's frames included).
     done: usize,
     total: usize,
@@ -310,54 +238,33 @@ fn track_at_working_scale(
         width: ww,
         height: wh,
     };
-    // Frames come out at the working size if the backend can make them so.
-    let decoded = if shrink > 1.0 && job.params.decoder_scaling && video.output_size(Some((ww, wh)))
+    // Frames come out at the working size if the backend can make them so (at 1080×1920
+    // converting at that size is cheaper than converting at full size and shrinking); not when
+    // the video's frames are already decoded in its cache, which the change would empty.
+    let decoded = if shrink > 1.0 && video.cached_bytes() == 0 && video.output_size(Some((ww, wh)))
     {
         (ww, wh)
     } else {
         (info.width, info.height)
     };
-    let mut params = job.params.at_frame_rate(info.fps);
-    params.parallel = params.parallel && job.threads > 1;
+    let params = job.params.tuning(info.fps, job.threads);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(job.threads.max(1))
         .build()
         .ok();
 
-    // Per frame, the forward pass's result in video pixels (None = not tracked); a re-track
-    // keeps the earlier result before the corrected frame as the forward pass there.
+    // Per frame, the forward pass's result in video pixels (None = not tracked).
     let mut forward: Vec<Option<PerJoint<JointResult>>> = vec![None; n];
-    let start = match job.from {
-        Some(from) => {
-            let prev = job
-                .previous
-                .as_ref()
-                .filter(|p| p.frames.len() == n && from < n)
-                .ok_or(TrackError::NoEarlierResult { frame: from })?;
-            for f in &prev.frames {
-                forward[f.index.get()] = Some(f.points.map(|_, p| JointResult {
-                    pos: p.pos,
-                    reliability: p.confidence,
-                }));
-            }
-            from
-        }
-        None => first_key,
-    };
-    // The backward pass runs from the last key frame down to `low`: the start of the clip, or
-    // on a re-track the earliest frame whose result the correction can change (every joint's
-    // key before it).
+    let start = first_key;
+    // The backward pass runs from the last key frame down to the start of the clip.
     let last_key = job
         .keys
         .frames
         .keys()
         .next_back()
         .map_or(first_key, |k| k.get());
-    let low = job.from.map_or(0, |from| {
-        job.keys.earliest_changed_by(FrameIndex(from)).get()
-    });
-    let backward_frames: Vec<usize> = if last_key > low {
-        (low..=last_key).rev().collect()
+    let backward_frames: Vec<usize> = if last_key > 0 {
+        (0..=last_key).rev().collect()
     } else {
         Vec::new()
     };
@@ -372,12 +279,12 @@ fn track_at_working_scale(
         threads: job.threads,
         damaged: Vec::new(),
         done: 0,
-        total: (n - start) + backward_frames.len() + if network { n - low } else { 0 },
+        total: (n - start) + backward_frames.len() + if network { n } else { 0 },
         progress,
         cancel,
         background: None,
     };
-    let tau = job.params.foreground_tau;
+    let tau = params.foreground_tau;
     let known = job.background.as_ref().and_then(|k| k.get((ww, wh), tau));
     ctx.background = match known {
         _ if job.params.arm_foreground <= 0.0 => None,
@@ -391,9 +298,6 @@ fn track_at_working_scale(
     // arrived on the corrected frame where the earlier result had it).
     type Arrivals = BTreeMap<usize, PerJoint<JointResult>>;
     let mut arrivals: (Arrivals, Arrivals) = Default::default();
-    if let Some(from) = job.from {
-        arrivals.0.extend(forward[from].map(|r| (from, r)));
-    }
     let run = |ctx: &mut PassContext,
                forward: &mut Vec<Option<PerJoint<JointResult>>>,
                backward: &mut Vec<Option<PerJoint<JointResult>>>,
@@ -409,54 +313,35 @@ fn track_at_working_scale(
             });
             (keyed(&base.map(|_, r| r.pos), &job.keys, f), base)
         };
-        // A pass over `order` from its first frame's pose, or going on with `resume` (the
-        // tracker an earlier part of the same pass left); returns the tracker it leaves.
+        // A pass over `order` from its first frame's pose.
         let run_pass =
             |ctx: &mut PassContext,
              order: &[usize],
              (pose, before): (PerJoint<Point2<f64>>, PerJoint<JointResult>),
-             resume: Option<super::body::BodyTracker>,
              into: &mut Vec<Option<PerJoint<JointResult>>>,
              arrived: &mut BTreeMap<usize, PerJoint<JointResult>>| {
-                let fresh = resume.is_none();
-                let out = ctx.pass(order, &pose, resume)?;
+                let out = ctx.pass(order, &pose)?;
                 for (f, r) in order.iter().zip(out.results) {
                     into[*f] = Some(r);
                 }
                 arrived.extend(out.arrivals);
-                if let Some(now) = into[order[0]].as_mut().filter(|_| fresh) {
+                if let Some(now) = into[order[0]].as_mut() {
                     for j in Joint::ALL {
                         if !job.keys.is_key(FrameIndex(order[0]), j) {
                             now[j].reliability = before[j].reliability;
                         }
                     }
                 }
-                Ok::<_, TrackError>(out.tracker)
+                Ok::<_, TrackError>(())
             };
-        // Forwards from the start to the end, then backwards from the last key frame, each
-        // re-started at every key frame on the way. A re-track from the last key frame runs the
-        // backward pass's first [`DRAWN_FIRST`] frames (those just before the correction)
-        // before the forward pass and the rest after it, so that both sides of the correction
-        // are drawn at once (the results are the same in either order).
+        // Forwards from the first key frame to the end, then backwards from the last key frame,
+        // each re-started at every key frame on the way.
         let forward_frames: Vec<usize> = (start..n).collect();
-        let near = match job.from {
-            Some(from) if backward_frames.first() == Some(&from) => {
-                DRAWN_FIRST.min(backward_frames.len())
-            }
-            _ => 0,
-        };
-        let (near, far) = backward_frames.split_at(near);
-        let mut resume = None;
-        if let Some(&first) = near.first() {
-            let begin = starting(forward, first);
-            resume = run_pass(ctx, near, begin, None, backward, &mut arrivals.1)?;
-        }
         let begin = starting(forward, start);
-        run_pass(ctx, &forward_frames, begin, None, forward, &mut arrivals.0)?;
-        if let Some(&first) = far.first() {
-            // (Not used when the pass goes on from `near`.)
+        run_pass(ctx, &forward_frames, begin, forward, &mut arrivals.0)?;
+        if let Some(&first) = backward_frames.first() {
             let begin = starting(forward, first);
-            run_pass(ctx, far, begin, resume, backward, &mut arrivals.1)?;
+            run_pass(ctx, &backward_frames, begin, backward, &mut arrivals.1)?;
         }
         Ok::<(), TrackError>(())
     };
@@ -464,20 +349,16 @@ fn track_at_working_scale(
         Some(pool) => pool.install(|| run(&mut ctx, &mut forward, &mut backward, &mut arrivals))?,
         None => run(&mut ctx, &mut forward, &mut backward, &mut arrivals)?,
     }
-    // Each joint's frames from the pass that holds there (whole clip; a re-track from the
-    // earliest frame it can change, the earlier result before).
+    // Each joint's frames from the pass that holds there.
     let torso_px = (first_pose[Joint::Neck] - first_pose[Joint::Pelvis]).norm();
-    let mut raw = forward.clone();
-    for (f, r) in (low..n).zip(fuse(
+    let raw = fuse(
         [&forward, &backward],
         [&arrivals.0, &arrivals.1],
         &job.keys,
-        low..n,
+        0..n,
         torso_px,
         job.params.weak_reliability,
-    )) {
-        raw[f] = r;
-    }
+    );
 
     let frames: Vec<FrameTracks> = raw
         .into_iter()
@@ -529,7 +410,6 @@ fn track_at_working_scale(
     damaged.dedup();
     Ok(Passes {
         tracks: Tracks2d { source, frames },
-        low,
         done: ctx.done,
         total: ctx.total,
         shrink,
@@ -558,8 +438,6 @@ mod tests {
                 ..TrackerParams::default()
             },
             threads: 1,
-            from: None,
-            previous: None,
             background: None,
             network: None,
             previous_network: None,

@@ -6,7 +6,7 @@ use super::{ExitError, say};
 use anyhow::anyhow;
 use std::path::Path;
 use videomocap_core::skeleton::Joint;
-use videomocap_core::track::SpanKind;
+use videomocap_core::track::{SpanKind, TrackerParams};
 
 /// File names `run` writes in its output directory.
 pub const TRACKS_JSON: &str = "tracks2d.json";
@@ -80,8 +80,11 @@ pub fn run_into(
         &mut video,
         &keys,
         input.threads,
-        input.tracker,
-        input.no_network,
+        TrackerParams {
+            // `--no-network` is the settings' switch turned off.
+            network: input.tracker.network && !input.no_network,
+            ..input.tracker
+        },
         global,
     )?;
     let path = out_dir.join(TRACKS_JSON);

@@ -55,14 +55,14 @@ fn check_keys(video: &Video, keys: &KeyFrames, path: &Path) -> Result<(), ExitEr
         .map_err(|e| ExitError::bad_input(anyhow!("{e} (video {})", info.path.display())))
 }
 
-/// The bundled pose network on `threads` threads, unless `off`; when it cannot be loaded, says
-/// why and tracks with VBA alone (never a failure).
+/// The bundled pose network on `threads` threads ([`PoseNetwork::shared`]), unless `off`; when
+/// it cannot be loaded, says why and tracks with VBA alone (never a failure).
 pub fn load_network(off: bool, threads: usize) -> Option<Arc<PoseNetwork>> {
     if off {
         return None;
     }
-    match PoseNetwork::bundled() {
-        Ok(n) => Some(Arc::new(n.with_threads(threads))),
+    match PoseNetwork::shared(threads) {
+        Ok(n) => Some(n),
         Err(e) => {
             eprintln!("warning: {e}; tracking with VBA alone");
             None
@@ -71,23 +71,21 @@ pub fn load_network(off: bool, threads: usize) -> Option<Arc<PoseNetwork>> {
 }
 
 /// Runs the tracker on `threads` threads (its pool and the pose network's) with a progress
-/// bar, with the pose network unless `no_network`; shared by `track` and `run`.
+/// bar, with the pose network when `params.network` (the one switch: `--no-network` turns it
+/// off); shared by `track` and `run`.
 pub fn track_with_progress(
     video: &mut Video,
     keys: &KeyFrames,
     threads: usize,
     params: TrackerParams,
-    no_network: bool,
     global: &GlobalArgs,
 ) -> Result<TrackOutput, ExitError> {
     let threads = threads.max(1);
-    let network = load_network(no_network || !params.network, threads);
+    let network = load_network(!params.network, threads);
     let job = TrackJob {
         keys: keys.clone(),
         params,
         threads,
-        from: None,
-        previous: None,
         background: None,
         network,
         previous_network: None,
@@ -220,13 +218,15 @@ pub fn run(a: &TrackArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             (v, k, None)
         }
     };
-    let params = match (&a.tracker_settings, settings) {
+    let mut params = match (&a.tracker_settings, settings) {
         (Some(p), _) => load_settings(p)?,
         (None, Some(s)) => s,
         (None, None) => TrackerParams::default(),
     };
+    // `--no-network` is the settings' switch turned off.
+    params.network &= !a.no_network;
     let t0 = std::time::Instant::now();
-    let out = track_with_progress(&mut video, &keys, threads, params, a.no_network, global)?;
+    let out = track_with_progress(&mut video, &keys, threads, params, global)?;
     let seconds = t0.elapsed().as_secs_f64();
     let mut written = Vec::new();
     if let Some(output) = &a.output {

@@ -15,8 +15,9 @@ use videomocap_core::formats::Tracks2d;
 use videomocap_core::skeleton::Joint;
 
 /// A joint further than this from the reference, in torso lengths, makes its frame one to fix:
-/// the same 0.2 as PCK@0.2, the error a user sees at a glance.
-pub const SEEN_TORSO: f64 = 0.2;
+/// 0.1, as the joints' issue (90) asks of its simulated user (was 0.2, the error a user sees at
+/// a glance; a user who checks the joints' definitions sees less).
+pub const SEEN_TORSO: f64 = 0.1;
 
 /// On the frame being fixed, a joint further than this from the reference is dragged: once the
 /// user is there, they put right what is off at all.
@@ -64,43 +65,48 @@ pub fn next_correction(
     None
 }
 
+/// A reference of `n` frames for tests: a standing figure 100 px from neck to pelvis.
+#[cfg(test)]
+pub(crate) fn tests_reference(n: usize) -> GroundTruth {
+    use crate::synth::GroundTruthFrame;
+    let pose = |j: Joint| -> [f64; 2] {
+        let k = j.index() as f64;
+        match j {
+            Joint::Neck => [100.0, 100.0],
+            Joint::Pelvis => [100.0, 200.0],
+            _ => [50.0 + 10.0 * k, 50.0 + 15.0 * k],
+        }
+    };
+    GroundTruth {
+        source: "test".into(),
+        fps: 30.0,
+        width: 320,
+        height: 320,
+        focal_px: 300.0,
+        cx: 160.0,
+        cy: 160.0,
+        joints: Joint::ALL.iter().map(|j| j.name().to_owned()).collect(),
+        stated_height_m: None,
+        derived_joints: vec!["chest".into()],
+        bone_lengths_m: Default::default(),
+        frames: (0..n)
+            .map(|index| GroundTruthFrame {
+                index,
+                points2d: Joint::ALL.iter().map(|&j| pose(j)).collect(),
+                points3d: vec![[0.0, 0.0, 3.0]; 16],
+                visible: vec![true; 16],
+            })
+            .collect(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::eval::pose3d::tracks_from_truth;
-    use crate::synth::GroundTruthFrame;
 
-    /// A reference of `n` frames: a standing figure 100 px from neck to pelvis.
     fn reference(n: usize) -> GroundTruth {
-        let pose = |j: Joint| -> [f64; 2] {
-            let k = j.index() as f64;
-            match j {
-                Joint::Neck => [100.0, 100.0],
-                Joint::Pelvis => [100.0, 200.0],
-                _ => [50.0 + 10.0 * k, 50.0 + 15.0 * k],
-            }
-        };
-        GroundTruth {
-            source: "test".into(),
-            fps: 30.0,
-            width: 320,
-            height: 320,
-            focal_px: 300.0,
-            cx: 160.0,
-            cy: 160.0,
-            joints: Joint::ALL.iter().map(|j| j.name().to_owned()).collect(),
-            stated_height_m: None,
-            derived_joints: vec!["chest".into()],
-            bone_lengths_m: Default::default(),
-            frames: (0..n)
-                .map(|index| GroundTruthFrame {
-                    index,
-                    points2d: Joint::ALL.iter().map(|&j| pose(j)).collect(),
-                    points3d: vec![[0.0, 0.0, 3.0]; 16],
-                    visible: vec![true; 16],
-                })
-                .collect(),
-        }
+        tests_reference(n)
     }
 
     /// Tracks equal to the reference, with `offsets[(frame, joint)]` pixels added along x.
@@ -115,15 +121,15 @@ mod tests {
     #[test]
     fn the_user_fixes_the_first_frame_visibly_off_and_puts_right_all_that_is_off_there() {
         let gt = reference(6);
-        // Frame 1: only a little off (never a frame to fix). Frame 3: a joint visibly off, one
+        // Frame 1: only a little off (never a frame to fix). Frame 3: a joint off, one
         // a little off, one barely. Frame 5: a joint lost. The chest is off on frame 0 but
         // derived: never dragged.
         let t = tracks(
             &gt,
             &[
-                (1, Joint::LeftWrist, 15.0),
+                (1, Joint::LeftWrist, 8.0),
                 (3, Joint::LeftKnee, 25.0),
-                (3, Joint::LeftElbow, 15.0),
+                (3, Joint::LeftElbow, 12.0),
                 (3, Joint::RightElbow, 5.0),
                 (5, Joint::HeadTop, 300.0),
                 (0, Joint::Chest, 90.0),

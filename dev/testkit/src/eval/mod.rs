@@ -173,3 +173,42 @@ pub fn score_tracks(gt: &GroundTruth, tracks: &Tracks2d) -> Result<ClipScore, Ev
             .map(|f| (f.index.get(), f.points.map(|_, p| p.pos))),
     )
 }
+
+/// Joint-frames (scored joints) within `tolerance` torso lengths of the reference in `before`
+/// and beyond it in `after`: what a change (a correction's re-track) spoiled.
+pub fn moved_out(gt: &GroundTruth, before: &Tracks2d, after: &Tracks2d, tolerance: f64) -> usize {
+    let derived = gt.derived();
+    let mut n = 0;
+    for (b, a) in before.frames.iter().zip(&after.frames) {
+        let Some(f) = gt.frames.get(b.index.get()) else {
+            continue;
+        };
+        let truth = f.points2d();
+        let torso = (truth[Joint::Neck] - truth[Joint::Pelvis]).norm().max(1.0);
+        for j in Joint::ALL.into_iter().filter(|j| !derived.contains(j)) {
+            let off = |p: Point2<f64>| (p - truth[j]).norm() / torso;
+            n += usize::from(off(b.points[j].pos) <= tolerance && off(a.points[j].pos) > tolerance);
+        }
+    }
+    n
+}
+
+#[cfg(test)]
+mod moved_tests {
+    use super::*;
+    use crate::eval::pose3d::tracks_from_truth;
+
+    #[test]
+    fn a_joint_frame_pushed_out_of_the_tolerance_counts_and_one_already_out_does_not() {
+        let gt = crate::eval::correction::tests_reference(3);
+        let before = tracks_from_truth(&gt, 0.0, 0);
+        let mut after = before.clone();
+        // 100 px torso: 15 px is out of 0.1; frame 2's wrist was out before already.
+        after.frames[1].points[Joint::LeftWrist].pos.x += 15.0;
+        let mut before2 = before.clone();
+        before2.frames[2].points[Joint::LeftWrist].pos.x += 30.0;
+        after.frames[2].points[Joint::LeftWrist].pos.x += 40.0;
+        after.frames[0].points[Joint::LeftKnee].pos.x += 5.0;
+        assert_eq!(moved_out(&gt, &before2, &after, 0.1), 1);
+    }
+}
