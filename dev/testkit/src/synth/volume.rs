@@ -3,9 +3,10 @@
 //! written as one binary PLY per frame and the true joints as `truth.skeleton3d.json`. This is
 //! the ground truth of the volume pipeline's tests and benchmark.
 
+use super::capsules::Body;
 use super::faults::SilhouetteFaults;
 use super::motion::{Motion, stature_of};
-use super::render::{Body, Surface};
+use super::render::Surface;
 use image::GrayImage;
 use nalgebra::{Point3, Vector3};
 use rand::{Rng, SeedableRng};
