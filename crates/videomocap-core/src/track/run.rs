@@ -204,16 +204,12 @@ fn working_scale(
     (shrink, (side(width), side(height)))
 }
 
-/// [`track_video`]'s passes, with the video's full-size info; `network`: the network's frames
-/// are counted in the progress's total.
-fn track_at_working_scale(
-    video: &mut Video,
+/// Where tracking starts: the first key frame with all 16 joints and its pose, after checking
+/// the video is long enough and every key frame lies in it.
+fn checked_start(
     info: &VideoInfo,
     job: &TrackJob,
-    network: bool,
-    progress: &mut (dyn FnMut(&TrackProgress) + Send),
-    cancel: &AtomicBool,
-) -> Result<Passes, TrackError> {
+) -> Result<(usize, PerJoint<Point2<f64>>), TrackError> {
     let n = info.frame_count;
     if n < 2 {
         return Err(TrackError::TooShort {
@@ -230,138 +226,71 @@ fn track_at_working_scale(
     }
     let (first_key, first_pose) = job.keys.first_full().ok_or(TrackError::NoFullKeyFrame)?;
     // The tracker works in video positions, which are frame numbers.
-    let first_key = first_key.get();
-    let (shrink, (ww, wh)) = working_scale(job, &first_pose, info.width, info.height);
-    let scale = Scale {
-        sx: f64::from(info.width) / f64::from(ww),
-        sy: f64::from(info.height) / f64::from(wh),
-        width: ww,
-        height: wh,
-    };
-    // Frames come out at the working size if the backend can make them so (at 1080×1920
-    // converting at that size is cheaper than converting at full size and shrinking); not when
-    // the video's frames are already decoded in its cache, which the change would empty.
-    let decoded = if shrink > 1.0 && video.cached_bytes() == 0 && video.output_size(Some((ww, wh)))
-    {
-        (ww, wh)
-    } else {
-        (info.width, info.height)
-    };
-    let params = job.params.tuning(info.fps, job.threads);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(job.threads.max(1))
-        .build()
-        .ok();
+    Ok((first_key.get(), first_pose))
+}
 
-    // Per frame, the forward pass's result in video pixels (None = not tracked).
-    let mut forward: Vec<Option<PerJoint<JointResult>>> = vec![None; n];
-    let start = first_key;
-    // The backward pass runs from the last key frame down to the start of the clip.
-    let last_key = job
-        .keys
-        .frames
-        .keys()
-        .next_back()
-        .map_or(first_key, |k| k.get());
-    let backward_frames: Vec<usize> = if last_key > 0 {
-        (0..=last_key).rev().collect()
-    } else {
-        Vec::new()
+/// Per frame, one pass's result in video pixels (`None` = not tracked).
+type PassResults = Vec<Option<PerJoint<JointResult>>>;
+/// Where a pass arrived on the key frames it went through.
+type Arrivals = BTreeMap<usize, PerJoint<JointResult>>;
+
+/// The two passes: forwards from the first key frame `start` to the end, then backwards over
+/// `backward_frames` (from the last key frame to the start), each re-started at every key frame
+/// on the way; each pass starts from the pose on its first frame with the hand-placed joints
+/// put in, the joints not placed there keeping the reliability they had.
+fn run_passes(
+    ctx: &mut PassContext,
+    job: &TrackJob,
+    first_pose: &PerJoint<Point2<f64>>,
+    start: usize,
+    backward_frames: &[usize],
+) -> Result<([PassResults; 2], [Arrivals; 2]), TrackError> {
+    let n = ctx.video.info().frame_count;
+    let mut results: [PassResults; 2] = [vec![None; n], vec![None; n]];
+    let mut arrivals: [Arrivals; 2] = Default::default();
+    let starting = |results: &[Option<PerJoint<JointResult>>], f: usize| {
+        let base = results[f].unwrap_or_else(|| {
+            first_pose.map(|_, p| JointResult {
+                pos: *p,
+                reliability: 1.0,
+            })
+        });
+        (keyed(&base.map(|_, r| r.pos), &job.keys, f), base)
     };
-    let mut ctx = PassContext {
-        video,
-        scale,
-        params,
-        keys: &job.keys,
-        path: info.path.clone(),
-        width: decoded.0,
-        height: decoded.1,
-        threads: job.threads,
-        damaged: Vec::new(),
-        done: 0,
-        total: (n - start) + backward_frames.len() + if network { n } else { 0 },
-        progress,
-        cancel,
-        background: None,
-    };
-    let tau = params.foreground_tau;
-    let known = job.background.as_ref().and_then(|k| k.get((ww, wh), tau));
-    ctx.background = match known {
-        _ if job.params.arm_foreground <= 0.0 => None,
-        Some(known) => known,
-        None => ctx.estimate_background(n, tau)?.map(Arc::new),
-    };
-    let background = (job.params.arm_foreground > 0.0)
-        .then(|| KnownBackground::new((ww, wh), tau, ctx.background.clone()));
-    let mut backward: Vec<Option<PerJoint<JointResult>>> = vec![None; n];
-    // Where each pass arrived on the key frames it went through (a re-track's forward pass
-    // arrived on the corrected frame where the earlier result had it).
-    type Arrivals = BTreeMap<usize, PerJoint<JointResult>>;
-    let mut arrivals: (Arrivals, Arrivals) = Default::default();
-    let run = |ctx: &mut PassContext,
-               forward: &mut Vec<Option<PerJoint<JointResult>>>,
-               backward: &mut Vec<Option<PerJoint<JointResult>>>,
-               arrivals: &mut (Arrivals, Arrivals)| {
-        // A pass starts from the pose on its first frame with the hand-placed joints put in;
-        // the joints not placed there keep the reliability they had.
-        let starting = |results: &[Option<PerJoint<JointResult>>], f: usize| {
-            let base = results[f].unwrap_or_else(|| {
-                first_pose.map(|_, p| JointResult {
-                    pos: *p,
-                    reliability: 1.0,
-                })
-            });
-            (keyed(&base.map(|_, r| r.pos), &job.keys, f), base)
+    let forward_frames: Vec<usize> = (start..n).collect();
+    let orders: [&[usize]; 2] = [&forward_frames, backward_frames];
+    for (k, order) in orders.into_iter().enumerate() {
+        let Some(&first) = order.first() else {
+            continue;
         };
-        // A pass over `order` from its first frame's pose.
-        let run_pass =
-            |ctx: &mut PassContext,
-             order: &[usize],
-             (pose, before): (PerJoint<Point2<f64>>, PerJoint<JointResult>),
-             into: &mut Vec<Option<PerJoint<JointResult>>>,
-             arrived: &mut BTreeMap<usize, PerJoint<JointResult>>| {
-                let out = ctx.pass(order, &pose)?;
-                for (f, r) in order.iter().zip(out.results) {
-                    into[*f] = Some(r);
-                }
-                arrived.extend(out.arrivals);
-                if let Some(now) = into[order[0]].as_mut() {
-                    for j in Joint::ALL {
-                        if !job.keys.is_key(FrameIndex(order[0]), j) {
-                            now[j].reliability = before[j].reliability;
-                        }
-                    }
-                }
-                Ok::<_, TrackError>(())
-            };
-        // Forwards from the first key frame to the end, then backwards from the last key frame,
-        // each re-started at every key frame on the way.
-        let forward_frames: Vec<usize> = (start..n).collect();
-        let begin = starting(forward, start);
-        run_pass(ctx, &forward_frames, begin, forward, &mut arrivals.0)?;
-        if let Some(&first) = backward_frames.first() {
-            let begin = starting(forward, first);
-            run_pass(ctx, &backward_frames, begin, backward, &mut arrivals.1)?;
+        // Both passes start from the forward pass's pose there.
+        let (pose, before) = starting(&results[0], first);
+        let out = ctx.pass(order, &pose)?;
+        for (f, r) in order.iter().zip(out.results) {
+            results[k][*f] = Some(r);
         }
-        Ok::<(), TrackError>(())
-    };
-    match &pool {
-        Some(pool) => pool.install(|| run(&mut ctx, &mut forward, &mut backward, &mut arrivals))?,
-        None => run(&mut ctx, &mut forward, &mut backward, &mut arrivals)?,
+        arrivals[k].extend(out.arrivals);
+        if let Some(now) = results[k][first].as_mut() {
+            for j in Joint::ALL {
+                if !job.keys.is_key(FrameIndex(first), j) {
+                    now[j].reliability = before[j].reliability;
+                }
+            }
+        }
     }
-    // Each joint's frames from the pass that holds there.
-    let torso_px = (first_pose[Joint::Neck] - first_pose[Joint::Pelvis]).norm();
-    let raw = fuse(
-        [&forward, &backward],
-        [&arrivals.0, &arrivals.1],
-        &job.keys,
-        0..n,
-        torso_px,
-        job.params.weak_reliability,
-    );
+    Ok((results, arrivals))
+}
 
-    let frames: Vec<FrameTracks> = raw
-        .into_iter()
+/// The fused results as tracks in video pixels: a key's joints as placed (confidence 1), a
+/// joint outside the image off the frame (confidence 0), a frame no pass reached at the first
+/// key's pose with confidence 0.
+fn frames_of(
+    raw: Vec<Option<PerJoint<JointResult>>>,
+    first_pose: &PerJoint<Point2<f64>>,
+    job: &TrackJob,
+    info: &VideoInfo,
+) -> Vec<FrameTracks> {
+    raw.into_iter()
         .enumerate()
         .map(|(index, r)| FrameTracks {
             index: FrameIndex(index),
@@ -397,7 +326,97 @@ fn track_at_working_scale(
                     }
                 }),
         })
-        .collect();
+        .collect()
+}
+
+/// [`track_video`]'s passes, with the video's full-size info; `network`: the network's frames
+/// are counted in the progress's total. The steps: where to start, the working scale, the
+/// background, the two passes, their fusion, the tracks.
+fn track_at_working_scale(
+    video: &mut Video,
+    info: &VideoInfo,
+    job: &TrackJob,
+    network: bool,
+    progress: &mut (dyn FnMut(&TrackProgress) + Send),
+    cancel: &AtomicBool,
+) -> Result<Passes, TrackError> {
+    let n = info.frame_count;
+    let (start, first_pose) = checked_start(info, job)?;
+    let (shrink, (ww, wh)) = working_scale(job, &first_pose, info.width, info.height);
+    let scale = Scale {
+        sx: f64::from(info.width) / f64::from(ww),
+        sy: f64::from(info.height) / f64::from(wh),
+        width: ww,
+        height: wh,
+    };
+    // Frames come out at the working size if the backend can make them so (at 1080×1920
+    // converting at that size is cheaper than converting at full size and shrinking); not when
+    // the video's frames are already decoded in its cache, which the change would empty.
+    let decoded = if shrink > 1.0 && video.cached_bytes() == 0 && video.output_size(Some((ww, wh)))
+    {
+        (ww, wh)
+    } else {
+        (info.width, info.height)
+    };
+    let params = job.params.tuning(info.fps, job.threads);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(job.threads.max(1))
+        .build()
+        .ok();
+    // The backward pass runs from the last key frame down to the start of the clip.
+    let last_key = job
+        .keys
+        .frames
+        .keys()
+        .next_back()
+        .map_or(start, |k| k.get());
+    let backward_frames: Vec<usize> = if last_key > 0 {
+        (0..=last_key).rev().collect()
+    } else {
+        Vec::new()
+    };
+    let mut ctx = PassContext {
+        video,
+        scale,
+        params,
+        keys: &job.keys,
+        path: info.path.clone(),
+        width: decoded.0,
+        height: decoded.1,
+        threads: job.threads,
+        damaged: Vec::new(),
+        done: 0,
+        total: (n - start) + backward_frames.len() + if network { n } else { 0 },
+        progress,
+        cancel,
+        background: None,
+    };
+    let tau = params.foreground_tau;
+    let known = job.background.as_ref().and_then(|k| k.get((ww, wh), tau));
+    ctx.background = match known {
+        _ if job.params.arm_foreground <= 0.0 => None,
+        Some(known) => known,
+        None => ctx.estimate_background(n, tau)?.map(Arc::new),
+    };
+    let background = (job.params.arm_foreground > 0.0)
+        .then(|| KnownBackground::new((ww, wh), tau, ctx.background.clone()));
+    let (results, arrivals) = match &pool {
+        Some(pool) => {
+            pool.install(|| run_passes(&mut ctx, job, &first_pose, start, &backward_frames))?
+        }
+        None => run_passes(&mut ctx, job, &first_pose, start, &backward_frames)?,
+    };
+    // Each joint's frames from the pass that holds there.
+    let torso_px = (first_pose[Joint::Neck] - first_pose[Joint::Pelvis]).norm();
+    let raw = fuse(
+        [&results[0], &results[1]],
+        [&arrivals[0], &arrivals[1]],
+        &job.keys,
+        0..n,
+        torso_px,
+        job.params.weak_reliability,
+    );
+    let frames = frames_of(raw, &first_pose, job, info);
     let source = SourceInfo {
         path: info.path.clone(),
         width: info.width,
