@@ -224,6 +224,10 @@ pub struct BenchArgs {
     /// clip of the split).
     #[arg(long)]
     pub clip: Option<String>,
+    /// `bench volume` with a split only: the suite tables whose label contains one of these
+    /// (`;`-separated, e.g. `40 mm;mesh bodies, 8 views`; the labels hold commas).
+    #[arg(long)]
+    pub tables: Option<String>,
     /// `learned` only: evidence settings to sweep (dev), `A,B,C,D,E,F;…` = VBA doubt, network
     /// doubt, swap cost, motion, key fade frames, jump cap (torso lengths).
     #[arg(long)]

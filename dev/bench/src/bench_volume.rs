@@ -168,13 +168,29 @@ const SUITE_VOXELS: [(f64, usize, f64); 4] = [
     (0.04, 200, 0.05),
 ];
 
-/// The volume pipeline on every take of suite v3 of `split` (`None`: both; its first clip's
+/// Which of the suite's takes and tables `bench volume` runs (`None`: all).
+#[derive(Debug, Clone, Copy, Default)]
+struct Only<'a> {
+    /// Takes whose name contains this.
+    take: Option<&'a str>,
+    /// Tables whose label contains one of these, `;`-separated.
+    tables: Option<&'a str>,
+}
+
+impl Only<'_> {
+    fn table(&self, label: &str) -> bool {
+        self.tables
+            .is_none_or(|t| t.split(';').any(|w| label.contains(w.trim())))
+    }
+}
+
+/// The volume pipeline on every take of suite v4 of `split` (`None`: both; its first clip's
 /// body and start, [`FRAMES`] frames at [`FPS`] fps) at each of [`SUITE_VOXELS`], dev and test
 /// side by side per family; returns the same as JSON.
 fn suite_takes(
     params: &VolumeParams,
     split: Option<Split>,
-    only: Option<&str>,
+    only: &Only,
     global: &GlobalArgs,
     lines: &mut Vec<String>,
 ) -> Result<serde_json::Value, ExitError> {
@@ -183,7 +199,7 @@ fn suite_takes(
     let mut seen = std::collections::BTreeSet::new();
     for clip in &suite.clips {
         if split.is_some_and(|s| s != clip.split)
-            || only.is_some_and(|o| !clip.take.contains(o))
+            || only.take.is_some_and(|o| !clip.take.contains(o))
             || !seen.insert(clip.take.clone())
         {
             continue;
@@ -221,6 +237,9 @@ fn suite_takes(
         } else {
             format!("{voxel_mm:.0} mm")
         };
+        if !only.table(&label) {
+            continue;
+        }
         let mut tally: Tally<Both> = Tally::default();
         let mut per_take = serde_json::Map::new();
         for (take, bench, motion, stature) in &takes {
@@ -261,6 +280,9 @@ fn suite_takes(
         ("mesh bodies, 4 faulty views", mesh(&faulty)),
     ];
     for (label, case) in cases {
+        if !only.table(&format!("carved {label}")) {
+            continue;
+        }
         let mut tally: Tally<Both> = Tally::default();
         let mut per_take = serde_json::Map::new();
         for (take, bench, motion, _) in &takes {
@@ -325,14 +347,20 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let split = parse_split(&a.split)?;
     if split.is_some() {
         let mut lines = Vec::new();
-        let suite_json = suite_takes(&params, split, a.clip.as_deref(), global, &mut lines)?;
+        let only = Only {
+            take: a.clip.as_deref(),
+            tables: a.tables.as_deref(),
+        };
+        let suite_json = suite_takes(&params, split, &only, global, &mut lines)?;
         let march = procedural(
             ProceduralMotion::March,
             &SubjectModel::default(),
             FRAMES,
             FPS,
         );
-        speed_table(&march, &params, global, &mut lines);
+        if only.table("speed") {
+            speed_table(&march, &params, global, &mut lines);
+        }
         print_tables(global, suite_json, &lines);
         return Ok(());
     }
@@ -403,7 +431,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         100.0 * others.consistency()
     ));
     lines.push(String::new());
-    let suite_json = suite_takes(&params, None, None, global, &mut lines)?;
+    let suite_json = suite_takes(&params, None, &Only::default(), global, &mut lines)?;
 
     // Carved from silhouettes (paper §2): the visual hull is fatter than the body and fills
     // gaps a camera cannot see through.
