@@ -163,11 +163,22 @@ pub fn resolve(
         weights,
         overrides,
         &memo,
+        Margins::Compute,
     )
 }
 
+/// Whether a solve works out each bone's margin ([`Resolved::margins`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Margins {
+    /// Every bone's margin, from the min-marginals of its group's chain.
+    Compute,
+    /// None (the margins left at 0): a trial solve whose cost alone is read, for the choice of
+    /// the calibration pose and the facing. The min-marginals cost as much again as the chain.
+    Skip,
+}
+
 /// [`resolve`] keeping the pose prior's costs in `memo` for the next solve of the same lift
-/// (the same rays, subject and weights).
+/// (the same rays, subject and weights), working out the margins only if asked.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn resolve_with(
     key: &[[Point3<f64>; 3]],
@@ -178,6 +189,7 @@ pub(crate) fn resolve_with(
     weights: &AmbiguityWeights,
     overrides: &DepthOverrides,
     memo: &PriorMemo,
+    margins: Margins,
 ) -> Resolved {
     let n = key.len();
     let points: Vec<PerJoint<Point3<f64>>> = key
@@ -203,6 +215,7 @@ pub(crate) fn resolve_with(
             .ok()
             .filter(|_| weights.pose_prior > 0.0),
         memo,
+        margins,
     };
     let mut resolved = Resolved {
         points,
@@ -251,6 +264,8 @@ struct Inputs<'a> {
     prior: Option<&'a PosePrior>,
     /// The prior's costs already computed in this lift.
     memo: &'a PriorMemo,
+    /// Whether the bones' margins are wanted.
+    margins: Margins,
 }
 
 /// Chooses the roots of group `g` over the whole sequence on the trajectories already chosen
@@ -340,7 +355,10 @@ fn solve_group(
         .map(|(t, &c)| candidates[t][c].steer)
         .sum();
     resolved.group_costs[g] = cost - steer;
-    let marginals = margins::min_marginals(&candidates);
+    let marginals = match inputs.margins {
+        Margins::Compute => margins::min_marginals(&candidates),
+        Margins::Skip => Vec::new(),
+    };
     // Margins in nats of the prior: the clip's cost at the prior's default exchange rate, so a
     // margin is the log-likelihood ratio of the bone's two roots (acceleration included).
     let per_nat = AmbiguityWeights::default().pose_prior;
@@ -351,10 +369,13 @@ fn solve_group(
             let b = bone.index();
             resolved.choices[t][b] = root_of(combo, k);
             resolved.too_long[t][b] = c.too_long[k];
+            let Some(marginals) = marginals.get(t) else {
+                continue;
+            };
             // The best the clip can do with this bone's other root here.
             let other = (0..combos)
                 .filter(|&o| root_of(o, k) != root_of(combo, k))
-                .map(|o| marginals[t][o])
+                .map(|o| marginals[o])
                 .fold(f64::INFINITY, f64::min);
             resolved.margins[t][b] = (other - cost).max(0.0) / per_nat;
         }
