@@ -36,7 +36,7 @@ pub struct AmbiguityWeights {
     /// each bone pays the squared difference between its depth step (child minus parent, along
     /// the camera's axis) and the network's, times the network's confidence in both ends.
     /// The same weight counts the network's word on the body's facing in the choice of the key
-    /// triangle's pose ([`super::image_facing_cost`], one more part of the fit's sum of
+    /// triangle's pose (the facing cost of `image_facing_cost`, one more part of the fit's sum of
     /// logarithms): the same evidence, one weight (issue 94; both were 1, set apart).
     /// Measured in `docs/method.md` ("Fitted constants of the lift").
     pub image_depth: f64,
