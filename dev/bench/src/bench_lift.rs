@@ -72,7 +72,7 @@ pub(crate) fn doubt_columns() -> String {
         "wrong f/unf",
         UNSURE_SWEEP
             .iter()
-            .map(|m| format!("{:>17}", format!("<{m}: u% wu/ws")))
+            .map(|m| format!("{:>17}", format!("<{m:.3}: u% wu/ws")))
             .collect::<Vec<_>>()
             .join(" ")
     )

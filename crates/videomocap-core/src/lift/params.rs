@@ -93,12 +93,6 @@ impl LiftParams {
             contact: self.hands_outside_body,
             image_depth: self.image_depth,
             pose_prior: self.pose_prior * AmbiguityWeights::default().pose_prior,
-            // The facing's evidence comes from the same network body: off with it.
-            image_facing: if self.image_depth > 0.0 {
-                AmbiguityWeights::default().image_facing
-            } else {
-                0.0
-            },
             ..AmbiguityWeights::default()
         }
     }

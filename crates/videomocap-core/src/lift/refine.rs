@@ -216,112 +216,144 @@ impl Problem<'_> {
 
 impl Residuals for Problem<'_> {
     fn rows(&self, x: &DVector<f64>, emit: &mut dyn FnMut(Row)) {
-        let n = self.images.len();
-        let lcol = n * PER_FRAME;
+        for t in 0..self.images.len() {
+            self.image_rows(x, t, emit);
+            self.length_rows(x, t, emit);
+            self.network_rows(x, t, emit);
+            self.acceleration_rows(x, t, emit);
+        }
+        self.global_rows(x, emit);
+    }
+}
+
+impl Problem<'_> {
+    /// Frame `t`'s reprojection rows and its anchor to the per-frame solve.
+    fn image_rows(&self, x: &DVector<f64>, t: usize, emit: &mut dyn FnMut(Row)) {
         let p = &self.params;
         let f = self.cam.focal_px;
-        let pairs = length_pairs();
-        for t in 0..n {
+        for j in Joint::ALL {
+            let c = Self::col(t, j);
+            let q = Self::point(x, t, j);
+            let z = q.z.max(1e-3);
+            let s = self.weights[t][j].sqrt() / p.reprojection_sigma_px;
+            let u = f * q.x / z + self.cam.cx - self.images[t][j].x;
+            let v = f * q.y / z + self.cam.cy - self.images[t][j].y;
+            emit(
+                Row::new(s * u)
+                    .with(c, s * f / z)
+                    .with(c + 2, -s * f * q.x / (z * z)),
+            );
+            emit(
+                Row::new(s * v)
+                    .with(c + 1, s * f / z)
+                    .with(c + 2, -s * f * q.y / (z * z)),
+            );
+        }
+        if p.anchor_sigma_m > 0.0 {
+            let s = 1.0 / p.anchor_sigma_m;
             for j in Joint::ALL {
                 let c = Self::col(t, j);
-                let q = Self::point(x, t, j);
-                let z = q.z.max(1e-3);
-                let s = self.weights[t][j].sqrt() / p.reprojection_sigma_px;
-                let u = f * q.x / z + self.cam.cx - self.images[t][j].x;
-                let v = f * q.y / z + self.cam.cy - self.images[t][j].y;
-                emit(
-                    Row::new(s * u)
-                        .with(c, s * f / z)
-                        .with(c + 2, -s * f * q.x / (z * z)),
-                );
-                emit(
-                    Row::new(s * v)
-                        .with(c + 1, s * f / z)
-                        .with(c + 2, -s * f * q.y / (z * z)),
-                );
-            }
-            if p.anchor_sigma_m > 0.0 {
-                let s = 1.0 / p.anchor_sigma_m;
-                for j in Joint::ALL {
-                    let c = Self::col(t, j);
-                    let q = Self::point(x, t, j) - self.start[t][j];
-                    for axis in 0..3 {
-                        emit(Row::new(s * q[axis]).with(c + axis, s));
-                    }
-                }
-            }
-            let s = 1.0 / p.length_sigma_m;
-            for (k, &(a, b)) in pairs.iter().enumerate() {
-                let d = Self::point(x, t, b) - Self::point(x, t, a);
-                let len = d.norm().max(1e-9);
-                let u = d / len;
-                let (ca, cb) = (Self::col(t, a), Self::col(t, b));
-                emit(
-                    Row::new(s * (len - x[lcol + k]))
-                        .with(cb, s * u.x)
-                        .with(cb + 1, s * u.y)
-                        .with(cb + 2, s * u.z)
-                        .with(ca, -s * u.x)
-                        .with(ca + 1, -s * u.y)
-                        .with(ca + 2, -s * u.z)
-                        .with(lcol + k, -s),
-                );
-            }
-            let (cl, cr, cp) = (
-                Self::col(t, Joint::LeftHip),
-                Self::col(t, Joint::RightHip),
-                Self::col(t, Joint::Pelvis),
-            );
-            for axis in 0..3 {
-                emit(
-                    Row::new(s * (x[cl + axis] + x[cr + axis] - 2.0 * x[cp + axis]))
-                        .with(cl + axis, s)
-                        .with(cr + axis, s)
-                        .with(cp + axis, -2.0 * s),
-                );
-            }
-            if p.network_direction_sigma_m > 0.0 {
-                for &(k, u, sure) in &self.directions[t] {
-                    let (a, b) = pairs[k];
-                    let s = sure.sqrt() / p.network_direction_sigma_m;
-                    let d = Self::point(x, t, b) - Self::point(x, t, a);
-                    let target = u * self.start_lengths[k];
-                    let (ca, cb) = (Self::col(t, a), Self::col(t, b));
-                    // Along the child's ray only: the image places the bone across it.
-                    let e = self.start[t][b]
-                        .coords
-                        .try_normalize(1e-9)
-                        .unwrap_or_else(Vector3::z);
-                    emit(
-                        Row::new(s * (d - target).dot(&e))
-                            .with(cb, s * e.x)
-                            .with(cb + 1, s * e.y)
-                            .with(cb + 2, s * e.z)
-                            .with(ca, -s * e.x)
-                            .with(ca + 1, -s * e.y)
-                            .with(ca + 2, -s * e.z),
-                    );
-                }
-            }
-            if t >= 1 && t + 1 < n {
-                let s = 1.0 / self.accel_sigma_m;
-                for j in Joint::ALL {
-                    for axis in 0..3 {
-                        let (a, b, c) = (
-                            Self::col(t - 1, j) + axis,
-                            Self::col(t, j) + axis,
-                            Self::col(t + 1, j) + axis,
-                        );
-                        emit(
-                            Row::new(s * (x[a] - 2.0 * x[b] + x[c]))
-                                .with(a, s)
-                                .with(b, -2.0 * s)
-                                .with(c, s),
-                        );
-                    }
+                let q = Self::point(x, t, j) - self.start[t][j];
+                for axis in 0..3 {
+                    emit(Row::new(s * q[axis]).with(c + axis, s));
                 }
             }
         }
+    }
+
+    /// Frame `t`'s bones (and shoulder line) at their lengths, the pelvis between the hips.
+    fn length_rows(&self, x: &DVector<f64>, t: usize, emit: &mut dyn FnMut(Row)) {
+        let p = &self.params;
+        let lcol = self.images.len() * PER_FRAME;
+        let pairs = length_pairs();
+        let s = 1.0 / p.length_sigma_m;
+        for (k, &(a, b)) in pairs.iter().enumerate() {
+            let d = Self::point(x, t, b) - Self::point(x, t, a);
+            let len = d.norm().max(1e-9);
+            let u = d / len;
+            let (ca, cb) = (Self::col(t, a), Self::col(t, b));
+            emit(
+                Row::new(s * (len - x[lcol + k]))
+                    .with(cb, s * u.x)
+                    .with(cb + 1, s * u.y)
+                    .with(cb + 2, s * u.z)
+                    .with(ca, -s * u.x)
+                    .with(ca + 1, -s * u.y)
+                    .with(ca + 2, -s * u.z)
+                    .with(lcol + k, -s),
+            );
+        }
+        let (cl, cr, cp) = (
+            Self::col(t, Joint::LeftHip),
+            Self::col(t, Joint::RightHip),
+            Self::col(t, Joint::Pelvis),
+        );
+        for axis in 0..3 {
+            emit(
+                Row::new(s * (x[cl + axis] + x[cr + axis] - 2.0 * x[cp + axis]))
+                    .with(cl + axis, s)
+                    .with(cr + axis, s)
+                    .with(cp + axis, -2.0 * s),
+            );
+        }
+    }
+
+    /// Frame `t`'s pull towards the network's bone directions, along the children's rays.
+    fn network_rows(&self, x: &DVector<f64>, t: usize, emit: &mut dyn FnMut(Row)) {
+        let p = &self.params;
+        let pairs = length_pairs();
+        if p.network_direction_sigma_m > 0.0 {
+            for &(k, u, sure) in &self.directions[t] {
+                let (a, b) = pairs[k];
+                let s = sure.sqrt() / p.network_direction_sigma_m;
+                let d = Self::point(x, t, b) - Self::point(x, t, a);
+                let target = u * self.start_lengths[k];
+                let (ca, cb) = (Self::col(t, a), Self::col(t, b));
+                // Along the child's ray only: the image places the bone across it.
+                let e = self.start[t][b]
+                    .coords
+                    .try_normalize(1e-9)
+                    .unwrap_or_else(Vector3::z);
+                emit(
+                    Row::new(s * (d - target).dot(&e))
+                        .with(cb, s * e.x)
+                        .with(cb + 1, s * e.y)
+                        .with(cb + 2, s * e.z)
+                        .with(ca, -s * e.x)
+                        .with(ca + 1, -s * e.y)
+                        .with(ca + 2, -s * e.z),
+                );
+            }
+        }
+    }
+
+    /// Frame `t`'s joints' accelerations (frames inside the clip).
+    fn acceleration_rows(&self, x: &DVector<f64>, t: usize, emit: &mut dyn FnMut(Row)) {
+        let n = self.images.len();
+        if t >= 1 && t + 1 < n {
+            let s = 1.0 / self.accel_sigma_m;
+            for j in Joint::ALL {
+                for axis in 0..3 {
+                    let (a, b, c) = (
+                        Self::col(t - 1, j) + axis,
+                        Self::col(t, j) + axis,
+                        Self::col(t + 1, j) + axis,
+                    );
+                    emit(
+                        Row::new(s * (x[a] - 2.0 * x[b] + x[c]))
+                            .with(a, s)
+                            .with(b, -2.0 * s)
+                            .with(c, s),
+                    );
+                }
+            }
+        }
+    }
+
+    /// The lengths near their start and their sum at its start (the scale).
+    fn global_rows(&self, x: &DVector<f64>, emit: &mut dyn FnMut(Row)) {
+        let p = &self.params;
+        let lcol = self.images.len() * PER_FRAME;
         let mut sum = 0.0;
         let mut start_sum = 0.0;
         for k in 0..LENGTHS {
@@ -507,103 +539,4 @@ pub fn refine(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::super::least_squares::assert_rows_match_finite_differences;
-    use super::*;
-
-    #[test]
-    fn the_adaptive_acceleration_term_is_firmer_for_noisier_tracks() {
-        let params = RefineParams::default();
-        let dt = 1.0 / 30.0;
-        let exact = acceleration_sigma_m(0.0, &params, dt);
-        let half = acceleration_sigma_m(0.5, &params, dt);
-        let noisy = acceleration_sigma_m(2.0, &params, dt);
-        let very = acceleration_sigma_m(8.0, &params, dt);
-        assert!(exact > half && half > noisy, "{exact} {half} {noisy}");
-        assert!((exact - 600.0 * dt * dt).abs() < 1e-9, "{exact}");
-        assert!(
-            (very - MIN_ACCELERATION_MPS2 * dt * dt).abs() < 1e-12,
-            "{very}"
-        );
-        let fixed = RefineParams {
-            adaptive: false,
-            ..params
-        };
-        assert_eq!(acceleration_sigma_m(2.0, &fixed, dt), 100.0 * dt * dt);
-    }
-
-    #[test]
-    fn snapping_puts_every_bone_at_its_length_along_its_direction() {
-        let free: PerJoint<Point3<f64>> = PerJoint::from_fn(|j| {
-            let i = j.index() as f64;
-            Point3::new(0.07 * i - 0.5, 0.11 * i - 0.9, 3.0 + 0.03 * (i * i).sin())
-        });
-        let mut fallback = free;
-        fallback[Joint::LeftWrist] = free[Joint::LeftElbow] + Vector3::new(0.0, 0.0, 0.3);
-        let mut free = free;
-        // A forearm shrunk to nothing takes the per-frame solve's direction.
-        free[Joint::LeftWrist] = free[Joint::LeftElbow];
-        let lengths: [f64; BONE_COUNT] = std::array::from_fn(|k| 0.2 + 0.01 * k as f64);
-        let snapped = snap_to_lengths(&free, &fallback, &lengths);
-        assert_eq!(snapped[Joint::Pelvis], free[Joint::Pelvis]);
-        for (b, &len) in Bone::ALL.iter().zip(&lengths) {
-            let d = snapped[b.child] - snapped[b.parent];
-            assert!((d.norm() - len).abs() < 1e-12, "{}", b.key());
-            let want = if b.child == Joint::LeftWrist {
-                Vector3::z()
-            } else {
-                (free[b.child] - free[b.parent]).normalize()
-            };
-            assert!((d.normalize() - want).norm() < 1e-12, "{}", b.key());
-        }
-    }
-
-    /// Central finite differences of every residual against the analytic rows.
-    #[test]
-    fn analytic_rows_match_finite_differences() {
-        let cam = PinholeCamera::centred(800.0, 640, 480);
-        let subject = SubjectModel::default();
-        let n = 4;
-        let start: Vec<PerJoint<Point3<f64>>> = (0..n)
-            .map(|t| {
-                PerJoint::from_fn(|j| {
-                    let i = j.index() as f64;
-                    Point3::new(
-                        0.05 * i - 0.3 + 0.01 * t as f64,
-                        0.1 * i - 0.8,
-                        3.0 + 0.02 * i,
-                    )
-                })
-            })
-            .collect();
-        let images: Vec<PerJoint<Point2<f64>>> = start
-            .iter()
-            .map(|f| f.map(|_, p| cam.project(p).unwrap() + nalgebra::Vector2::new(1.5, -0.5)))
-            .collect();
-        let weights = vec![PerJoint::from_fn(|j| 0.3 + 0.04 * j.index() as f64); n];
-        // The network's body, turned a little from the start, on every frame but the second.
-        let bodies: Vec<Option<NetworkBody>> = (0..n)
-            .map(|t| {
-                (t != 1).then(|| NetworkBody {
-                    points: start[t].map(|j, p| {
-                        p.coords + Vector3::new(0.0, 0.0, 0.03 * (j.index() % 3) as f64)
-                    }),
-                    confidence: PerJoint::from_fn(|j| 0.4 + 0.05 * j.index() as f32),
-                })
-            })
-            .collect();
-        let start_lengths = subject_lengths(&subject);
-        let problem = Problem {
-            cam: &cam,
-            images: &images,
-            weights: &weights,
-            start: &start,
-            start_lengths,
-            params: RefineParams::default(),
-            accel_sigma_m: 20.0 / 900.0,
-            directions: network_directions(&start, &bodies),
-        };
-        let x = Problem::pack(&start, &start_lengths.map(|l| l * 1.05));
-        assert_rows_match_finite_differences(&problem, &x);
-    }
-}
+mod tests;

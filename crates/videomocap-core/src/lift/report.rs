@@ -54,10 +54,11 @@ pub struct FrameReport {
     pub flags: Vec<FrameFlag>,
 }
 
-/// The clip-wide margin under which a bone's depth choice is shown unsure
-/// ([`BoneDepth::unsure`]), nats: the log of the likelihood ratio of its two roots under the
-/// pose prior and smooth motion. Chosen on the suite's dev split (`docs/method.md`, issue 94).
-pub const UNSURE_MARGIN: f64 = 5.0;
+/// The margin under which a bone's depth choice is shown unsure ([`BoneDepth::unsure`]), nats:
+/// the pose prior's log-likelihood ratio of its two roots below ln 19, i.e. with both roots
+/// alike beforehand, the other root keeps at least a 5 % chance (derived, not tuned: the
+/// usual 95 %). Measured in `docs/method.md` (issue 94, "Unsure from the prior").
+pub const UNSURE_MARGIN: f64 = 2.944_438_979_166_44;
 
 /// One bone's depth choice on one frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -67,8 +68,9 @@ pub struct BoneDepth {
     /// The bone's two roots were one point (its 2D image too long for its length): flipping
     /// it there changes nothing.
     pub single_root: bool,
-    /// How much the clip-wide cost of the bone's group would rise, at best, with the other
-    /// root on this frame (infinite where the user forced the root).
+    /// How sure the root is, nats: the pose prior's log-likelihood ratio of the chosen root
+    /// against the other (without the prior, the clip-wide cost of taking the other root, at
+    /// the prior's exchange rate); infinite where the user forced the root.
     pub margin: f64,
 }
 

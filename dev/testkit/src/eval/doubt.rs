@@ -10,7 +10,7 @@ use videomocap_core::lift::{BoneDepth, lift_order};
 use videomocap_core::skeleton::{BONE_COUNT, Bone};
 
 /// The margins tried for "unsure", nats (the product's is [`videomocap_core::lift::UNSURE_MARGIN`]).
-pub const UNSURE_SWEEP: [f64; 5] = [0.5, 1.0, 2.0, 5.0, 10.0];
+pub const UNSURE_SWEEP: [f64; 5] = [0.5, 1.0, 2.0, videomocap_core::lift::UNSURE_MARGIN, 5.0];
 
 /// Counts of depth choices that matter (their roots apart, not a coin flip), wrong or not, by
 /// what the lift said of them.

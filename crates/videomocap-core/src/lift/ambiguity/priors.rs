@@ -24,7 +24,7 @@ pub(super) const TRUNK_DEPTH: f64 = 0.35;
 /// of, as a share of the thigh's breadth (0.45 of the default subject's 0.16 m is 0.07 m).
 pub(super) const THIGH_DEPTH: f64 = 0.45;
 
-/// [`AmbiguityWeights::image_facing`]'s cost of a key path (unweighted, squared metres): each
+/// The facing's cost of a key path, weighed by [`AmbiguityWeights::image_depth`] (unweighted, squared metres): each
 /// frame's shoulders' depth step (left minus right) against the network's, squared, times
 /// the network's confidence in both shoulders; `None` without any network body.
 pub fn image_facing_cost(key: &[[Point3<f64>; 3]], bodies: &[Option<NetworkBody>]) -> Option<f64> {

@@ -502,3 +502,60 @@ fn the_image_depth_evidence_turns_a_bone_it_is_sure_of() {
     // It steers and stays out of the reported cost.
     assert_eq!(unsure.group_costs, alone.group_costs);
 }
+
+/// With the prior, a bone's margin is the prior's own log-likelihood ratio of its two roots on
+/// the frame (the group's other bones free), infinite where the user forced the root; without
+/// the prior it is the clip-wide min-marginal, at the prior's exchange rate. The product's
+/// unsure margin is ln 19 (the other root keeps a 5 % chance).
+#[test]
+fn a_margin_is_the_priors_likelihood_ratio_of_the_two_roots() {
+    assert!((crate::lift::UNSURE_MARGIN - 19f64.ln()).abs() < 1e-12);
+    let subject = SubjectModel::default();
+    let frames = striding(&subject, 8, 0.5, Vector3::new(0.0, 0.0, 3.0), |phase, s| {
+        let arm = Vector3::new(0.15 * s, -1.0, 0.2 * phase).normalize();
+        let forearm = Vector3::new(0.1 * s, -0.7, 0.5).normalize();
+        [arm, forearm, -Vector3::y(), -Vector3::y()]
+    });
+    let (key, rays, index) = seen(&frames);
+    let w = AmbiguityWeights::default();
+    let forearm = Bone::new(LeftElbow, LeftWrist);
+    let forced: DepthOverrides = [((index[3], forearm), Root::Far)].into_iter().collect();
+    let r = resolve(&key, &rays, &index, &[], &subject, &w, &forced);
+    let prior = PosePrior::bundled().unwrap();
+    let arm = &GROUPS[ARM_GROUPS[0]];
+    let k = arm.bones.iter().position(|&b| b == forearm).unwrap();
+    for (t, p) in r.points.iter().enumerate() {
+        let trunk = TrunkFrame::of(p);
+        let chosen = usize::from(r.choices[t][arm.bones[0].index()] == Root::Far)
+            | usize::from(r.choices[t][forearm.index()] == Root::Far) << 1;
+        let nats = |combo: usize| {
+            prior.cost(
+                arm.prior,
+                &placed(ARM_GROUPS[0], combo, p, &rays[t], &subject),
+                &trunk,
+            )
+        };
+        let other = (0..4)
+            .filter(|&o| root_of(o, k) != root_of(chosen, k))
+            .map(nats)
+            .fold(f64::INFINITY, f64::min);
+        let margin = r.margins[t][forearm.index()];
+        if t == 3 {
+            assert!(margin.is_infinite());
+            assert_eq!(r.choices[t][forearm.index()], Root::Far);
+        } else {
+            assert!(
+                (margin - (other - nats(chosen)).max(0.0)).abs() < 1e-9,
+                "frame {t}"
+            );
+        }
+    }
+    // Without the prior: the clip-wide margins, finite and not negative but where forced.
+    let geometry = AmbiguityWeights {
+        pose_prior: 0.0,
+        ..w
+    };
+    let g = resolve(&key, &rays, &index, &[], &subject, &geometry, &forced);
+    assert!(g.margins[3][forearm.index()].is_infinite());
+    assert!(g.margins.iter().flatten().all(|m| *m >= 0.0));
+}

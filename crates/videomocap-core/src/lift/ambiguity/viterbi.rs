@@ -129,5 +129,6 @@ pub(super) fn test_candidate(x: f64, unary: f64) -> Candidate {
         too_long: [false; 2],
         unary,
         steer: 0.0,
+        nats: 0.0,
     }
 }

@@ -35,14 +35,11 @@ pub struct AmbiguityWeights {
     /// The image's depth evidence: where the pose network saw the body (the tracks' `body3d`),
     /// each bone pays the squared difference between its depth step (child minus parent, along
     /// the camera's axis) and the network's, times the network's confidence in both ends.
+    /// The same weight counts the network's word on the body's facing in the choice of the key
+    /// triangle's pose (the facing cost of `image_facing_cost`, one more part of the fit's sum of
+    /// logarithms): the same evidence, one weight (issue 94; both were 1, set apart).
     /// Measured in `docs/method.md` ("Fitted constants of the lift").
     pub image_depth: f64,
-    /// The image's evidence for which way the body faces: how strongly the shoulders' depth
-    /// order against the network's (each frame's squared difference of the two depth steps,
-    /// times the network's confidence, summed over the clip) counts in the choice of the key
-    /// triangle's pose and facing, as one more part of the fit's sum of logarithms. Measured in
-    /// `docs/method.md` ("Fitted constants of the lift").
-    pub image_facing: f64,
 }
 
 impl Default for AmbiguityWeights {
@@ -55,7 +52,6 @@ impl Default for AmbiguityWeights {
             lookahead: 1.0,
             gait_symmetry: 0.3,
             image_depth: IMAGE_DEPTH,
-            image_facing: IMAGE_FACING,
         }
     }
 }
@@ -68,6 +64,3 @@ const POSE_PRIOR: f64 = 0.006;
 
 /// [`AmbiguityWeights::image_depth`]'s default: chosen on the suite's dev split.
 const IMAGE_DEPTH: f64 = 1.0;
-
-/// [`AmbiguityWeights::image_facing`]'s default: chosen on the suite's dev split.
-const IMAGE_FACING: f64 = 1.0;

@@ -29,6 +29,11 @@ pub struct Gmm {
     packed: Vec<f64>,
 }
 
+/// How far (nats) below the best term so far a component's term may be left out of the
+/// log-sum-exp: e^−37 ≈ 8.5·10⁻¹⁷ is under half the spacing of doubles at the running sum (at
+/// least 1), so adding it would leave the sum's bits unchanged.
+const NEGLIGIBLE: f64 = 37.0;
+
 /// The most dimensions a mixture may have (the pose prior's largest group has 9).
 pub const MAX_DIMS: usize = 16;
 
@@ -88,8 +93,55 @@ impl Gmm {
         })
     }
 
-    /// Each component's log term at `x`: ln(weight · N(x; μ, Σ)), in order.
-    fn terms<'a>(&'a self, x: &'a [f64]) -> impl Iterator<Item = f64> + 'a {
+    /// The log density at `x` (`x.len() == dims`): the components' terms ln(weight · N(x; μ,
+    /// Σ)) summed in order by a running log-sum-exp. A component is left off as soon as its
+    /// Mahalanobis sum, accumulated row by row of `L⁻¹ (x − μ)` (it only grows), puts its term
+    /// more than [`NEGLIGIBLE`] below the best so far: added, it would not have changed the
+    /// running sum's bits (so the result is the same as the full sum's, to the bit; checked in
+    /// a test against [`Gmm::log_density_full`]).
+    pub fn log_density(&self, x: &[f64]) -> f64 {
+        let dims = self.dims;
+        let (mut best, mut sum) = (f64::NEG_INFINITY, 0.0);
+        let mut d = [0.0f64; MAX_DIMS];
+        'components: for c in self.packed.chunks_exact(stride(dims)) {
+            let (mean, inverse) = c[1..].split_at(dims);
+            for i in 0..dims {
+                d[i] = x[i] - mean[i];
+            }
+            // The term may fall below `best − NEGLIGIBLE` once 0.5 · maha exceeds this.
+            let cut = 2.0 * (c[0] - best + NEGLIGIBLE);
+            let mut maha = 0.0;
+            let mut row = 0;
+            for i in 0..dims {
+                let y: f64 = inverse[row..row + i + 1]
+                    .iter()
+                    .zip(&d[..=i])
+                    .map(|(a, b)| a * b)
+                    .sum();
+                maha += y * y;
+                row += i + 1;
+                if maha > cut {
+                    continue 'components;
+                }
+            }
+            let t = c[0] - 0.5 * maha;
+            if t > best {
+                sum = sum * (best - t).exp() + 1.0;
+                best = t;
+            } else {
+                sum += (t - best).exp();
+            }
+        }
+        if best.is_finite() {
+            best + sum.ln()
+        } else {
+            best
+        }
+    }
+
+    /// Each component's log term at `x`: ln(weight · N(x; μ, Σ)), in order (for the fit's E
+    /// step and the reference sum).
+    pub(super) fn terms<'a>(&'a self, x: &'a [f64]) -> impl Iterator<Item = f64> + 'a {
         let dims = self.dims;
         self.packed.chunks_exact(stride(dims)).map(move |c| {
             let (mean, inverse) = c[1..].split_at(dims);
@@ -112,9 +164,9 @@ impl Gmm {
         })
     }
 
-    /// The log density at `x` (`x.len() == dims`): the components' terms summed by a running
-    /// log-sum-exp.
-    pub fn log_density(&self, x: &[f64]) -> f64 {
+    /// [`Gmm::log_density`] with every component summed (the slow reference).
+    #[cfg(test)]
+    pub(crate) fn log_density_full(&self, x: &[f64]) -> f64 {
         let (mut best, mut sum) = (f64::NEG_INFINITY, 0.0);
         for t in self.terms(x) {
             if t > best {

@@ -1,9 +1,11 @@
 //! Tests of the parent module.
 
+use super::super::calibrate::KeyTriangle;
 use super::super::calibrate::{Residuals, calibrate_from};
 use super::super::facing::*;
 use super::super::key_candidates::*;
 use super::super::key_path::{centroid, tilt_m};
+use super::per_frame::fit_score;
 use super::*;
 use nalgebra::Vector3;
 
