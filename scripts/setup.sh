@@ -14,6 +14,8 @@ packages=(
   libxcursor1 libxi6 libxkbcommon-x11-0 libx11-6 libwayland-client0 libgl1 libegl1 libegl-mesa0 libgl1-mesa-dri
   # tests, screenshots, benchmarks
   ffmpeg xvfb xauth imagemagick xdotool
+  # the house checks (scripts/module_cycles.py)
+  python3
   # fetching rustup when cargo is missing
   curl ca-certificates
 )

@@ -8,7 +8,8 @@
 //! search around the best grid value.
 
 use super::error::LiftError;
-use super::solve::{LiftJob, lift_per_frame, miss_m};
+use super::job::LiftJob;
+use super::solve::{lift_per_frame, miss_m};
 use crate::camera::PinholeCamera;
 
 pub use crate::camera::{DEFAULT_FOV_LONG_SIDE_DEG, default_focal};

@@ -4,9 +4,9 @@
 use super::calibrate::{
     CALIBRATION_TOLERANCE_PX, KeyTriangle, Residuals, calibrate_all, calibrate_from, starting_poses,
 };
+use super::job::LiftJob;
 use super::key_path::{centroid, tilt_m};
 use super::propagate::{PROPAGATION_TOLERANCE_M, key_depths};
-use super::solve::LiftJob;
 use crate::camera::PinholeCamera;
 use crate::skeleton::{Joint, PerJoint, SubjectModel};
 use nalgebra::{Point2, Point3};

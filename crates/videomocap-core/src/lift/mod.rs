@@ -17,7 +17,8 @@
 //! a planted foot stays put (`contact`).
 //! Its input is [`crate::formats::Tracks2d`], its output [`crate::formats::Skeleton3d`].
 //! Every front end runs it through [`reconstruct`] (`pipeline`): the camera, the subject's
-//! lengths, then the skeleton, reporting each [`LiftStage`] as it starts.
+//! lengths, then the skeleton, reporting each [`LiftStage`] as it starts. What the steps share
+//! (the job, its progress and stages, the check of its inputs) is in `job`, below them all.
 
 mod ambiguity;
 mod backproject;
@@ -26,6 +27,7 @@ mod contact;
 mod error;
 mod facing;
 mod focal;
+mod job;
 mod key_candidates;
 mod key_path;
 mod least_squares;
@@ -47,14 +49,13 @@ pub use calibrate::{KEY_JOINTS, KeyTriangle};
 pub use contact::{FEET, FootContacts};
 pub use error::LiftError;
 pub use focal::{DEFAULT_FOV_LONG_SIDE_DEG, default_focal};
+pub use job::{LiftJob, LiftProgress, LiftStage};
 pub use params::{LiftParams, retired_lift_settings};
-pub use pipeline::{
-    CameraChoice, FocalSource, LiftStage, Reconstruction, SubjectChoice, reconstruct,
-};
+pub use pipeline::{CameraChoice, FocalSource, Reconstruction, SubjectChoice, reconstruct};
 pub use prior::{
     BUNDLED_PRIOR, Component, GroupFile, PosePrior, PriorError, PriorFile, PriorGroup, Side, learn,
 };
 pub use refine::RefineParams;
 pub use report::{BoneDepth, FrameFlag, FrameReport, UNSURE_MARGIN};
-pub use solve::{LiftJob, LiftOutput, LiftProgress, PerFrame, lift, lift_per_frame};
+pub use solve::{LiftOutput, PerFrame, lift, lift_per_frame};
 pub use subject_fit::{SubjectFit, subject_from_height};

@@ -4,14 +4,14 @@
 
 use super::error::LiftError;
 use super::focal::{default_focal, estimate_focal};
+use super::job::{LiftJob, LiftStage};
 use super::params::LiftParams;
-use super::solve::{LiftJob, LiftOutput, lift};
+use super::solve::{LiftOutput, lift};
 use super::subject_fit::{SubjectFit, subject_from_height};
 use super::{DepthOverrides, LiftProgress};
 use crate::camera::PinholeCamera;
 use crate::formats::{KnownLengths, Tracks2d};
 use crate::skeleton::{Proportions, SubjectModel};
-use std::fmt;
 use std::sync::atomic::AtomicBool;
 
 /// How the camera's focal length is chosen (the principal point is the image centre unless the
@@ -44,30 +44,6 @@ pub enum SubjectChoice {
     },
     /// A body whose every length is known (a benchmark's true lengths).
     Model(Box<SubjectModel>),
-}
-
-/// The stages of [`reconstruct`], in the order they run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum LiftStage {
-    /// Choosing the focal length.
-    Camera,
-    /// Reading the body's lengths from the tracks.
-    Subject,
-    /// Calibration on the key triangle, its path, the roots of every bone (eqs. 6–11).
-    PerFrame,
-    /// The global least-squares refinement of all frames and lengths.
-    Refine,
-}
-
-impl fmt::Display for LiftStage {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            LiftStage::Camera => "camera",
-            LiftStage::Subject => "body lengths",
-            LiftStage::PerFrame => "per-frame solve",
-            LiftStage::Refine => "global refinement",
-        })
-    }
 }
 
 /// Where the focal length came from, for the user.

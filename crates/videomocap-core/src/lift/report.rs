@@ -3,8 +3,8 @@
 //! frame or lost; a key triangle that did not fit), and per bone how sure its depth choice was.
 
 use super::backproject::Root;
+use super::job::LiftJob;
 use super::smoothing::median_noise_px;
-use super::solve::LiftJob;
 use crate::camera::PinholeCamera;
 use crate::formats::FrameIndex;
 use crate::skeleton::{BONE_COUNT, Bone, Joint, PerJoint};

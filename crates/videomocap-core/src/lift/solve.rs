@@ -9,33 +9,16 @@ pub use per_frame::lift_per_frame;
 pub(crate) use per_frame::miss_m;
 use per_frame::{network_bodies, per_frame_solve};
 
-use super::ambiguity::{DepthOverrides, Resolved};
+use super::ambiguity::Resolved;
 use super::error::LiftError;
-use super::params::LiftParams;
-use super::pipeline::LiftStage;
+use super::job::{LiftJob, LiftProgress, LiftStage};
 use super::refine::{RefineParams, RefineSummary, refine, track_weight};
 use super::report::{BoneDepth, FrameFlag, FrameReport, flag_too_long};
 use super::smoothing::median_noise_px;
-use crate::camera::PinholeCamera;
-use crate::formats::{Frame3d, PointSource, Skeleton3d, Tracks2d};
-use crate::skeleton::{BONE_COUNT, Bone, Joint, PerJoint, SubjectModel};
+use crate::formats::{Frame3d, PointSource, Skeleton3d};
+use crate::skeleton::{BONE_COUNT, Bone, Joint, PerJoint};
 use nalgebra::{Point2, Point3};
 use std::sync::atomic::{AtomicBool, Ordering};
-
-/// What to lift and how.
-#[derive(Debug, Clone)]
-pub struct LiftJob<'a> {
-    /// The 2D tracks.
-    pub tracks: &'a Tracks2d,
-    /// The camera (focal length given or estimated by `super::focal`).
-    pub camera: PinholeCamera,
-    /// The subject's bone lengths and shoulder width.
-    pub subject: SubjectModel,
-    /// Settings.
-    pub params: LiftParams,
-    /// Root choices forced by the user.
-    pub overrides: DepthOverrides,
-}
 
 /// The per-frame solve before refinement.
 #[derive(Debug, Clone, PartialEq)]
@@ -48,17 +31,6 @@ pub struct PerFrame {
     pub calibration_frame: usize,
     /// The (smoothed) 2D points the solve used, per frame.
     pub images: Vec<PerJoint<Point2<f64>>>,
-}
-
-/// Where the lift is.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LiftProgress {
-    /// What is being done.
-    pub stage: LiftStage,
-    /// Steps done.
-    pub done: usize,
-    /// Steps in this stage.
-    pub total: usize,
 }
 
 /// The result of a lift.
@@ -80,32 +52,6 @@ pub struct LiftOutput {
     /// Per frame, whether each foot (left, right) was found planted (all false with
     /// `foot_lock` off).
     pub contacts: super::contact::FootContacts,
-}
-
-/// Checks the job's inputs.
-fn check(job: &LiftJob<'_>) -> Result<(), LiftError> {
-    job.params.validate()?;
-    if job.params.pose_prior > 0.0 {
-        super::prior::PosePrior::bundled()?;
-    }
-    let f = job.camera.focal_px;
-    if !(f.is_finite() && f > 0.0) {
-        return Err(LiftError::BadFocal(f));
-    }
-    if job.tracks.frames.is_empty() {
-        return Err(LiftError::NoFrames);
-    }
-    for frame in &job.tracks.frames {
-        for (joint, p) in frame.points.iter() {
-            if !(p.pos.x.is_finite() && p.pos.y.is_finite()) {
-                return Err(LiftError::NonFinite {
-                    frame: frame.index,
-                    joint,
-                });
-            }
-        }
-    }
-    Ok(())
 }
 
 /// A skeleton3d from per-frame joints.

@@ -28,9 +28,10 @@ mod reading;
 pub use reading::{ChestDrop, LengthOrigin, PartLength, SubjectFit};
 
 use super::LiftError;
+use super::job::LiftJob;
 use super::params::LiftParams;
 use super::smoothing::{adaptive_sigmas, smoothed_images};
-use super::solve::{LiftJob, lift_per_frame};
+use super::solve::lift_per_frame;
 use crate::camera::PinholeCamera;
 use crate::formats::{KnownLengths, PointSource, Tracks2d};
 use crate::skeleton::{Bone, Joint, PerJoint, Proportions, SubjectModel};

@@ -10,6 +10,7 @@ use super::super::calibrate::{
 };
 use super::super::error::LiftError;
 use super::super::facing::facing_by_segments;
+use super::super::job::{LiftJob, check};
 use super::super::key_candidates::{
     deepest_trunk, key_candidates, plausible_key, smoothest_key_path,
 };
@@ -17,7 +18,7 @@ use super::super::key_path::{chain_pitch_prior, smooth_key_path};
 use super::super::refine::track_weight;
 use super::super::report::{FrameFlag, FrameReport, flag_too_long};
 use super::super::smoothing::{adaptive_sigmas, median_noise_px, smoothed_images};
-use super::{LiftJob, PerFrame, check};
+use super::PerFrame;
 use crate::camera::PinholeCamera;
 use crate::formats::{FrameIndex, NetworkBody, PointSource, Tracks2d};
 use crate::skeleton::{BONE_COUNT, JOINT_COUNT, Joint, PerJoint};

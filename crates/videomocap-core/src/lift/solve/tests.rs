@@ -1,12 +1,17 @@
 //! Tests of the parent module.
 
+use super::super::ambiguity::DepthOverrides;
 use super::super::calibrate::KeyTriangle;
 use super::super::calibrate::{Residuals, calibrate_from};
 use super::super::facing::*;
 use super::super::key_candidates::*;
 use super::super::key_path::{centroid, tilt_m};
+use super::super::params::LiftParams;
 use super::per_frame::fit_score;
 use super::*;
+use crate::camera::PinholeCamera;
+use crate::formats::Tracks2d;
+use crate::skeleton::SubjectModel;
 use nalgebra::Vector3;
 
 #[test]
