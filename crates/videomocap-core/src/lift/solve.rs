@@ -99,8 +99,9 @@ fn with_lengths(p: &PerJoint<Point3<f64>>, lengths: &[f64; BONE_COUNT]) -> PerJo
 }
 
 /// The whole lift: per frame, then (if enabled) the global refinement. Bones with a length
-/// doubt ([`SubjectModel::length_doubt`]) are solved that much shorter, leaning towards lying
-/// square to their rays, and given back their lengths along the directions found.
+/// doubt ([`crate::skeleton::SubjectModel::length_doubt`]) are solved that much shorter,
+/// leaning towards lying square to their rays, and given back their lengths along the
+/// directions found.
 pub fn lift(
     job: &LiftJob<'_>,
     progress: &mut dyn FnMut(&LiftProgress),

@@ -45,7 +45,7 @@ const RETIRED: [&str; 28] = [
 /// The tracker's settings a user changes, each named for what it does (the app's Tracker
 /// panel shows exactly these). Serialised as JSON (`--tracker-settings`, a project's
 /// `settings.tracker`); missing keys take their defaults, retired keys of older files are
-/// dropped on load. Everything else the tracker uses is a fitted constant ([`Tuning`]).
+/// dropped on load. Everything else the tracker uses is a fitted constant (`Tuning`, beside it).
 /// Measurements behind each default: `docs/method.md` ("The tracker's settings and
 /// constants").
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
