@@ -38,8 +38,7 @@ pub const MAX_ROWS: usize = 24;
 pub const MAX_COLS: usize = 10;
 
 /// The weights of eqs. 3–5 and of the colour-model mix.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SimilarityWeights {
     /// `W_R, W_G, W_B` of eq. 3. Default equal thirds: clothes and skin differ as much in hue as
     /// in brightness, so no channel is favoured.

@@ -101,7 +101,7 @@ impl Gmm {
     /// a test against [`Gmm::log_density_full`]).
     pub fn log_density(&self, x: &[f64]) -> f64 {
         let dims = self.dims;
-        let (mut best, mut sum) = (f64::NEG_INFINITY, 0.0);
+        let mut total = LogSumExp::default();
         let mut d = [0.0f64; MAX_DIMS];
         'components: for c in self.packed.chunks_exact(stride(dims)) {
             let (mean, inverse) = c[1..].split_at(dims);
@@ -109,7 +109,7 @@ impl Gmm {
                 d[i] = x[i] - mean[i];
             }
             // The term may fall below `best − NEGLIGIBLE` once 0.5 · maha exceeds this.
-            let cut = 2.0 * (c[0] - best + NEGLIGIBLE);
+            let cut = 2.0 * (c[0] - total.best + NEGLIGIBLE);
             let mut maha = 0.0;
             let mut row = 0;
             for i in 0..dims {
@@ -124,19 +124,9 @@ impl Gmm {
                     continue 'components;
                 }
             }
-            let t = c[0] - 0.5 * maha;
-            if t > best {
-                sum = sum * (best - t).exp() + 1.0;
-                best = t;
-            } else {
-                sum += (t - best).exp();
-            }
+            total.add(c[0] - 0.5 * maha);
         }
-        if best.is_finite() {
-            best + sum.ln()
-        } else {
-            best
-        }
+        total.value()
     }
 
     /// Each component's log term at `x`: ln(weight · N(x; μ, Σ)), in order (for the fit's E
@@ -167,20 +157,11 @@ impl Gmm {
     /// [`Gmm::log_density`] with every component summed (the slow reference).
     #[cfg(test)]
     pub(crate) fn log_density_full(&self, x: &[f64]) -> f64 {
-        let (mut best, mut sum) = (f64::NEG_INFINITY, 0.0);
+        let mut total = LogSumExp::default();
         for t in self.terms(x) {
-            if t > best {
-                sum = sum * (best - t).exp() + 1.0;
-                best = t;
-            } else {
-                sum += (t - best).exp();
-            }
+            total.add(t);
         }
-        if best.is_finite() {
-            best + sum.ln()
-        } else {
-            best
-        }
+        total.value()
     }
 
     /// The highest log density over the components' means (about the mixture's mode).
@@ -351,6 +332,43 @@ pub fn fit(
         };
         Gmm::new(dims, vec![standard])
     })
+}
+
+/// A running log-sum-exp: ln Σ exp(tᵢ) over the terms added, kept as the largest term and the
+/// sum of the others' exp relative to it (no overflow, and the same bits whatever adds it).
+#[derive(Debug, Clone, Copy)]
+struct LogSumExp {
+    best: f64,
+    sum: f64,
+}
+
+impl Default for LogSumExp {
+    fn default() -> Self {
+        LogSumExp {
+            best: f64::NEG_INFINITY,
+            sum: 0.0,
+        }
+    }
+}
+
+impl LogSumExp {
+    #[inline]
+    fn add(&mut self, t: f64) {
+        if t > self.best {
+            self.sum = self.sum * (self.best - t).exp() + 1.0;
+            self.best = t;
+        } else {
+            self.sum += (t - self.best).exp();
+        }
+    }
+
+    fn value(self) -> f64 {
+        if self.best.is_finite() {
+            self.best + self.sum.ln()
+        } else {
+            self.best
+        }
+    }
 }
 
 #[cfg(test)]
