@@ -151,132 +151,27 @@ impl Tracks2d {
         )?;
         let columns = joint_columns(path, &raw.joints)?;
         let src = raw.source;
-        if src.width == 0 || src.height == 0 || !(src.fps.is_finite() && src.fps > 0.0) {
-            return Err(FormatError::Invalid {
-                path: path.to_owned(),
-                problem: format!(
-                    "source has size {}×{} at {} fps; both sides and the frame rate must be positive",
-                    src.width, src.height, src.fps
-                ),
-            });
-        }
+        check_source(path, &src)?;
         let mut frames = Vec::with_capacity(raw.frames.len());
         let mut previous: Option<FrameIndex> = None;
         for f in raw.frames {
-            let n = raw.joints.len();
-            let off_frame = f.off_frame.unwrap_or_else(|| vec![false; n]);
-            let lost = f.lost.unwrap_or_else(|| vec![false; n]);
-            let gait = f.gait.unwrap_or_else(|| vec![false; n]);
-            for (field, found) in [
-                ("points", f.points.len()),
-                ("confidence", f.confidence.len()),
-                ("interpolated", f.interpolated.len()),
-                ("off_frame", off_frame.len()),
-                ("lost", lost.len()),
-                ("gait", gait.len()),
-                ("body3d", f.body3d.as_ref().map_or(n, Vec::len)),
-            ] {
-                if found != n {
-                    return Err(FormatError::WrongLength {
-                        path: path.to_owned(),
-                        frame: f.index,
-                        field,
-                        found,
-                        expected: n,
-                    });
-                }
-            }
+            let flags = FrameFlags::of(path, &f, raw.joints.len())?;
             check_frame_order(path, &mut previous, f.index)?;
-            let mut points = Vec::with_capacity(n);
+            let mut points = Vec::with_capacity(raw.joints.len());
             for joint in Joint::ALL {
-                let col = columns[joint.index()];
-                let [x, y] = f.points[col];
-                let confidence = f.confidence[col];
-                if !(x.is_finite() && y.is_finite() && confidence.is_finite()) {
-                    return Err(FormatError::NonFinite {
-                        path: path.to_owned(),
-                        joint,
-                        frame: Some(f.index),
-                    });
-                }
-                if !(0.0..=1.0).contains(&confidence) {
-                    return Err(FormatError::Invalid {
-                        path: path.to_owned(),
-                        problem: format!(
-                            "joint {joint} in frame {}: confidence {confidence} is outside [0, 1]",
-                            f.index
-                        ),
-                    });
-                }
-                let pos = Point2::new(x, y);
-                let inside = point_in_frame(&pos, src.width, src.height);
-                if !inside && !off_frame[col] {
-                    return Err(FormatError::OutsideFrame {
-                        path: path.to_owned(),
-                        joint,
-                        x,
-                        y,
-                        width: src.width,
-                        height: src.height,
-                        frame: Some(f.index),
-                    });
-                }
-                let problem = if off_frame[col] && inside {
-                    Some("is marked off_frame but lies on the frame")
-                } else if off_frame[col] && f.interpolated[col] {
-                    Some("is marked both off_frame and interpolated")
-                } else if off_frame[col] && confidence != 0.0 {
-                    Some("is marked off_frame with a confidence other than 0")
-                } else if lost[col] && (off_frame[col] || f.interpolated[col]) {
-                    Some("is marked lost and also off_frame or interpolated")
-                } else if gait[col] && (off_frame[col] || f.interpolated[col] || lost[col]) {
-                    Some("is marked gait and also off_frame, interpolated or lost")
-                } else {
-                    None
-                };
-                if let Some(problem) = problem {
-                    return Err(FormatError::Invalid {
-                        path: path.to_owned(),
-                        problem: format!(
-                            "joint {joint} in frame {} at ({x:.1}, {y:.1}) {problem}",
-                            f.index
-                        ),
-                    });
-                }
-                points.push(TrackedPoint {
-                    pos,
-                    confidence,
-                    source: if off_frame[col] {
-                        PointSource::OffFrame
-                    } else if lost[col] {
-                        PointSource::Lost
-                    } else if gait[col] || f.interpolated[col] {
-                        PointSource::Interpolated
-                    } else {
-                        PointSource::Tracked
-                    },
-                });
+                points.push(parse_point(
+                    path,
+                    &f,
+                    &flags,
+                    &src,
+                    joint,
+                    columns[joint.index()],
+                )?);
             }
-            let body3d = match &f.body3d {
-                Some(b) => {
-                    if b.iter().flatten().any(|v| !v.is_finite()) {
-                        return Err(FormatError::Invalid {
-                            path: path.to_owned(),
-                            problem: format!("frame {}: body3d holds a non-number", f.index),
-                        });
-                    }
-                    let at = |j: Joint| b[columns[j.index()]];
-                    Some(Box::new(NetworkBody {
-                        points: PerJoint::from_fn(|j| Vector3::new(at(j)[0], at(j)[1], at(j)[2])),
-                        confidence: PerJoint::from_fn(|j| at(j)[3].clamp(0.0, 1.0) as f32),
-                    }))
-                }
-                None => None,
-            };
             frames.push(FrameTracks {
                 index: f.index,
                 points: PerJoint::from_fn(|j| points[j.index()]),
-                body3d,
+                body3d: parse_body3d(path, &f, &columns)?,
             });
         }
         Ok(Tracks2d {
@@ -342,6 +237,161 @@ impl Tracks2d {
 fn flags(frame: &FrameTracks, source: PointSource) -> Option<Vec<bool>> {
     let flags: Vec<bool> = frame.points.0.iter().map(|p| p.source == source).collect();
     flags.contains(&true).then_some(flags)
+}
+
+/// Refuses a source with no size or no frame rate.
+fn check_source(path: &Path, src: &SourceInfo) -> Result<(), FormatError> {
+    if src.width == 0 || src.height == 0 || !(src.fps.is_finite() && src.fps > 0.0) {
+        return Err(FormatError::Invalid {
+            path: path.to_owned(),
+            problem: format!(
+                "source has size {}×{} at {} fps; both sides and the frame rate must be positive",
+                src.width, src.height, src.fps
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// A frame's per-joint flags, absent ones all false, every list checked to hold one entry per
+/// joint.
+struct FrameFlags {
+    off_frame: Vec<bool>,
+    lost: Vec<bool>,
+    gait: Vec<bool>,
+}
+
+impl FrameFlags {
+    fn of(path: &Path, f: &FrameFile, n: usize) -> Result<Self, FormatError> {
+        let or_none = |v: &Option<Vec<bool>>| v.clone().unwrap_or_else(|| vec![false; n]);
+        let flags = FrameFlags {
+            off_frame: or_none(&f.off_frame),
+            lost: or_none(&f.lost),
+            gait: or_none(&f.gait),
+        };
+        for (field, found) in [
+            ("points", f.points.len()),
+            ("confidence", f.confidence.len()),
+            ("interpolated", f.interpolated.len()),
+            ("off_frame", flags.off_frame.len()),
+            ("lost", flags.lost.len()),
+            ("gait", flags.gait.len()),
+            ("body3d", f.body3d.as_ref().map_or(n, Vec::len)),
+        ] {
+            if found != n {
+                return Err(FormatError::WrongLength {
+                    path: path.to_owned(),
+                    frame: f.index,
+                    field,
+                    found,
+                    expected: n,
+                });
+            }
+        }
+        Ok(flags)
+    }
+}
+
+/// One joint's point of a frame (the file's column `col`), checked: finite, its confidence in
+/// [0, 1], on the frame unless marked off it, and its flags consistent.
+fn parse_point(
+    path: &Path,
+    f: &FrameFile,
+    flags: &FrameFlags,
+    src: &SourceInfo,
+    joint: Joint,
+    col: usize,
+) -> Result<TrackedPoint, FormatError> {
+    let [x, y] = f.points[col];
+    let confidence = f.confidence[col];
+    if !(x.is_finite() && y.is_finite() && confidence.is_finite()) {
+        return Err(FormatError::NonFinite {
+            path: path.to_owned(),
+            joint,
+            frame: Some(f.index),
+        });
+    }
+    if !(0.0..=1.0).contains(&confidence) {
+        return Err(FormatError::Invalid {
+            path: path.to_owned(),
+            problem: format!(
+                "joint {joint} in frame {}: confidence {confidence} is outside [0, 1]",
+                f.index
+            ),
+        });
+    }
+    let pos = Point2::new(x, y);
+    let inside = point_in_frame(&pos, src.width, src.height);
+    let (off_frame, lost, gait) = (flags.off_frame[col], flags.lost[col], flags.gait[col]);
+    let interpolated = f.interpolated[col];
+    if !inside && !off_frame {
+        return Err(FormatError::OutsideFrame {
+            path: path.to_owned(),
+            joint,
+            x,
+            y,
+            width: src.width,
+            height: src.height,
+            frame: Some(f.index),
+        });
+    }
+    let problem = if off_frame && inside {
+        Some("is marked off_frame but lies on the frame")
+    } else if off_frame && interpolated {
+        Some("is marked both off_frame and interpolated")
+    } else if off_frame && confidence != 0.0 {
+        Some("is marked off_frame with a confidence other than 0")
+    } else if lost && (off_frame || interpolated) {
+        Some("is marked lost and also off_frame or interpolated")
+    } else if gait && (off_frame || interpolated || lost) {
+        Some("is marked gait and also off_frame, interpolated or lost")
+    } else {
+        None
+    };
+    if let Some(problem) = problem {
+        return Err(FormatError::Invalid {
+            path: path.to_owned(),
+            problem: format!(
+                "joint {joint} in frame {} at ({x:.1}, {y:.1}) {problem}",
+                f.index
+            ),
+        });
+    }
+    Ok(TrackedPoint {
+        pos,
+        confidence,
+        source: if off_frame {
+            PointSource::OffFrame
+        } else if lost {
+            PointSource::Lost
+        } else if gait || interpolated {
+            PointSource::Interpolated
+        } else {
+            PointSource::Tracked
+        },
+    })
+}
+
+/// The network's 3D body of a frame (version 4), when the file has one; a non-number refused.
+fn parse_body3d(
+    path: &Path,
+    f: &FrameFile,
+    columns: &[usize; crate::skeleton::JOINT_COUNT],
+) -> Result<Option<Box<NetworkBody>>, FormatError> {
+    let Some(b) = &f.body3d else {
+        return Ok(None);
+    };
+    if b.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(FormatError::Invalid {
+            path: path.to_owned(),
+            problem: format!("frame {}: body3d holds a non-number", f.index),
+        });
+    }
+    let at = |j: Joint| b[columns[j.index()]];
+    Ok(Some(Box::new(NetworkBody {
+        points: PerJoint::from_fn(|j| Vector3::new(at(j)[0], at(j)[1], at(j)[2])),
+        confidence: PerJoint::from_fn(|j| at(j)[3].clamp(0.0, 1.0) as f32),
+    })))
 }
 
 #[cfg(test)]

@@ -7,11 +7,17 @@
 //! out; a request for the frame right after the last one decoded just decodes on, with no seek.
 
 use super::{VideoError, VideoInfo, VideoSource, rotate_clockwise};
-use ff::packet::Ref as _;
 use ffmpeg_next as ff;
 use image::RgbImage;
 use std::path::{Path, PathBuf};
 use std::sync::Once;
+
+mod open;
+
+use open::{
+    display_rotation, frame_order, frame_rate, index_packets, longest_interval, open_decoder,
+    open_input,
+};
 
 static INIT: Once = Once::new();
 
@@ -69,29 +75,6 @@ fn not_a_video(path: &Path, e: impl std::fmt::Display) -> VideoError {
     }
 }
 
-/// Reads the display rotation (clockwise degrees, multiple of 90) from a stream's display matrix.
-fn display_rotation(stream: &ff::format::stream::Stream) -> u32 {
-    for side in stream.side_data() {
-        if side.kind() == ff::codec::packet::side_data::Type::DisplayMatrix
-            && side.data().len() >= 36
-        {
-            let mut m = [0i32; 9];
-            for (k, chunk) in side.data().chunks_exact(4).take(9).enumerate() {
-                m[k] = i32::from_ne_bytes([chunk[0], chunk[1], chunk[2], chunk[3]]);
-            }
-            // SAFETY: `m` holds the 9 entries av_display_rotation_get reads.
-            let ccw = unsafe { ff::ffi::av_display_rotation_get(m.as_ptr()) };
-            if !ccw.is_finite() {
-                return 0;
-            }
-            // As FFmpeg's own autorotate: the display matrix angle is counter-clockwise.
-            let cw = (-ccw).rem_euclid(360.0);
-            return ((cw / 90.0).round() as u32 % 4) * 90;
-        }
-    }
-    0
-}
-
 impl FfmpegSource {
     /// Opens a video file and indexes its frames, decoding on as many threads as the process
     /// may use.
@@ -110,19 +93,7 @@ impl FfmpegSource {
             path: path.to_owned(),
             source,
         })?;
-        let mut input = ff::format::input(path).map_err(|e| {
-            let mp4 = path.extension().and_then(|e| e.to_str()).is_some_and(|e| {
-                ["mp4", "mov", "m4v"].contains(&e.to_ascii_lowercase().as_str())
-            });
-            if mp4 && e == ff::Error::InvalidData {
-                not_a_video(
-                    path,
-                    format!("{e}; an MP4/MOV recording cut short, before its index was written, reads like this"),
-                )
-            } else {
-                not_a_video(path, e)
-            }
-        })?;
+        let mut input = open_input(path)?;
         let stream = input
             .streams()
             .best(ff::media::Type::Video)
@@ -134,69 +105,19 @@ impl FfmpegSource {
         let time_base = f64::from(tb.numerator()) / f64::from(tb.denominator().max(1));
         let rotation_deg = display_rotation(&stream);
         let avg_rate = stream.avg_frame_rate();
-        let mut ctx = ff::codec::Context::from_parameters(stream.parameters())
-            .map_err(|e| not_a_video(path, e))?;
-        ctx.set_threading(ff::codec::threading::Config {
-            kind: ff::codec::threading::Type::Frame,
-            count: threads
-                .unwrap_or_else(|| std::thread::available_parallelism().map_or(2, |n| n.get()))
-                .max(1),
-            ..Default::default()
-        });
-        let decoder = ctx.decoder().video().map_err(|e| not_a_video(path, e))?;
+        let decoder = open_decoder(path, stream.parameters(), threads)?;
         let codec = decoder
             .codec()
             .map_or_else(|| "unknown".to_owned(), |c| c.name().to_owned());
         let (coded_w, coded_h) = (decoder.width(), decoder.height());
-
-        // Index: every packet of the stream, in file order.
-        let mut packets: Vec<(i64, bool)> = Vec::new();
-        let mut ordinal = 0i64;
-        for (s, packet) in input.packets() {
-            if s.index() != stream_index {
-                continue;
-            }
-            // SAFETY: reading the flags field of a valid packet.
-            let discard = unsafe { (*packet.as_ptr()).flags } & ff::ffi::AV_PKT_FLAG_DISCARD != 0;
-            if discard || packet.is_corrupt() {
-                continue;
-            }
-            let ts = packet.pts().or(packet.dts()).unwrap_or(ordinal);
-            packets.push((ts, packet.is_key()));
-            ordinal += 1;
-        }
+        let packets = index_packets(&mut input, stream_index);
         if packets.is_empty() || coded_w == 0 || coded_h == 0 {
             return Err(VideoError::NoFrames {
                 path: path.to_owned(),
             });
         }
-        let mut pts: Vec<i64> = packets.iter().map(|p| p.0).collect();
-        pts.sort_unstable();
-        pts.dedup();
-        let mut keyframes: Vec<usize> = packets
-            .iter()
-            .filter(|p| p.1)
-            .filter_map(|p| pts.binary_search(&p.0).ok())
-            .collect();
-        keyframes.sort_unstable();
-        keyframes.dedup();
-        if keyframes.first() != Some(&0) {
-            keyframes.insert(0, 0);
-        }
-
-        let frame_count = pts.len();
-        let span = (pts[frame_count - 1] - pts[0]) as f64 * time_base;
-        let variable_frame_rate = is_variable(&pts);
-        // Constant rate: the median frame interval (exact, whatever the container's average
-        // says); variable rate: frames over span; a single frame: the container's average.
-        let fps = match median_interval(&pts) {
-            Some(d) if !variable_frame_rate => 1.0 / (d as f64 * time_base),
-            _ if span > 0.0 => (frame_count - 1) as f64 / span,
-            _ if avg_rate.numerator() > 0 && avg_rate.denominator() > 0 => {
-                f64::from(avg_rate.numerator()) / f64::from(avg_rate.denominator())
-            }
-            _ => DEFAULT_FPS_WHEN_UNKNOWN,
-        };
+        let (pts, keyframes) = frame_order(&packets);
+        let (fps, span, variable_frame_rate) = frame_rate(&pts, time_base, avg_rate);
         let (width, height) = if rotation_deg % 180 == 90 {
             (coded_h, coded_w)
         } else {
@@ -207,12 +128,12 @@ impl FfmpegSource {
             width,
             height,
             fps,
-            frame_count,
+            frame_count: pts.len(),
             duration_s: span + 1.0 / fps,
             rotation_deg,
             codec,
             variable_frame_rate,
-            keyframe_interval: longest_interval(&keyframes, frame_count),
+            keyframe_interval: longest_interval(&keyframes, pts.len()),
         };
         // Back to the start for decoding.
         input.seek(i64::MIN + 1, ..).ok();
@@ -479,35 +400,6 @@ impl Converter {
             None => self.to_rgb.run(frame, rgb),
         }
     }
-}
-
-/// The longest run of frames from a keyframe to the next one, or to the end.
-fn longest_interval(keyframes: &[usize], frame_count: usize) -> usize {
-    keyframes
-        .iter()
-        .zip(keyframes.iter().skip(1).chain([&frame_count]))
-        .map(|(a, b)| b.saturating_sub(*a))
-        .max()
-        .unwrap_or(frame_count)
-}
-
-/// Frame rate reported when the file gives none and has a single frame.
-const DEFAULT_FPS_WHEN_UNKNOWN: f64 = 30.0;
-
-/// Median interval between consecutive timestamps, if there are at least two.
-fn median_interval(pts: &[i64]) -> Option<i64> {
-    let mut d: Vec<i64> = pts.windows(2).map(|w| w[1] - w[0]).collect();
-    d.sort_unstable();
-    d.get(d.len() / 2).copied().filter(|&m| m > 0)
-}
-
-/// Whether frame intervals differ from the median by more than 10% of it (variable frame rate).
-fn is_variable(pts: &[i64]) -> bool {
-    let Some(median) = median_interval(pts) else {
-        return false;
-    };
-    pts.windows(2)
-        .any(|w| ((w[1] - w[0]) - median).abs() as f64 > 0.1 * median as f64)
 }
 
 // SAFETY: every FFmpeg object in `FfmpegSource` (demuxer, decoder, scaler) is owned by it alone
