@@ -230,20 +230,75 @@ pub fn fit(
     floor: f64,
 ) -> Result<Gmm, String> {
     let n = data.len();
-    let mut state: u64 = 0x9e37_79b9_7f4a_7c15;
-    let mut next = || {
-        state = state
+    let means = kmeans_pp_seeds(data, k, &mut Lcg(0x9e37_79b9_7f4a_7c15));
+    let spread = data.iter().map(|x| dist(x, &means[0])).sum::<f64>() / (n * dims) as f64;
+    let mut components: Vec<Component> = means
+        .into_iter()
+        .map(|mean| Component {
+            weight: 1.0 / k as f64,
+            mean,
+            cov_chol: scaled_identity(dims, spread.max(floor).sqrt()),
+        })
+        .collect();
+    let mut resp = vec![0.0; n * k];
+    for _ in 0..iterations {
+        let Ok(gmm) = Gmm::new(dims, components.clone()) else {
+            break;
+        };
+        e_step(&gmm, data, &mut resp);
+        for (j, c) in components.iter_mut().enumerate() {
+            m_step(c, data, &resp, j, k, floor);
+        }
+        let total: f64 = components.iter().map(|c| c.weight).sum();
+        components.iter_mut().for_each(|c| c.weight /= total);
+    }
+    components.retain(|c| c.weight > 1e-9);
+    let total: f64 = components.iter().map(|c| c.weight).sum();
+    components.iter_mut().for_each(|c| c.weight /= total);
+    Gmm::new(dims, components).or_else(|_| {
+        let standard = Component {
+            weight: 1.0,
+            mean: vec![0.0; dims],
+            cov_chol: scaled_identity(dims, 1.0),
+        };
+        Gmm::new(dims, vec![standard])
+    })
+}
+
+/// The fixed linear congruential sequence the seeds are drawn by, uniform in [0, 1).
+struct Lcg(u64);
+
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
             .wrapping_mul(6_364_136_223_846_793_005)
             .wrapping_add(1_442_695_040_888_963_407);
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let dist = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>();
-    // k-means++ seeds.
-    let mut means: Vec<Vec<f64>> = vec![data[(next() * n as f64) as usize % n].clone()];
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// Squared distance.
+fn dist(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>()
+}
+
+/// A `dims` × `dims` matrix (row-major) with `s` on its diagonal.
+fn scaled_identity(dims: usize, s: f64) -> Vec<f64> {
+    (0..dims * dims)
+        .map(|i| if i % (dims + 1) == 0 { s } else { 0.0 })
+        .collect()
+}
+
+/// `k` k-means++ seeds: the first drawn uniformly, each next with probability proportional to
+/// its squared distance from the nearest seed so far.
+fn kmeans_pp_seeds(data: &[Vec<f64>], k: usize, rng: &mut Lcg) -> Vec<Vec<f64>> {
+    let n = data.len();
+    let mut means: Vec<Vec<f64>> = vec![data[(rng.next() * n as f64) as usize % n].clone()];
     let mut nearest: Vec<f64> = data.iter().map(|x| dist(x, &means[0])).collect();
     while means.len() < k {
         let total: f64 = nearest.iter().sum();
-        let mut pick = next() * total;
+        let mut pick = rng.next() * total;
         let mut chosen = n - 1;
         for (i, d) in nearest.iter().enumerate() {
             pick -= d;
@@ -257,81 +312,57 @@ pub fn fit(
             *d = d.min(dist(x, &data[chosen]));
         }
     }
-    let spread = data.iter().map(|x| dist(x, &means[0])).sum::<f64>() / (n * dims) as f64;
-    let identity = |s: f64| -> Vec<f64> {
-        (0..dims * dims)
-            .map(|i| if i % (dims + 1) == 0 { s } else { 0.0 })
-            .collect()
-    };
-    let mut components: Vec<Component> = means
-        .into_iter()
-        .map(|mean| Component {
-            weight: 1.0 / k as f64,
-            mean,
-            cov_chol: identity(spread.max(floor).sqrt()),
-        })
-        .collect();
-    let mut resp = vec![0.0; n * k];
-    for _ in 0..iterations {
-        let Ok(gmm) = Gmm::new(dims, components.clone()) else {
-            break;
-        };
-        // E step.
-        for (i, x) in data.iter().enumerate() {
-            let logs: Vec<f64> = gmm.terms(x).collect();
-            let best = logs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            let sum: f64 = logs.iter().map(|l| (l - best).exp()).sum();
-            for (j, l) in logs.iter().enumerate() {
-                resp[i * k + j] = (l - best).exp() / sum;
-            }
+    means
+}
+
+/// Expectation: each point's responsibilities (`resp[i * k + j]`, `k` the mixture's size).
+fn e_step(gmm: &Gmm, data: &[Vec<f64>], resp: &mut [f64]) {
+    let k = resp.len() / data.len().max(1);
+    for (i, x) in data.iter().enumerate() {
+        let logs: Vec<f64> = gmm.terms(x).collect();
+        let best = logs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let sum: f64 = logs.iter().map(|l| (l - best).exp()).sum();
+        for (j, l) in logs.iter().enumerate() {
+            resp[i * k + j] = (l - best).exp() / sum;
         }
-        // M step.
-        for (j, c) in components.iter_mut().enumerate() {
-            let weight: f64 = (0..n).map(|i| resp[i * k + j]).sum();
-            if weight < 1e-6 {
-                continue;
-            }
-            let mut mean = vec![0.0; dims];
-            for (i, x) in data.iter().enumerate() {
-                for (m, v) in mean.iter_mut().zip(x) {
-                    *m += resp[i * k + j] * v;
-                }
-            }
-            mean.iter_mut().for_each(|m| *m /= weight);
-            let mut cov = identity(floor);
-            for (i, x) in data.iter().enumerate() {
-                let r = resp[i * k + j] / weight;
-                for a in 0..dims {
-                    for b in 0..=a {
-                        cov[a * dims + b] += r * (x[a] - mean[a]) * (x[b] - mean[b]);
-                    }
-                }
-            }
-            for a in 0..dims {
-                for b in 0..a {
-                    cov[b * dims + a] = cov[a * dims + b];
-                }
-            }
-            if let Some(l) = cholesky(&cov, dims) {
-                c.weight = weight / n as f64;
-                c.mean = mean;
-                c.cov_chol = l;
-            }
-        }
-        let total: f64 = components.iter().map(|c| c.weight).sum();
-        components.iter_mut().for_each(|c| c.weight /= total);
     }
-    components.retain(|c| c.weight > 1e-9);
-    let total: f64 = components.iter().map(|c| c.weight).sum();
-    components.iter_mut().for_each(|c| c.weight /= total);
-    Gmm::new(dims, components).or_else(|_| {
-        let standard = Component {
-            weight: 1.0,
-            mean: vec![0.0; dims],
-            cov_chol: identity(1.0),
-        };
-        Gmm::new(dims, vec![standard])
-    })
+}
+
+/// Maximisation for component `j` of `k`: its weight, mean and covariance (plus `floor` on the
+/// diagonal) from the responsibilities; left as it was when it holds no weight or its
+/// covariance has no Cholesky factor.
+fn m_step(c: &mut Component, data: &[Vec<f64>], resp: &[f64], j: usize, k: usize, floor: f64) {
+    let (n, dims) = (data.len(), c.mean.len());
+    let weight: f64 = (0..n).map(|i| resp[i * k + j]).sum();
+    if weight < 1e-6 {
+        return;
+    }
+    let mut mean = vec![0.0; dims];
+    for (i, x) in data.iter().enumerate() {
+        for (m, v) in mean.iter_mut().zip(x) {
+            *m += resp[i * k + j] * v;
+        }
+    }
+    mean.iter_mut().for_each(|m| *m /= weight);
+    let mut cov = scaled_identity(dims, floor);
+    for (i, x) in data.iter().enumerate() {
+        let r = resp[i * k + j] / weight;
+        for a in 0..dims {
+            for b in 0..=a {
+                cov[a * dims + b] += r * (x[a] - mean[a]) * (x[b] - mean[b]);
+            }
+        }
+    }
+    for a in 0..dims {
+        for b in 0..a {
+            cov[b * dims + a] = cov[a * dims + b];
+        }
+    }
+    if let Some(l) = cholesky(&cov, dims) {
+        c.weight = weight / n as f64;
+        c.mean = mean;
+        c.cov_chol = l;
+    }
 }
 
 /// A running log-sum-exp: ln Σ exp(tᵢ) over the terms added, kept as the largest term and the
