@@ -74,6 +74,19 @@ pub enum Command {
     /// parameter file (`assets/pose_prior/pose_prior.json`), listing the takes it used; the
     /// suite's test takes are refused.
     Prior(PriorArgs),
+    /// Write the README's benchmark figures from the outputs committed under `docs/bench/`
+    /// (`figures.json` names each), or with `--check` fail when the README differs from them.
+    Report {
+        /// The README to write or check.
+        #[arg(long, default_value = "README.md")]
+        readme: PathBuf,
+        /// The figures file beside the committed outputs.
+        #[arg(long, default_value = "docs/bench/figures.json")]
+        figures: PathBuf,
+        /// Only compare: exit non-zero naming each figure that differs.
+        #[arg(long)]
+        check: bool,
+    },
     /// Save a project and write its exports over and over until killed; the crash-safety test
     /// kills it at random moments and checks every file left behind.
     StressWrite(StressWriteArgs),

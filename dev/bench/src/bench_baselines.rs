@@ -225,6 +225,23 @@ pub fn opencv(
     Ok(Some(tally))
 }
 
+/// OpenCV's table: its heading line (naming what is scored) and the per-family rows, or the line
+/// that says how to install it.
+pub fn opencv_lines(tally: Option<&Tally<[Accuracy; 2]>>) -> Vec<String> {
+    let Some(t) = tally else {
+        return vec!["(OpenCV baselines: python3 with cv2 not found; `python3 -m pip install opencv-contrib-python-headless numpy` adds them)".to_owned()];
+    };
+    let mut lines = vec![
+        "OpenCV from the same clicked marks, all 16 joints: Lucas–Kanade (PCK@0.2, lost), CSRT (PCK@0.2, lost; test split and real clips only)".to_owned(),
+    ];
+    lines.extend(Tally::<[Accuracy; 2]>::heading(
+        OPENCV_WIDTH,
+        OPENCV_COLUMNS,
+    ));
+    lines.extend(t.lines(OPENCV_WIDTH, opencv_cell));
+    lines
+}
+
 /// The learned comparison per split and family, and per clip (name, scores).
 pub type LearnedScores = (Tally<Learned>, Vec<(String, Learned)>);
 

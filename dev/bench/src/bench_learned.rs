@@ -249,6 +249,16 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         }
     ));
     lines.extend(views.lines());
+    let clicked = clips
+        .iter()
+        .map(|clip| {
+            let marks = Marks::load(&clip.dir.join("marks.json")).map_err(ExitError::failed)?;
+            Ok(clicked_marks(&marks, CLICK_NOISE_PX, &clip.name))
+        })
+        .collect::<Result<Vec<_>, ExitError>>()?;
+    let opencv = crate::bench_baselines::opencv(&clips, &clicked, &a.suite_dir, global)?;
+    lines.push(String::new());
+    lines.extend(crate::bench_baselines::opencv_lines(opencv.as_ref()));
     if settings.len() > 1 {
         lines.push(String::new());
         lines.push("together, each setting swept (13 limb joints, PCK@0.2 / lost)".to_owned());

@@ -265,22 +265,8 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         ));
     }
     let opencv = crate::bench_baselines::opencv(&clips, &clicked, &a.suite_dir, global)?;
-    if let Some(t) = &opencv {
-        lines.push(String::new());
-        lines.push(
-            "OpenCV from the same clicked marks: Lucas–Kanade (PCK@0.2, lost), CSRT (PCK@0.2, lost; test split and real clips only)".to_owned(),
-        );
-        lines.extend(Tally::<[Accuracy; 2]>::heading(
-            crate::bench_baselines::OPENCV_WIDTH,
-            crate::bench_baselines::OPENCV_COLUMNS,
-        ));
-        lines.extend(t.lines(
-            crate::bench_baselines::OPENCV_WIDTH,
-            crate::bench_baselines::opencv_cell,
-        ));
-    } else {
-        lines.push("(OpenCV baselines: python3 with cv2 not found; `python3 -m pip install opencv-contrib-python-headless numpy` adds them)".to_owned());
-    }
+    lines.push(String::new());
+    lines.extend(crate::bench_baselines::opencv_lines(opencv.as_ref()));
     let mediapipe = crate::bench_baselines::mediapipe(&clips, &vba_limbs, &a.suite_dir, global)?;
     let mut views = crate::bench_views::ViewTable::new(&["VBA", "MediaPipe"]);
     if let Some((_, mp)) = &mediapipe {

@@ -16,6 +16,7 @@ mod bench_track;
 mod bench_views;
 mod bench_volume;
 mod prior;
+mod report;
 mod score;
 mod stress_write;
 mod synth;
@@ -25,9 +26,30 @@ use clap::Parser;
 use std::process::ExitCode;
 use videomocap::cli::{ExitError, message_with_causes, progress_bar, say};
 
+/// Whether the command is a benchmark (its output may be committed for `report`).
+fn is_benchmark(command: &Command) -> bool {
+    matches!(
+        command,
+        Command::Track(_)
+            | Command::Correct(_)
+            | Command::Lift(_)
+            | Command::Volume(_)
+            | Command::Motion(_)
+            | Command::Scrub(_)
+            | Command::Learned(_)
+            | Command::Speed { .. }
+    )
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let global = &cli.global;
+    if is_benchmark(&cli.command) && !global.json {
+        // The first line of a benchmark's output names it, so an output committed under
+        // docs/bench/ says what made it (`report` reads those files).
+        let args: Vec<String> = std::env::args().skip(1).collect();
+        println!("# videomocap-bench {}\n", args.join(" "));
+    }
     let result = match &cli.command {
         Command::Track(a) => bench::run("track", a, global),
         Command::Correct(a) => bench::run("correct", a, global),
@@ -40,6 +62,17 @@ fn main() -> ExitCode {
         Command::Synth(a) => synth::run(a, global),
         Command::Score { tracks, reference } => score::run(tracks, reference, global),
         Command::Prior(a) => prior::run(a, global),
+        Command::Report {
+            readme,
+            figures,
+            check,
+        } => report::run(
+            &report::ReportPaths {
+                readme: readme.clone(),
+                figures: figures.clone(),
+            },
+            *check,
+        ),
         Command::StressWrite(a) => stress_write::run(a),
     };
     match result {
