@@ -116,74 +116,17 @@ impl Skeleton3d {
         check_header(path, SKELETON3D_FORMAT, raw.format.as_deref(), raw.version)?;
         let columns = joint_columns(path, &raw.joints)?;
         let cam = raw.camera;
-        let camera_ok = cam.focal_px.is_finite()
-            && cam.focal_px > 0.0
-            && cam.cx.is_finite()
-            && cam.cy.is_finite();
-        if !camera_ok {
-            return Err(FormatError::Invalid {
-                path: path.to_owned(),
-                problem: format!(
-                    "camera focal_px must be positive and finite and cx, cy finite (got {}, {}, {})",
-                    cam.focal_px, cam.cx, cam.cy
-                ),
-            });
-        }
-        if let Some(fps) = raw.fps
-            && !(fps.is_finite() && fps > 0.0)
-        {
-            return Err(FormatError::Invalid {
-                path: path.to_owned(),
-                problem: format!("fps must be positive and finite (got {fps})"),
-            });
-        }
-        for (key, &len) in &raw.bone_lengths_m {
-            if Bone::from_key(key).is_none() {
-                return Err(FormatError::Invalid {
-                    path: path.to_owned(),
-                    problem: format!("unknown bone \"{key}\" in bone_lengths_m"),
-                });
-            }
-            if !(len.is_finite() && len > 0.0) {
-                return Err(FormatError::Invalid {
-                    path: path.to_owned(),
-                    problem: format!("bone \"{key}\" has length {len}; it must be positive"),
-                });
-            }
-        }
+        check_header_values(path, &cam, raw.fps, &raw.bone_lengths_m)?;
         let mut frames = Vec::with_capacity(raw.frames.len());
         let mut previous: Option<FrameIndex> = None;
         for f in raw.frames {
-            if f.points.len() != raw.joints.len() {
-                return Err(FormatError::WrongLength {
-                    path: path.to_owned(),
-                    frame: f.index,
-                    field: "points",
-                    found: f.points.len(),
-                    expected: raw.joints.len(),
-                });
-            }
-            check_frame_order(path, &mut previous, f.index)?;
-            for joint in Joint::ALL {
-                if !f.points[columns[joint.index()]]
-                    .iter()
-                    .all(|v| v.is_finite())
-                {
-                    return Err(FormatError::NonFinite {
-                        path: path.to_owned(),
-                        joint,
-                        frame: Some(f.index),
-                    });
-                }
-            }
-            frames.push(Frame3d {
-                index: f.index,
-                points: PerJoint::from_fn(|j| {
-                    let [x, y, z] = f.points[columns[j.index()]];
-                    Point3::new(x, y, z)
-                }),
-                flags: f.flags,
-            });
+            frames.push(parse_frame(
+                path,
+                f,
+                &columns,
+                raw.joints.len(),
+                &mut previous,
+            )?);
         }
         Ok(Skeleton3d {
             camera: cam,
@@ -228,6 +171,91 @@ impl Skeleton3d {
                 .collect(),
         }
     }
+}
+
+/// Refuses a camera without a positive finite focal length or a finite centre, a frame rate
+/// that is not positive, an unknown bone or a length that is not positive.
+fn check_header_values(
+    path: &Path,
+    cam: &PinholeCamera,
+    fps: Option<f64>,
+    bone_lengths_m: &BTreeMap<String, f64>,
+) -> Result<(), FormatError> {
+    let camera_ok =
+        cam.focal_px.is_finite() && cam.focal_px > 0.0 && cam.cx.is_finite() && cam.cy.is_finite();
+    if !camera_ok {
+        return Err(FormatError::Invalid {
+            path: path.to_owned(),
+            problem: format!(
+                "camera focal_px must be positive and finite and cx, cy finite (got {}, {}, {})",
+                cam.focal_px, cam.cx, cam.cy
+            ),
+        });
+    }
+    if let Some(fps) = fps
+        && !(fps.is_finite() && fps > 0.0)
+    {
+        return Err(FormatError::Invalid {
+            path: path.to_owned(),
+            problem: format!("fps must be positive and finite (got {fps})"),
+        });
+    }
+    for (key, &len) in bone_lengths_m {
+        if Bone::from_key(key).is_none() {
+            return Err(FormatError::Invalid {
+                path: path.to_owned(),
+                problem: format!("unknown bone \"{key}\" in bone_lengths_m"),
+            });
+        }
+        if !(len.is_finite() && len > 0.0) {
+            return Err(FormatError::Invalid {
+                path: path.to_owned(),
+                problem: format!("bone \"{key}\" has length {len}; it must be positive"),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// One frame of the file (`n` joints in the file's `columns`), after `previous`, every point
+/// finite.
+fn parse_frame(
+    path: &Path,
+    f: FrameFile,
+    columns: &[usize; crate::skeleton::JOINT_COUNT],
+    n: usize,
+    previous: &mut Option<FrameIndex>,
+) -> Result<Frame3d, FormatError> {
+    if f.points.len() != n {
+        return Err(FormatError::WrongLength {
+            path: path.to_owned(),
+            frame: f.index,
+            field: "points",
+            found: f.points.len(),
+            expected: n,
+        });
+    }
+    check_frame_order(path, previous, f.index)?;
+    for joint in Joint::ALL {
+        if !f.points[columns[joint.index()]]
+            .iter()
+            .all(|v| v.is_finite())
+        {
+            return Err(FormatError::NonFinite {
+                path: path.to_owned(),
+                joint,
+                frame: Some(f.index),
+            });
+        }
+    }
+    Ok(Frame3d {
+        index: f.index,
+        points: PerJoint::from_fn(|j| {
+            let [x, y, z] = f.points[columns[j.index()]];
+            Point3::new(x, y, z)
+        }),
+        flags: f.flags,
+    })
 }
 
 #[cfg(test)]

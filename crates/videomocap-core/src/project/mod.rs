@@ -98,73 +98,10 @@ impl Project {
     /// Parses project JSON; `path` names the file in errors.
     pub fn parse(text: &str, path: &Path) -> Result<Project, FormatError> {
         let raw: ProjectFile = parse_json(text, path)?;
-        let invalid = |problem: String| FormatError::Invalid {
-            path: path.to_owned(),
-            problem,
-        };
-        if raw.format != PROJECT_FORMAT {
-            return Err(FormatError::WrongFormat {
-                path: path.to_owned(),
-                found: raw.format,
-                expected: PROJECT_FORMAT,
-            });
-        }
-        if raw.version != FORMAT_VERSION {
-            return Err(FormatError::UnsupportedVersion {
-                path: path.to_owned(),
-                version: raw.version,
-                supported: FORMAT_VERSION,
-            });
-        }
+        check_header(path, &raw)?;
         let keys = KeyFrames::from_entries(raw.keys, path)?;
-        let mut overrides = DepthOverrides::default();
-        for o in raw.depth_overrides {
-            let bone = Bone::from_key(&o.bone).ok_or_else(|| {
-                invalid(format!("unknown bone \"{}\" in depth_overrides", o.bone))
-            })?;
-            let root = match o.root.as_str() {
-                "near" => Root::Near,
-                "far" => Root::Far,
-                other => {
-                    return Err(invalid(format!(
-                        "depth override root must be \"near\" or \"far\", not \"{other}\""
-                    )));
-                }
-            };
-            overrides.insert((o.frame, bone), root);
-        }
-        let height = raw.settings.height_m;
-        if !(height.is_finite() && (0.5..=2.8).contains(&height)) {
-            return Err(invalid(format!(
-                "settings.height_m must be between 0.5 and 2.8 m (got {height})"
-            )));
-        }
-        let mut tape = raw.settings.lengths;
-        for (name, value) in tape.fields_mut() {
-            if let Some(v) = *value
-                && !(v.is_finite() && (LENGTH_RANGE_M.0..=LENGTH_RANGE_M.1).contains(&v))
-            {
-                return Err(invalid(format!(
-                    "settings.lengths: the {name} must be between {} and {} m (got {v})",
-                    LENGTH_RANGE_M.0, LENGTH_RANGE_M.1
-                )));
-            }
-        }
-        if let Some(f) = raw.settings.focal_px
-            && !(f.is_finite() && f > 0.0)
-        {
-            return Err(invalid(format!(
-                "settings.focal_px must be positive (got {f})"
-            )));
-        }
-        raw.settings
-            .tracker
-            .validate()
-            .map_err(|e| invalid(format!("settings.tracker: {e}")))?;
-        raw.settings
-            .lift
-            .validate()
-            .map_err(|e| invalid(format!("settings.lift: {e}")))?;
+        let overrides = parse_overrides(path, raw.depth_overrides)?;
+        check_settings(path, &raw.settings)?;
         let tracks = raw
             .tracks
             .map(|v| Tracks2d::from_json_value(v, path).map(Arc::new))
@@ -243,6 +180,101 @@ struct OverrideFile {
     frame: FrameIndex,
     bone: String,
     root: String,
+}
+
+/// Refuses another format or version.
+fn check_header(path: &Path, raw: &ProjectFile) -> Result<(), FormatError> {
+    if raw.format != PROJECT_FORMAT {
+        return Err(FormatError::WrongFormat {
+            path: path.to_owned(),
+            found: raw.format.clone(),
+            expected: PROJECT_FORMAT,
+        });
+    }
+    if raw.version != FORMAT_VERSION {
+        return Err(FormatError::UnsupportedVersion {
+            path: path.to_owned(),
+            version: raw.version,
+            supported: FORMAT_VERSION,
+        });
+    }
+    Ok(())
+}
+
+/// A problem with the project file's contents.
+fn invalid(path: &Path, problem: String) -> FormatError {
+    FormatError::Invalid {
+        path: path.to_owned(),
+        problem,
+    }
+}
+
+/// The "flip this limb" choices, each a known bone and `near` or `far`.
+fn parse_overrides(path: &Path, entries: Vec<OverrideFile>) -> Result<DepthOverrides, FormatError> {
+    let mut overrides = DepthOverrides::default();
+    for o in entries {
+        let bone = Bone::from_key(&o.bone).ok_or_else(|| {
+            invalid(
+                path,
+                format!("unknown bone \"{}\" in depth_overrides", o.bone),
+            )
+        })?;
+        let root = match o.root.as_str() {
+            "near" => Root::Near,
+            "far" => Root::Far,
+            other => {
+                return Err(invalid(
+                    path,
+                    format!("depth override root must be \"near\" or \"far\", not \"{other}\""),
+                ));
+            }
+        };
+        overrides.insert((o.frame, bone), root);
+    }
+    Ok(overrides)
+}
+
+/// Refuses a height, a known length or a focal length out of range, and tracker or lift
+/// settings their own checks refuse.
+fn check_settings(path: &Path, settings: &Settings) -> Result<(), FormatError> {
+    let height = settings.height_m;
+    if !(height.is_finite() && (0.5..=2.8).contains(&height)) {
+        return Err(invalid(
+            path,
+            format!("settings.height_m must be between 0.5 and 2.8 m (got {height})"),
+        ));
+    }
+    let mut tape = settings.lengths;
+    for (name, value) in tape.fields_mut() {
+        if let Some(v) = *value
+            && !(v.is_finite() && (LENGTH_RANGE_M.0..=LENGTH_RANGE_M.1).contains(&v))
+        {
+            return Err(invalid(
+                path,
+                format!(
+                    "settings.lengths: the {name} must be between {} and {} m (got {v})",
+                    LENGTH_RANGE_M.0, LENGTH_RANGE_M.1
+                ),
+            ));
+        }
+    }
+    if let Some(f) = settings.focal_px
+        && !(f.is_finite() && f > 0.0)
+    {
+        return Err(invalid(
+            path,
+            format!("settings.focal_px must be positive (got {f})"),
+        ));
+    }
+    settings
+        .tracker
+        .validate()
+        .map_err(|e| invalid(path, format!("settings.tracker: {e}")))?;
+    settings
+        .lift
+        .validate()
+        .map_err(|e| invalid(path, format!("settings.lift: {e}")))?;
+    Ok(())
 }
 
 #[cfg(test)]
