@@ -11,7 +11,7 @@ use videomocap_volume::cloud::{CloudKind, parse_cloud};
 
 /// The fuzz targets, by name (also the folder names under `seeds/` and `regressions/`).
 #[allow(dead_code)]
-pub const TARGETS: [&str; 8] = [
+pub(crate) const TARGETS: [&str; 8] = [
     "marks",
     "tracks2d",
     "skeleton3d",
@@ -24,7 +24,7 @@ pub const TARGETS: [&str; 8] = [
 
 /// Feeds `data` to the parser of `target`; panics when an invariant breaks. Returns whether
 /// the input parsed.
-pub fn check(target: &str, data: &[u8]) -> bool {
+pub(crate) fn check(target: &str, data: &[u8]) -> bool {
     let path = Path::new("fuzz-input");
     let cloud = |kind| match parse_cloud(kind, data, path) {
         Ok(points) => {

@@ -18,7 +18,7 @@ use std::path::PathBuf;
 const STRIPS_MAY_TAKE: f32 = 0.1;
 
 /// The desktop app.
-pub struct App {
+pub(crate) struct App {
     state: State,
     frame_view: FrameView,
     orbit: Orbit,
@@ -46,12 +46,12 @@ pub struct App {
 impl App {
     /// A window with the desktop's dialogs and autosave, opening `path` (a video, an image
     /// folder or a project) if given.
-    pub fn new(ctx: &egui::Context, path: Option<PathBuf>) -> App {
+    pub(crate) fn new(ctx: &egui::Context, path: Option<PathBuf>) -> App {
         App::with_config(ctx, path, Config::default())
     }
 
     /// A window with the given dialogs and autosave directory.
-    pub fn with_config(ctx: &egui::Context, path: Option<PathBuf>, config: Config) -> App {
+    pub(crate) fn with_config(ctx: &egui::Context, path: Option<PathBuf>, config: Config) -> App {
         let mut state = State::new(ctx, config);
         if let Some(p) = path {
             state.apply(Intent::Open(p));
@@ -76,19 +76,19 @@ impl App {
 
     /// The layout kept across restarts (tests).
     #[cfg(test)]
-    pub fn layout(&self) -> &Layout {
+    pub(crate) fn layout(&self) -> &Layout {
         &self.layout
     }
 
     /// Where the 3D view's panel was drawn last.
     #[cfg(test)]
-    pub fn view3d_rect(&self) -> egui::Rect {
+    pub(crate) fn view3d_rect(&self) -> egui::Rect {
         self.view3d_rect
     }
 
     /// Where the 3D view drew its scene last.
     #[cfg(test)]
-    pub fn view3d_canvas(&self) -> egui::Rect {
+    pub(crate) fn view3d_canvas(&self) -> egui::Rect {
         self.view3d_canvas
     }
 
@@ -153,37 +153,37 @@ impl App {
 
     /// Whether the timeline showed a strip per joint last (tests).
     #[cfg(test)]
-    pub fn timeline_unfolded(&self) -> bool {
+    pub(crate) fn timeline_unfolded(&self) -> bool {
         self.central.1
     }
 
     /// Where the frame view's panel was drawn last (tests).
     #[cfg(test)]
-    pub fn central_rect(&self) -> egui::Rect {
+    pub(crate) fn central_rect(&self) -> egui::Rect {
         self.central.0
     }
 
     /// The app's state (tests read it).
     #[cfg(test)]
-    pub fn state(&self) -> &State {
+    pub(crate) fn state(&self) -> &State {
         &self.state
     }
 
     /// The app's state, to act on it directly (tests).
     #[cfg(test)]
-    pub fn state_mut(&mut self) -> &mut State {
+    pub(crate) fn state_mut(&mut self) -> &mut State {
         &mut self.state
     }
 
     /// The frame view's mapping (tests click through it).
     #[cfg(test)]
-    pub fn frame_view(&self) -> &FrameView {
+    pub(crate) fn frame_view(&self) -> &FrameView {
         &self.frame_view
     }
 
     /// The 3D view's orbit.
     #[cfg(test)]
-    pub fn orbit(&self) -> Orbit {
+    pub(crate) fn orbit(&self) -> Orbit {
         self.orbit
     }
 

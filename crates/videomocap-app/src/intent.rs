@@ -9,7 +9,7 @@ use videomocap_core::skeleton::{Bone, Joint};
 
 /// One thing the user asked for.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Intent {
+pub(crate) enum Intent {
     /// Open a video, image folder, project or point-volume folder (asks to save first when
     /// there are unsaved changes).
     Open(PathBuf),

@@ -3,6 +3,7 @@
 //! file either opens and tracks, or gives a clear error naming it with exit code 1 or 2. None
 //! panics or hangs. Prints the table (`cargo test --test bad_videos -- --nocapture`).
 
+#![allow(clippy::unwrap_used)] // a test's unwrap is its failure, named by the panic
 #![cfg(feature = "ffmpeg")]
 
 use assert_cmd::Command;

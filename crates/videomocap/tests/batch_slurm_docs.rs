@@ -4,6 +4,8 @@
 //! as bare as `--export=NONE` gives: `HOME` and a system `PATH`), then the `--wrap` gather.
 //! No Slurm needed.
 
+#![allow(clippy::unwrap_used)] // a test's unwrap is its failure, named by the panic
+
 use std::os::unix::fs::PermissionsExt;
 use std::path::Path;
 use std::process::Command;

@@ -5,6 +5,8 @@
 //! to run (state `R`) at each look. A thread that is ready but waiting for a core counts as
 //! well, so the measure does not depend on how busy the machine is.
 
+#![allow(clippy::unwrap_used)] // a test's unwrap is its failure, named by the panic
+
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use std::time::Duration;

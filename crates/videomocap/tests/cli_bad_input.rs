@@ -1,6 +1,8 @@
 //! Bad input through the command line: each case exits with code 2 and a message naming the
 //! file and the problem, never a panic.
 
+#![allow(clippy::unwrap_used)] // a test's unwrap is its failure, named by the panic
+
 use assert_cmd::Command;
 use std::path::{Path, PathBuf};
 

@@ -1,6 +1,8 @@
 //! `videomocap batch`: one process and three shards give the same summary, every row runs
 //! exactly once, a rerun skips what is done, and a bad row fails alone.
 
+#![allow(clippy::unwrap_used)] // a test's unwrap is its failure, named by the panic
+
 use assert_cmd::Command;
 use std::collections::BTreeSet;
 use std::path::Path;

@@ -1,5 +1,7 @@
 //! `videomocap track` end to end: marks, keys with a correction, and a project re-tracked.
 
+#![allow(clippy::unwrap_used)] // a test's unwrap is its failure, named by the panic
+
 use assert_cmd::Command;
 use videomocap_core::formats::FrameIndex;
 use videomocap_core::formats::{Marks, Tracks2d};

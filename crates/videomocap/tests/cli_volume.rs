@@ -1,6 +1,8 @@
 //! The point-volume commands end to end (`volume`, `carve`): volumes and carving set-ups made
 //! by the test kit, the user binary run on them.
 
+#![allow(clippy::unwrap_used)] // a test's unwrap is its failure, named by the panic
+
 use assert_cmd::Command;
 use videomocap_core::formats::Skeleton3d;
 use videomocap_core::skeleton::{Joint, SubjectModel};

@@ -6,6 +6,8 @@
 //! the frame, and which were lost (weak runs too long to fill: the left elbow, which the
 //! tracker follows poorly on this clip).
 
+#![allow(clippy::unwrap_used)] // a test's unwrap is its failure, named by the panic
+
 use assert_cmd::Command;
 use nalgebra::Point2;
 use std::collections::BTreeSet;

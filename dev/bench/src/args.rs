@@ -3,7 +3,7 @@
 
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
-pub use videomocap::cli::args::GlobalArgs;
+pub(crate) use videomocap::cli::args::GlobalArgs;
 
 const EXAMPLES: &str = "\
 Examples:
@@ -23,7 +23,7 @@ real figures: cargo run --release -p videomocap-bench -- track --split test";
 /// videomocap's developer tool: benchmarks, synthetic clips with ground truth, scoring.
 #[derive(Debug, Parser)]
 #[command(name = "videomocap-bench", version, about, after_help = EXAMPLES)]
-pub struct Cli {
+pub(crate) struct Cli {
     /// What to do.
     #[command(subcommand)]
     pub command: Command,
@@ -33,7 +33,7 @@ pub struct Cli {
 
 /// The developer tool's commands.
 #[derive(Debug, Subcommand)]
-pub enum Command {
+pub(crate) enum Command {
     /// Tracking accuracy on suite v3's dev and test splits and the two real clips from clicked
     /// marks, beside the fixed template and OpenCV's trackers when present, and tracking speed.
     Track(BenchArgs),
@@ -94,7 +94,7 @@ pub enum Command {
 
 /// `prior`: where the takes are and where the parameters go.
 #[derive(Debug, Args)]
-pub struct PriorArgs {
+pub(crate) struct PriorArgs {
     /// The folder of takes (`*.bvh` or `*.bvh.gz`, read recursively).
     pub mocap: PathBuf,
     /// The parameter file to write.
@@ -110,7 +110,7 @@ pub struct PriorArgs {
 
 /// `stress-write`: the writer the crash-safety test kills.
 #[derive(Debug, Args)]
-pub struct StressWriteArgs {
+pub(crate) struct StressWriteArgs {
     /// The project to rewrite in place (it must hold a skeleton).
     pub project: PathBuf,
     /// Directory for motion.bvh, joints3d.csv and motion.trc.
@@ -123,7 +123,7 @@ pub struct StressWriteArgs {
 
 /// `synth`.
 #[derive(Debug, Args)]
-pub struct SynthArgs {
+pub(crate) struct SynthArgs {
     /// Motion: walk, treadmill, wave, jumping-jacks, sit-down, bend, march, or a BVH file.
     #[arg(long, default_value = "walk")]
     pub motion: String,
@@ -208,7 +208,7 @@ pub struct SynthArgs {
 
 /// The options every benchmark takes.
 #[derive(Debug, Args)]
-pub struct BenchArgs {
+pub(crate) struct BenchArgs {
     /// Frames per measured clip (decode).
     #[arg(long, default_value_t = 300)]
     pub frames: usize,

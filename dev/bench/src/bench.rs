@@ -13,7 +13,7 @@ use videomocap_core::video::{OpenOptions, Video};
 use videomocap_testkit::synth::{SynthParams, VideoOutput, render_clip};
 
 /// Says so when this is a debug build (its figures are not the product's).
-pub fn note_debug_build(global: &GlobalArgs) {
+pub(crate) fn note_debug_build(global: &GlobalArgs) {
     if cfg!(debug_assertions) {
         say(
             global,
@@ -23,7 +23,7 @@ pub fn note_debug_build(global: &GlobalArgs) {
 }
 
 /// Runs the benchmark `what` (track, correct, lift, volume, or all, decode, synth).
-pub fn run(what: &str, a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+pub(crate) fn run(what: &str, a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     note_debug_build(global);
     if what == "track" {
         return crate::bench_track::run(a, global);

@@ -24,12 +24,12 @@ use videomocap_testkit::repo_root;
 use videomocap_testkit::synth::GroundTruth;
 
 /// Width of [`opencv_cell`].
-pub const OPENCV_WIDTH: usize = 28;
+pub(crate) const OPENCV_WIDTH: usize = 28;
 /// The columns of [`opencv_cell`].
-pub const OPENCV_COLUMNS: &str = "LK PCK.2  lost  CSRT   lost";
+pub(crate) const OPENCV_COLUMNS: &str = "LK PCK.2  lost  CSRT   lost";
 
 /// One split's column: Lucas–Kanade's PCK@0.2 and lost share, then CSRT's (blank without).
-pub fn opencv_cell(s: &[Accuracy; 2]) -> String {
+pub(crate) fn opencv_cell(s: &[Accuracy; 2]) -> String {
     let csrt = if s[1].count > 0 {
         format!("{:>6.3} {:>5.1}%", s[1].pck02(), 100.0 * s[1].lost())
     } else {
@@ -39,16 +39,16 @@ pub fn opencv_cell(s: &[Accuracy; 2]) -> String {
 }
 
 /// Width of [`learned_cell`].
-pub const LEARNED_WIDTH: usize = 35;
+pub(crate) const LEARNED_WIDTH: usize = 35;
 /// The columns of [`learned_cell`].
-pub const LEARNED_COLUMNS: &str = "VBA limbs  MP limbs   lost  MP all";
+pub(crate) const LEARNED_COLUMNS: &str = "VBA limbs  MP limbs   lost  MP all";
 
 /// VBA against MediaPipe: [VBA's 13 limb joints, MediaPipe's 13 limb joints, MediaPipe's 16].
-pub type Learned = [Accuracy; 3];
+pub(crate) type Learned = [Accuracy; 3];
 
 /// One split's column of the learned comparison: PCK@0.2 of VBA's limb joints, MediaPipe's limb
 /// joints (and its lost share), MediaPipe's 16 joints.
-pub fn learned_cell(s: &Learned) -> String {
+pub(crate) fn learned_cell(s: &Learned) -> String {
     format!(
         "{:>9.3} {:>9.3} {:>5.1}% {:>7.3}",
         s[0].pck02(),
@@ -168,7 +168,7 @@ fn score_output(
 
 /// Runs OpenCV's trackers on `clips` from `clicked` (one set of marks per clip) and scores them;
 /// `None` when OpenCV is not there.
-pub fn opencv(
+pub(crate) fn opencv(
     clips: &[BenchClip],
     clicked: &[Marks],
     suite_dir: &Path,
@@ -227,7 +227,7 @@ pub fn opencv(
 
 /// OpenCV's table: its heading line (naming what is scored) and the per-family rows, or the line
 /// that says how to install it.
-pub fn opencv_lines(tally: Option<&Tally<[Accuracy; 2]>>) -> Vec<String> {
+pub(crate) fn opencv_lines(tally: Option<&Tally<[Accuracy; 2]>>) -> Vec<String> {
     let Some(t) = tally else {
         return vec!["(OpenCV baselines: python3 with cv2 not found; `python3 -m pip install opencv-contrib-python-headless numpy` adds them)".to_owned()];
     };
@@ -243,11 +243,11 @@ pub fn opencv_lines(tally: Option<&Tally<[Accuracy; 2]>>) -> Vec<String> {
 }
 
 /// The learned comparison per split and family, and per clip (name, scores).
-pub type LearnedScores = (Tally<Learned>, Vec<(String, Learned)>);
+pub(crate) type LearnedScores = (Tally<Learned>, Vec<(String, Learned)>);
 
 /// Runs MediaPipe Pose on `clips` (outputs kept and reused) and scores it, one score per clip;
 /// `None` when MediaPipe is not there.
-pub fn mediapipe_scores(
+pub(crate) fn mediapipe_scores(
     clips: &[BenchClip],
     suite_dir: &Path,
     global: &GlobalArgs,
@@ -286,7 +286,7 @@ pub fn mediapipe_scores(
 
 /// Runs MediaPipe Pose on `clips` and scores it beside VBA's limb joints (`vba_limbs`, one per
 /// clip); `None` when MediaPipe is not there. Also each clip's MediaPipe score.
-pub fn mediapipe(
+pub(crate) fn mediapipe(
     clips: &[BenchClip],
     vba_limbs: &[Accuracy],
     suite_dir: &Path,

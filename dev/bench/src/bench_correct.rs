@@ -175,7 +175,7 @@ fn cell(s: &[Accuracy; 3]) -> String {
 }
 
 /// Runs the correction benchmark and prints its table.
-pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let (threads, params) = threads_and_settings(a)?;
     let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;
     let network = a

@@ -156,7 +156,7 @@ fn network_alone(
 }
 
 /// Runs the comparison and prints its tables.
-pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let (threads, params) = threads_and_settings(a)?;
     let settings = sweep(a.evidence.as_deref())?;
     let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;

@@ -226,7 +226,7 @@ fn run_clip(
 }
 
 /// Runs the lift benchmark and prints its tables.
-pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let threads = crate::bench_suite::machine_threads();
     let params = crate::bench_suite::lift_settings(a)?;
     let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;

@@ -359,7 +359,7 @@ fn view_lines(views: &BTreeMap<(Split, &'static str), Scores>, names: &[String])
 }
 
 /// Runs the comparison and prints its tables.
-pub fn run(a: &BenchArgs, global: &GlobalArgs, weights: &[f64]) -> Result<(), ExitError> {
+pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs, weights: &[f64]) -> Result<(), ExitError> {
     let threads = crate::bench_suite::machine_threads();
     let params = crate::bench_suite::lift_settings(a)?;
     let network = crate::bench_suite::bundled_network(threads)?;

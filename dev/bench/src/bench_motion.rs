@@ -155,7 +155,7 @@ fn cell(s: &([MotionScore; 3], LockShift)) -> String {
 }
 
 /// Runs the motion benchmark and prints its tables.
-pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let threads = crate::bench_suite::machine_threads();
     let network = crate::bench_suite::bundled_network(threads)?;
     let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;

@@ -13,7 +13,7 @@ use videomocap_core::formats::Marks;
 use videomocap_core::track::{TrackJob, TrackerParams, track_video};
 use videomocap_core::video::{OpenOptions, Video, VideoError};
 
-pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     crate::bench::note_debug_build(global);
     let dir = std::path::Path::new("out/bench-scrub");
     std::fs::create_dir_all(dir).map_err(ExitError::failed)?;

@@ -12,7 +12,7 @@ use videomocap_testkit::repo_root;
 
 /// One clip a benchmark scores.
 #[derive(Debug, Clone)]
-pub struct BenchClip {
+pub(crate) struct BenchClip {
     /// Its name.
     pub name: String,
     /// Its family ([`Family::Real`] for the real clips).
@@ -29,7 +29,7 @@ pub struct BenchClip {
 /// suite's oblique, raised and low views, 30–45° to a side), in profile, behind; and the real
 /// clips.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum ViewFamily {
+pub(crate) enum ViewFamily {
     /// In front.
     Frontal,
     /// 30–45° to a side (oblique, raised, low).
@@ -44,7 +44,7 @@ pub enum ViewFamily {
 
 impl ViewFamily {
     /// Every view family, in table order.
-    pub const ALL: [ViewFamily; 5] = [
+    pub(crate) const ALL: [ViewFamily; 5] = [
         ViewFamily::Frontal,
         ViewFamily::Oblique,
         ViewFamily::Side,
@@ -53,7 +53,7 @@ impl ViewFamily {
     ];
 
     /// The family of a suite view.
-    pub fn of(view: videomocap_testkit::synth::View) -> ViewFamily {
+    pub(crate) fn of(view: videomocap_testkit::synth::View) -> ViewFamily {
         use videomocap_testkit::synth::View;
         match view {
             View::Frontal => ViewFamily::Frontal,
@@ -64,7 +64,7 @@ impl ViewFamily {
     }
 
     /// Its name in tables.
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             ViewFamily::Frontal => "frontal",
             ViewFamily::Oblique => "oblique",
@@ -76,7 +76,7 @@ impl ViewFamily {
 }
 
 /// A clip opened for scoring: its reference, the marks as a user clicks them, and its video.
-pub struct OpenedClip {
+pub(crate) struct OpenedClip {
     /// The reference (gt.json).
     pub gt: videomocap_testkit::synth::GroundTruth,
     /// The marks with [`CLICK_NOISE_PX`] of clicking noise.
@@ -87,7 +87,7 @@ pub struct OpenedClip {
 
 impl BenchClip {
     /// Opens the clip's reference, clicked marks and video.
-    pub fn open(&self) -> Result<OpenedClip, ExitError> {
+    pub(crate) fn open(&self) -> Result<OpenedClip, ExitError> {
         use videomocap_core::formats::Marks;
         use videomocap_core::video::{OpenOptions, Video};
         let dir = &self.dir;
@@ -105,14 +105,14 @@ impl BenchClip {
 }
 
 /// The threads the benchmarks use: all the machine has.
-pub fn machine_threads() -> usize {
+pub(crate) fn machine_threads() -> usize {
     std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(1)
 }
 
 /// `--lift-settings`, else the lift's defaults.
-pub fn lift_settings(
+pub(crate) fn lift_settings(
     a: &crate::args::BenchArgs,
 ) -> Result<videomocap_core::lift::LiftParams, ExitError> {
     match &a.lift_settings {
@@ -123,14 +123,14 @@ pub fn lift_settings(
 
 /// The bundled pose network on `threads` threads (the product's loader), shareable between
 /// jobs.
-pub fn bundled_network(
+pub(crate) fn bundled_network(
     threads: usize,
 ) -> Result<std::sync::Arc<videomocap_core::network::PoseNetwork>, ExitError> {
     videomocap_core::network::PoseNetwork::shared(threads).map_err(ExitError::failed)
 }
 
 /// `--split`: all (`None`), dev or test.
-pub fn parse_split(split: &str) -> Result<Option<Split>, ExitError> {
+pub(crate) fn parse_split(split: &str) -> Result<Option<Split>, ExitError> {
     match split {
         "all" => Ok(None),
         "dev" => Ok(Some(Split::Dev)),
@@ -142,7 +142,7 @@ pub fn parse_split(split: &str) -> Result<Option<Split>, ExitError> {
 }
 
 /// The suite's clips, rendered into `suite_dir` when missing, then the real clips.
-pub fn bench_clips(
+pub(crate) fn bench_clips(
     suite_dir: &Path,
     split: &str,
     clip: Option<&str>,
@@ -183,7 +183,7 @@ pub fn bench_clips(
 }
 
 /// Scores that add up over clips.
-pub trait Merge: Default + Clone {
+pub(crate) trait Merge: Default + Clone {
     /// Adds another's samples.
     fn merge_from(&mut self, other: &Self);
 }
@@ -243,13 +243,13 @@ impl<T: Merge + Clone> Merge for Vec<T> {
 
 /// A score per (split, family) and per split over all synthetic clips.
 #[derive(Debug, Clone, Default)]
-pub struct Tally<T> {
+pub(crate) struct Tally<T> {
     cells: BTreeMap<(Split, Option<Family>), T>,
 }
 
 impl<T: Merge> Tally<T> {
     /// Adds a clip's score to its family and, for synthetic clips, to its split's overall.
-    pub fn add(&mut self, clip: &BenchClip, score: &T) {
+    pub(crate) fn add(&mut self, clip: &BenchClip, score: &T) {
         self.cells
             .entry((clip.split, Some(clip.family)))
             .or_default()
@@ -263,14 +263,14 @@ impl<T: Merge> Tally<T> {
     }
 
     /// The score of a split's family (`None`: all its synthetic clips).
-    pub fn get(&self, split: Split, family: Option<Family>) -> Option<&T> {
+    pub(crate) fn get(&self, split: Split, family: Option<Family>) -> Option<&T> {
         self.cells.get(&(split, family))
     }
 
     /// One line per family that has clips and one overall, `dev` and `test` side by side: `cell`
     /// formats a score into a fixed-width column (`width` characters, blank where a split has no
     /// clip of the family).
-    pub fn lines(&self, width: usize, cell: impl Fn(&T) -> String) -> Vec<String> {
+    pub(crate) fn lines(&self, width: usize, cell: impl Fn(&T) -> String) -> Vec<String> {
         let rows = Family::ALL
             .iter()
             .map(|f| (f.name(), Some(*f)))
@@ -292,7 +292,7 @@ impl<T: Merge> Tally<T> {
 
     /// The table's heading: the split names over columns of `width` characters, then the
     /// columns' own heading.
-    pub fn heading(width: usize, columns: &str) -> Vec<String> {
+    pub(crate) fn heading(width: usize, columns: &str) -> Vec<String> {
         vec![
             format!("{:<18} | {:<width$} | {:<width$}", "", "dev", "test"),
             format!("{:<18} | {columns:<width$} | {columns:<width$}", "family"),
@@ -300,7 +300,7 @@ impl<T: Merge> Tally<T> {
     }
 
     /// Every cell as JSON: `{"dev": {"walk/run": …, "overall": …}, "test": …}`.
-    pub fn json(&self, value: impl Fn(&T) -> serde_json::Value) -> serde_json::Value {
+    pub(crate) fn json(&self, value: impl Fn(&T) -> serde_json::Value) -> serde_json::Value {
         let mut out = serde_json::Map::new();
         for split in [Split::Dev, Split::Test] {
             let mut m = serde_json::Map::new();

@@ -36,7 +36,7 @@ use videomocap_testkit::synth::GroundTruth;
 /// The fixed-template baseline: each joint's marked square patch (side 8% of the marked
 /// stature) searched by the sum of absolute RGB differences within ±20% of the stature of its
 /// last position (every 2 px, then ±1 px around the best). No prediction, no model update.
-pub fn fixed_template_track(
+pub(crate) fn fixed_template_track(
     video: &mut Video,
     marks: &PerJoint<Point2<f64>>,
     stature_px: f64,
@@ -118,7 +118,7 @@ pub fn fixed_template_track(
 }
 
 /// Tracks an opened suite clip from its marks with the VBA tracker.
-pub fn track_opened(
+pub(crate) fn track_opened(
     video: &mut Video,
     marks: &Marks,
     threads: usize,
@@ -135,7 +135,7 @@ const SPEED_RUNS: usize = 3;
 
 /// The tracking benchmarks' threads (all the machine has) and tracker settings (`--tracker-
 /// settings`, else the defaults).
-pub fn threads_and_settings(a: &BenchArgs) -> Result<(usize, TrackerParams), ExitError> {
+pub(crate) fn threads_and_settings(a: &BenchArgs) -> Result<(usize, TrackerParams), ExitError> {
     let threads = crate::bench_suite::machine_threads();
     let params = match &a.tracker_settings {
         Some(p) => videomocap::cli::track::load_settings(p)?,
@@ -195,7 +195,7 @@ fn score_clip(
 }
 
 /// Runs the accuracy and speed benchmark and prints its tables.
-pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let (threads, params) = threads_and_settings(a)?;
     let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;
     let mut tally: Tally<TrackScores> = Tally::default();
@@ -404,7 +404,7 @@ pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
 }
 
 /// An accuracy as JSON: PCK@0.1, PCK@0.2, lost share, mean error in pixels, samples.
-pub fn accuracy_json(a: &Accuracy) -> serde_json::Value {
+pub(crate) fn accuracy_json(a: &Accuracy) -> serde_json::Value {
     serde_json::json!({"pck01": a.pck01(), "pck02": a.pck02(), "lost": a.lost(), "mean_px": a.mean_px(), "samples": a.count})
 }
 

@@ -10,14 +10,14 @@ use videomocap_testkit::eval::{Accuracy, ClipScore, is_limb_joint};
 
 /// Per split and view, each method's per-joint accuracy summed over the clips.
 #[derive(Debug, Clone)]
-pub struct ViewTable {
+pub(crate) struct ViewTable {
     methods: Vec<&'static str>,
     cells: BTreeMap<(Split, ViewFamily), Vec<PerJoint<Accuracy>>>,
 }
 
 impl ViewTable {
     /// A table of `methods` (one score per method and clip, in this order).
-    pub fn new(methods: &[&'static str]) -> ViewTable {
+    pub(crate) fn new(methods: &[&'static str]) -> ViewTable {
         ViewTable {
             methods: methods.to_vec(),
             cells: BTreeMap::new(),
@@ -25,7 +25,7 @@ impl ViewTable {
     }
 
     /// Adds a clip's scores, one per method.
-    pub fn add(&mut self, clip: &BenchClip, scores: &[&ClipScore]) {
+    pub(crate) fn add(&mut self, clip: &BenchClip, scores: &[&ClipScore]) {
         let cell = self
             .cells
             .entry((clip.split, clip.view))
@@ -59,7 +59,7 @@ impl ViewTable {
 
     /// The tables as text: per split, PCK@0.1 / PCK@0.2 per view and method (13 limb joints,
     /// then all scored joints), then each joint's mean error per view and method.
-    pub fn lines(&self) -> Vec<String> {
+    pub(crate) fn lines(&self) -> Vec<String> {
         let mut lines = Vec::new();
         for split in [Split::Dev, Split::Test] {
             let views = self.views(split);
@@ -127,7 +127,7 @@ impl ViewTable {
 
     /// Every cell as JSON: per split and view, per method, PCK@0.1/0.2 of the limb joints and
     /// each joint's mean error in torso lengths.
-    pub fn json(&self) -> serde_json::Value {
+    pub(crate) fn json(&self) -> serde_json::Value {
         let mut out = serde_json::Map::new();
         for ((split, view), cell) in &self.cells {
             let methods: serde_json::Map<String, serde_json::Value> = self

@@ -341,7 +341,7 @@ fn push_table(
 }
 
 /// Runs the volume benchmark and prints its tables.
-pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let params = VolumeParams::default();
     // One split: only the suite's takes (the other tables have no split).
     let split = parse_split(&a.split)?;

@@ -67,7 +67,7 @@ fn read_bvh(path: &Path) -> anyhow::Result<Bvh> {
 }
 
 /// Learns the prior and writes it.
-pub fn run(a: &PriorArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+pub(crate) fn run(a: &PriorArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let suite = Suite::load(&videomocap_testkit::repo_root()).map_err(ExitError::failed)?;
     let test: Vec<String> = suite
         .clips

@@ -9,7 +9,7 @@ use videomocap_testkit::synth::GroundTruth;
 
 /// Prints the per-joint and overall accuracy of `tracks` against `reference` (and, with
 /// `--json`, a summary on stdout).
-pub fn run(tracks: &Path, reference: &Path, global: &GlobalArgs) -> Result<(), ExitError> {
+pub(crate) fn run(tracks: &Path, reference: &Path, global: &GlobalArgs) -> Result<(), ExitError> {
     let tracks = Tracks2d::load(tracks).map_err(ExitError::bad_input)?;
     let gt = GroundTruth::load(reference).map_err(ExitError::bad_input)?;
     let s = score_tracks(&gt, &tracks).map_err(ExitError::bad_input)?;

@@ -16,9 +16,9 @@ use videomocap_core::project::Project;
 use videomocap_core::skeleton::{Joint, PerJoint};
 
 /// The frame whose left wrist carries the round number.
-pub const ROUND_FRAME: usize = 1;
+pub(crate) const ROUND_FRAME: usize = 1;
 
-pub fn run(a: &StressWriteArgs) -> Result<(), ExitError> {
+pub(crate) fn run(a: &StressWriteArgs) -> Result<(), ExitError> {
     let mut project = Project::load(&a.project).map_err(ExitError::bad_input)?;
     let skeleton = project.skeleton.clone().ok_or_else(|| {
         ExitError::bad_input(anyhow!(

@@ -17,7 +17,7 @@ use videomocap_testkit::synth::{
 const DEFAULT_FOV_DEG: f64 = 56.0;
 
 /// Builds the library's parameters from the command line.
-pub fn params_from_args(a: &SynthArgs) -> Result<SynthParams, ExitError> {
+pub(crate) fn params_from_args(a: &SynthArgs) -> Result<SynthParams, ExitError> {
     let motion = match ProceduralMotion::from_name(&a.motion) {
         Some(kind) => MotionSource::Procedural(kind),
         None => {
@@ -92,7 +92,7 @@ pub fn params_from_args(a: &SynthArgs) -> Result<SynthParams, ExitError> {
     })
 }
 
-pub fn run(a: &SynthArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+pub(crate) fn run(a: &SynthArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let params = params_from_args(a)?;
     if a.volume {
         return volume(a, &params, global);

@@ -4,6 +4,8 @@
 //! on disk loads and is one of the versions the writer made, and that every export reads back
 //! whole. `VIDEOMOCAP_KILLS` sets the number of kills (default 200).
 
+#![allow(clippy::unwrap_used)] // a test's unwrap is its failure, named by the panic
+
 use rand::{Rng, SeedableRng};
 use std::io::{BufRead, BufReader};
 use std::path::Path;

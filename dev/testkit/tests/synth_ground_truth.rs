@@ -2,6 +2,8 @@
 //! points, bones keep their lengths, the person is drawn where the joints are, self-occlusion
 //! is seen, and the marks are frame 0.
 
+#![allow(clippy::unwrap_used)] // a test's unwrap is its failure, named by the panic
+
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use videomocap_core::formats::Marks;

@@ -8,17 +8,17 @@ use std::thread::JoinHandle;
 use videomocap_core::project::Project;
 
 /// Name of the recovery file in the autosave directory.
-pub const AUTOSAVE_FILE: &str = "autosave.videomocap.json";
+pub(crate) const AUTOSAVE_FILE: &str = "autosave.videomocap.json";
 
 /// The default autosave directory: `$XDG_STATE_HOME/videomocap` (or the platform's equivalent).
-pub fn default_dir() -> Option<PathBuf> {
+pub(crate) fn default_dir() -> Option<PathBuf> {
     dirs::state_dir()
         .or_else(dirs::data_local_dir)
         .map(|d| d.join("videomocap"))
 }
 
 /// Writes projects to the recovery file off the UI thread.
-pub struct Autosaver {
+pub(crate) struct Autosaver {
     path: PathBuf,
     tx: Option<Sender<Project>>,
     worker: Option<JoinHandle<()>>,
@@ -26,7 +26,7 @@ pub struct Autosaver {
 
 impl Autosaver {
     /// An autosaver writing `dir/autosave.videomocap.json`.
-    pub fn new(dir: &Path) -> Autosaver {
+    pub(crate) fn new(dir: &Path) -> Autosaver {
         let path = dir.join(AUTOSAVE_FILE);
         let (tx, rx) = channel::<Project>();
         let target = path.clone();
@@ -53,19 +53,19 @@ impl Autosaver {
     }
 
     /// The recovery file.
-    pub fn path(&self) -> &Path {
+    pub(crate) fn path(&self) -> &Path {
         &self.path
     }
 
     /// Queues a save of `project`.
-    pub fn save(&self, project: &Project) {
+    pub(crate) fn save(&self, project: &Project) {
         if let Some(tx) = &self.tx {
             let _ = tx.send(project.clone());
         }
     }
 
     /// Waits until every queued save is on disk (tests, and before deleting the file).
-    pub fn flush(&mut self) {
+    pub(crate) fn flush(&mut self) {
         self.tx = None;
         if let Some(w) = self.worker.take() {
             let _ = w.join();
@@ -75,7 +75,7 @@ impl Autosaver {
     }
 
     /// Removes the recovery file (after an explicit save or a discard).
-    pub fn clear(&mut self) {
+    pub(crate) fn clear(&mut self) {
         self.flush();
         let _ = std::fs::remove_file(&self.path);
     }

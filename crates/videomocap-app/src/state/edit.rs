@@ -14,7 +14,7 @@ type HistoryStep = fn(&mut History<Project>, Project) -> Option<(Project, String
 /// A frame's pose before the user flipped a bone's depth on it: the 3D view draws it grey
 /// under the new pose, so the flip shows (a forearm's flip moved it a few pixels).
 #[derive(Debug, Clone, PartialEq)]
-pub struct FlipGhost {
+pub(crate) struct FlipGhost {
     /// The frame flipped on.
     pub frame: usize,
     /// The bone flipped.
@@ -27,7 +27,7 @@ pub struct FlipGhost {
 impl State {
     /// Whether the subject is seen from behind on the current frame (their own left on the
     /// image's left): from the shoulders placed there, else the hips, else as the user said.
-    pub fn seen_from_behind(&self) -> bool {
+    pub(crate) fn seen_from_behind(&self) -> bool {
         let Some(keys) = self
             .project
             .as_ref()
@@ -45,14 +45,14 @@ impl State {
     }
 
     /// The joint the marking guide asks for, if marking, and its place in the order.
-    pub fn asking(&self) -> Option<(usize, Joint)> {
+    pub(crate) fn asking(&self) -> Option<(usize, Joint)> {
         self.marking
             .and_then(|k| Joint::MARKING_ORDER.get(k).map(|&j| (k, j)))
     }
 
     /// Where the joint asked for lies by its definition, when the joints placed already say:
     /// the pelvis halfway between the two hips placed on the current frame.
-    pub fn marking_hint(&self) -> Option<Point2<f64>> {
+    pub(crate) fn marking_hint(&self) -> Option<Point2<f64>> {
         let (_, Joint::Pelvis) = self.asking()? else {
             return None;
         };
@@ -69,7 +69,7 @@ impl State {
     }
 
     /// The words the marking guide uses for what the camera sees.
-    pub fn marking_view(&self) -> MarkingView {
+    pub(crate) fn marking_view(&self) -> MarkingView {
         if self.seen_from_behind() {
             MarkingView::Behind
         } else {
@@ -78,7 +78,7 @@ impl State {
     }
 
     /// The pose before the last edit, when that edit was a flip of a bone's depth.
-    pub fn flip_ghost(&self) -> Option<&FlipGhost> {
+    pub(crate) fn flip_ghost(&self) -> Option<&FlipGhost> {
         self.flip_ghost.as_ref()
     }
 }

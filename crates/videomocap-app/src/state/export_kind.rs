@@ -2,7 +2,7 @@
 
 /// Things the export menu can write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ExportKind {
+pub(crate) enum ExportKind {
     /// The motion as BVH (CMU bone names).
     Bvh,
     /// The motion as BVH with Mixamo's bone names, for retargeting onto Mixamo characters.
@@ -23,7 +23,7 @@ pub enum ExportKind {
 
 impl ExportKind {
     /// Every export, in menu order.
-    pub const ALL: [ExportKind; 8] = [
+    pub(crate) const ALL: [ExportKind; 8] = [
         ExportKind::Bvh,
         ExportKind::BvhMixamo,
         ExportKind::TracksJson,
@@ -35,7 +35,7 @@ impl ExportKind {
     ];
 
     /// The menu entry.
-    pub fn label(self) -> &'static str {
+    pub(crate) fn label(self) -> &'static str {
         match self {
             ExportKind::Bvh => "BVH (Blender, motion builders)…",
             ExportKind::BvhMixamo => "BVH, Mixamo bone names (retargeting)…",

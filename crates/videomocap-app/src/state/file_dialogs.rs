@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 
 /// What a file dialog gave.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Picked {
+pub(crate) enum Picked {
     /// The user chose this path.
     Path(PathBuf),
     /// The user closed the dialog without choosing.
@@ -21,7 +21,7 @@ pub enum Picked {
 }
 
 /// Asks the user for files.
-pub trait Dialogs {
+pub(crate) trait Dialogs {
     /// A file to open, filtered to `extensions` (empty = any).
     fn open_file(&self, title: &str, extensions: &[&str]) -> Picked;
     /// A folder to open (image sequences, point volumes).
@@ -31,7 +31,7 @@ pub trait Dialogs {
 }
 
 /// The desktop's dialogs (XDG portal, or zenity).
-pub struct RfdDialogs;
+pub(crate) struct RfdDialogs;
 
 /// A dialog that returned nothing sooner than this was never shown: rfd returns at once when
 /// the desktop has no portal and no zenity, and no one closes a shown dialog this fast.
@@ -81,7 +81,7 @@ impl Dialogs for RfdDialogs {
 /// Answers every dialog with the next prepared path (tests; clones share the answers).
 #[cfg(test)]
 #[derive(Default, Clone)]
-pub struct PreparedDialogs {
+pub(crate) struct PreparedDialogs {
     /// Paths handed out in order; once empty, the user cancels.
     pub answers: std::rc::Rc<RefCell<VecDeque<PathBuf>>>,
     /// No dialog can be shown (a desktop without a portal or zenity).

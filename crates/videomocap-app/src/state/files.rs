@@ -16,7 +16,7 @@ use videomocap_core::project::Project;
 
 /// What can be opened from the File menu.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Choose {
+pub(crate) enum Choose {
     /// A video file.
     Video,
     /// A folder of images.
@@ -43,7 +43,7 @@ impl Choose {
 
 /// Where the user is going once "save changes?" is answered.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Leave {
+pub(crate) enum Leave {
     /// Opening this file or folder.
     Open(PathBuf),
     /// Quitting the app.
@@ -52,7 +52,7 @@ pub enum Leave {
 
 /// The answers to "save changes?".
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SaveAnswer {
+pub(crate) enum SaveAnswer {
     /// Save, then go on.
     Save,
     /// Go on without saving.
@@ -63,7 +63,7 @@ pub enum SaveAnswer {
 
 /// What a path typed into the app's own path field is for.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub enum PathPurpose {
+pub(crate) enum PathPurpose {
     /// Opening something.
     Open(Choose),
     /// Saving the project, then going where the user was going.
@@ -74,7 +74,7 @@ pub enum PathPurpose {
 
 /// The app's own path field: shown when no file dialog can be.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct PathRequest {
+pub(crate) struct PathRequest {
     /// What the path is for.
     pub purpose: PathPurpose,
     /// The window's title.

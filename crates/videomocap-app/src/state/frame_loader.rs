@@ -19,7 +19,7 @@ use videomocap_core::video::proxy::{self, BuildOutcome};
 use videomocap_core::video::{Frame, OpenOptions, Video, VideoError, VideoInfo};
 
 /// What the worker reports.
-pub enum LoaderEvent {
+pub(crate) enum LoaderEvent {
     /// The video opened (or could not be).
     Opened(Result<VideoInfo, VideoError>),
     /// A decoded frame or the error decoding it.
@@ -32,7 +32,7 @@ pub enum LoaderEvent {
 
 /// State of the seek proxy.
 #[derive(Debug, Clone, PartialEq)]
-pub enum ProxyStatus {
+pub(crate) enum ProxyStatus {
     /// Being built: frames done of total.
     Building(usize, usize),
     /// In use: seeks show its frame first.
@@ -42,7 +42,7 @@ pub enum ProxyStatus {
 }
 
 /// The UI side of the workers.
-pub struct FrameLoader {
+pub(crate) struct FrameLoader {
     requests: Option<Sender<usize>>,
     previews: Option<Sender<usize>>,
     results: Receiver<LoaderEvent>,
@@ -67,7 +67,11 @@ const PAUSE_POLL: Duration = Duration::from_millis(100);
 impl FrameLoader {
     /// Opens `path` on a new worker thread; [`FrameLoader::poll`] reports when it is open.
     /// With a `proxy_dir`, a video with far-apart keyframes gets a seek proxy kept there.
-    pub fn open(path: PathBuf, ctx: egui::Context, proxy_dir: Option<PathBuf>) -> FrameLoader {
+    pub(crate) fn open(
+        path: PathBuf,
+        ctx: egui::Context,
+        proxy_dir: Option<PathBuf>,
+    ) -> FrameLoader {
         let (req_tx, req_rx) = channel::<usize>();
         let (pre_tx, pre_rx) = channel::<usize>();
         let (res_tx, res_rx) = channel::<LoaderEvent>();
@@ -143,23 +147,23 @@ impl FrameLoader {
     }
 
     /// Metadata of the video, once open.
-    pub fn info(&self) -> Option<&VideoInfo> {
+    pub(crate) fn info(&self) -> Option<&VideoInfo> {
         self.info.as_ref()
     }
 
     /// The seek proxy's state, if the video gets one.
-    pub fn proxy(&self) -> Option<&ProxyStatus> {
+    pub(crate) fn proxy(&self) -> Option<&ProxyStatus> {
         self.proxy.as_ref()
     }
 
     /// Holds a running proxy build (while tracking needs the cores) or lets it go on.
-    pub fn pause_background(&self, pause: bool) {
+    pub(crate) fn pause_background(&self, pause: bool) {
         self.pause.store(pause, Ordering::Relaxed);
     }
 
     /// Asks for a frame (answered later through [`FrameLoader::poll`]): for a seek, a preview
     /// first when the seek proxy is ready; then the full frame.
-    pub fn request(&self, index: usize) {
+    pub(crate) fn request(&self, index: usize) {
         if let Some(tx) = &self.requests {
             let _ = tx.send(index);
         }
@@ -177,7 +181,7 @@ impl FrameLoader {
 
     /// What arrived since the last call: the open result (first), the proxy's state, the
     /// newest preview and the newest frame.
-    pub fn poll(&mut self) -> Vec<LoaderEvent> {
+    pub(crate) fn poll(&mut self) -> Vec<LoaderEvent> {
         let mut opened = None;
         let mut frame = None;
         let mut preview = None;

@@ -16,7 +16,7 @@ use videomocap_core::video::{OpenOptions, Video};
 use videomocap_volume::{Processed, VolumeParams, process_directory};
 
 /// What a job sends back.
-pub enum JobEvent {
+pub(crate) enum JobEvent {
     /// Steps done of a total, and a frame just tracked.
     Progress {
         done: usize,
@@ -35,7 +35,7 @@ pub enum JobEvent {
 }
 
 /// A running job.
-pub struct Job {
+pub(crate) struct Job {
     /// "Tracking" or "Lifting".
     pub what: &'static str,
     events: Receiver<JobEvent>,
@@ -53,7 +53,7 @@ pub struct Job {
 
 impl Job {
     /// Tracks `video` on a worker thread.
-    pub fn track(video: PathBuf, mut job: TrackJob, ctx: egui::Context) -> Job {
+    pub(crate) fn track(video: PathBuf, mut job: TrackJob, ctx: egui::Context) -> Job {
         let (tx, rx) = channel();
         let cancel = Arc::new(AtomicBool::new(false));
         let flag = cancel.clone();
@@ -91,7 +91,7 @@ impl Job {
 
     /// Lifts `tracks` to 3D on a worker thread with the project's lift settings `params` and
     /// the lengths the user knows.
-    pub fn lift(
+    pub(crate) fn lift(
         tracks: Arc<Tracks2d>,
         focal_px: f64,
         height_m: f64,
@@ -134,7 +134,7 @@ impl Job {
     }
 
     /// Runs the point-volume pipeline on `dir` on a worker thread (frames in parallel).
-    pub fn volume(dir: PathBuf, fps: f64, ctx: egui::Context) -> Job {
+    pub(crate) fn volume(dir: PathBuf, fps: f64, ctx: egui::Context) -> Job {
         let (tx, rx) = channel();
         let cancel = Arc::new(AtomicBool::new(false));
         let flag = cancel.clone();
@@ -171,12 +171,12 @@ impl Job {
     }
 
     /// Asks the job to stop (it answers with a "cancelled" error).
-    pub fn cancel(&self) {
+    pub(crate) fn cancel(&self) {
         self.cancel.store(true, Ordering::Relaxed);
     }
 
     /// Events since the last call (progress is folded into `done`/`total`).
-    pub fn poll(&mut self) -> Vec<JobEvent> {
+    pub(crate) fn poll(&mut self) -> Vec<JobEvent> {
         let mut out = Vec::new();
         while let Ok(e) = self.events.try_recv() {
             if let JobEvent::Progress {
@@ -201,7 +201,7 @@ impl Job {
     /// The progress bar's text: what, the stage, the share done, and once the stage has run
     /// a second and done a step, the time left in it. A share and not a step count: a track's
     /// steps are its passes over the frames (and the network's), not the clip's frames.
-    pub fn progress_text(&self) -> String {
+    pub(crate) fn progress_text(&self) -> String {
         let (share, _, left) = self.rate();
         let mut text = self.what.to_owned();
         // The stage in brackets when it says more than the job's name ("Tracking (tracking)").
@@ -218,7 +218,7 @@ impl Job {
     }
 
     /// Share done, steps per second and seconds left, in the current stage.
-    pub fn rate(&self) -> (f32, f64, Option<f64>) {
+    pub(crate) fn rate(&self) -> (f32, f64, Option<f64>) {
         let share = if self.total == 0 {
             0.0
         } else {

@@ -14,15 +14,15 @@ const VIDEOS_KEPT: usize = 8;
 /// The 3D view's width when the user has not chosen one, points: narrower than the 380 it
 /// was, so a landscape clip gets the width (on a 1440-point window with the side panel at 280,
 /// 860 points for the video instead of 820).
-pub const DEFAULT_VIEW3D_PX: f32 = 300.0;
+pub(crate) const DEFAULT_VIEW3D_PX: f32 = 300.0;
 
 /// The side panel's width when the user has not chosen one, points: the widest setting's
 /// label ("hands outside the body", 134 points) fits beside its number box and a short bar.
-pub const DEFAULT_SIDE_PX: f32 = 280.0;
+pub(crate) const DEFAULT_SIDE_PX: f32 = 280.0;
 
 /// The frame view's zoom on one video.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct FrameZoom {
+pub(crate) struct FrameZoom {
     /// 1: the frame fits the view.
     pub zoom: f32,
     /// The image point at the view's centre, pixels (`None`: the image's centre).
@@ -39,7 +39,7 @@ struct VideoZoom {
 
 /// The layout kept across restarts.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-pub struct Layout {
+pub(crate) struct Layout {
     /// The side panel's width, points.
     #[serde(default)]
     pub side_px: Option<f32>,
@@ -62,7 +62,7 @@ impl Layout {
     }
 
     /// The layout kept in `dir` (the defaults when there is none or it cannot be read).
-    pub fn load(dir: Option<&Path>) -> Layout {
+    pub(crate) fn load(dir: Option<&Path>) -> Layout {
         dir.map(Layout::path)
             .and_then(|p| std::fs::read_to_string(p).ok())
             .and_then(|t| serde_json::from_str(&t).ok())
@@ -70,7 +70,7 @@ impl Layout {
     }
 
     /// Writes the layout into `dir` (atomically; a failure only loses the layout).
-    pub fn save(&self, dir: Option<&Path>) {
+    pub(crate) fn save(&self, dir: Option<&Path>) {
         let Some(dir) = dir else { return };
         let _ = std::fs::create_dir_all(dir);
         if let Ok(text) = serde_json::to_string_pretty(self) {
@@ -79,12 +79,12 @@ impl Layout {
     }
 
     /// The zoom last used on `video`.
-    pub fn zoom_of(&self, video: &Path) -> Option<FrameZoom> {
+    pub(crate) fn zoom_of(&self, video: &Path) -> Option<FrameZoom> {
         self.zooms.iter().find(|z| z.video == video).map(|z| z.zoom)
     }
 
     /// Keeps `zoom` for `video`; `true` when it changed.
-    pub fn set_zoom(&mut self, video: &Path, zoom: FrameZoom) -> bool {
+    pub(crate) fn set_zoom(&mut self, video: &Path, zoom: FrameZoom) -> bool {
         if self.zoom_of(video) == Some(zoom) {
             return false;
         }

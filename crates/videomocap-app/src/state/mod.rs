@@ -10,27 +10,27 @@
 //! zoom kept across restarts), `read` (what the views read). The workers it owns: [`frame_loader`], [`jobs`], [`autosave`], and the
 //! desktop's [`file_dialogs`].
 
-pub mod autosave;
+pub(crate) mod autosave;
 mod edit;
 mod export;
 mod export_kind;
-pub mod file_dialogs;
+pub(crate) mod file_dialogs;
 mod files;
-pub mod frame_loader;
-pub mod jobs;
-pub mod layout;
+pub(crate) mod frame_loader;
+pub(crate) mod jobs;
+pub(crate) mod layout;
 mod outdated;
 mod read;
 mod recent;
 mod strips;
-pub mod volume;
+pub(crate) mod volume;
 mod work;
 
-pub use edit::FlipGhost;
-pub use export_kind::ExportKind;
-pub use files::{Choose, Leave, PathPurpose, PathRequest, SaveAnswer};
-pub use outdated::Outdated;
-pub use strips::Strips;
+pub(crate) use edit::FlipGhost;
+pub(crate) use export_kind::ExportKind;
+pub(crate) use files::{Choose, Leave, PathPurpose, PathRequest, SaveAnswer};
+pub(crate) use outdated::Outdated;
+pub(crate) use strips::Strips;
 
 use crate::intent::Intent;
 use crate::views::frame_view::PointState;
@@ -53,7 +53,7 @@ use videomocap_core::video::VideoInfo;
 use volume::VolumeSequence;
 
 /// How the app is set up (tests swap the dialogs and the autosave directory).
-pub struct Config {
+pub(crate) struct Config {
     /// File dialogs.
     pub dialogs: Box<dyn Dialogs>,
     /// Where the recovery file lives (`None`: no autosave).
@@ -90,7 +90,7 @@ struct LiftChoices {
 
 /// How much of the clip's tracks is weak, lost or filled in (the side panel's headline).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct WeakShare {
+pub(crate) struct WeakShare {
     /// Joint-frames in weak spans (a joint on a frame counts once).
     pub joint_frames: usize,
     /// All joint-frames of the tracked clip (16 per frame).
@@ -99,13 +99,13 @@ pub struct WeakShare {
 
 impl WeakShare {
     /// The weak share of the clip, 0–1.
-    pub fn share(self) -> f64 {
+    pub(crate) fn share(self) -> f64 {
         self.joint_frames as f64 / self.total.max(1) as f64
     }
 }
 
 /// Everything the app knows and does, without a window.
-pub struct State {
+pub(crate) struct State {
     ctx: egui::Context,
     config: Config,
     loader: Option<FrameLoader>,
@@ -183,7 +183,7 @@ pub struct State {
 impl State {
     /// The state at start, with the given dialogs and autosave directory; a recovery file left
     /// by an earlier session is offered.
-    pub fn new(ctx: &egui::Context, config: Config) -> State {
+    pub(crate) fn new(ctx: &egui::Context, config: Config) -> State {
         let autosaver = config.autosave_dir.as_deref().map(Autosaver::new);
         let recovery = autosaver
             .as_ref()
@@ -240,7 +240,7 @@ impl State {
     }
 
     /// Carries out what a view asked for.
-    pub fn apply(&mut self, intent: Intent) {
+    pub(crate) fn apply(&mut self, intent: Intent) {
         match intent {
             Intent::Open(path) => self.leave(Leave::Open(path)),
             Intent::Choose(what) => self.choose(what),
@@ -288,13 +288,13 @@ impl State {
     }
     /// The recovery file's path (when autosave is on).
     #[cfg(test)]
-    pub fn autosave_path(&self) -> Option<PathBuf> {
+    pub(crate) fn autosave_path(&self) -> Option<PathBuf> {
         self.autosaver.as_ref().map(|a| a.path().to_owned())
     }
 
     /// Waits until autosaves are written (tests).
     #[cfg(test)]
-    pub fn flush_autosave(&mut self) {
+    pub(crate) fn flush_autosave(&mut self) {
         if let Some(a) = &mut self.autosaver {
             a.flush();
         }
@@ -302,13 +302,13 @@ impl State {
 
     /// As a tracking job does when the pose network cannot load (tests of the Tracker panel).
     #[cfg(test)]
-    pub fn report_network_problem_for_test(&mut self, why: String) {
+    pub(crate) fn report_network_problem_for_test(&mut self, why: String) {
         self.network_problem = Some(why);
     }
 
     /// Gives the project's 3D skeleton the lift's depth choices `bones` (tests of the 3D view).
     #[cfg(test)]
-    pub fn set_depth_choices_for_test(&mut self, bones: Vec<[BoneDepth; BONE_COUNT]>) {
+    pub(crate) fn set_depth_choices_for_test(&mut self, bones: Vec<[BoneDepth; BONE_COUNT]>) {
         if let Some(skeleton) = self.project.as_ref().and_then(|p| p.skeleton.clone()) {
             self.choices.push(LiftChoices { skeleton, bones });
         }
@@ -316,7 +316,7 @@ impl State {
 
     /// Puts a project in place without a video (tests of the panels).
     #[cfg(test)]
-    pub fn set_project_for_test(&mut self, p: Project) {
+    pub(crate) fn set_project_for_test(&mut self, p: Project) {
         self.set_project(p);
     }
 
@@ -357,7 +357,7 @@ impl State {
     }
 
     /// Per frame by play time: advances the current frame while playing (the caller repaints).
-    pub fn play(&mut self, dt_s: f64) {
+    pub(crate) fn play(&mut self, dt_s: f64) {
         if !self.playing {
             return;
         }

@@ -27,7 +27,7 @@ impl MadeWith {
 
 /// A result that no longer matches the settings, with what changed in words.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Outdated {
+pub(crate) enum Outdated {
     /// The tracks: Track again.
     Tracks(String),
     /// The 3D skeleton: Lift again.
@@ -50,7 +50,7 @@ impl State {
 
     /// The results the settings changed under since they were made: the tracks, then the 3D
     /// skeleton (not while a job makes new ones).
-    pub fn outdated(&self) -> Vec<Outdated> {
+    pub(crate) fn outdated(&self) -> Vec<Outdated> {
         let Some(p) = self.project.as_ref().filter(|_| !self.busy()) else {
             return Vec::new();
         };

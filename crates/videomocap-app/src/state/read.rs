@@ -7,27 +7,27 @@ use super::*;
 impl State {
     /// The folder the app keeps its state in between sessions (recovery file, recent list,
     /// layout); `None`: nothing is kept.
-    pub fn state_dir(&self) -> Option<&Path> {
+    pub(crate) fn state_dir(&self) -> Option<&Path> {
         self.config.autosave_dir.as_deref()
     }
 
     /// The project being edited.
-    pub fn project(&self) -> Option<&Project> {
+    pub(crate) fn project(&self) -> Option<&Project> {
         self.project.as_ref()
     }
 
     /// Metadata of the open video.
-    pub fn video_info(&self) -> Option<&VideoInfo> {
+    pub(crate) fn video_info(&self) -> Option<&VideoInfo> {
         self.loader.as_ref().and_then(FrameLoader::info)
     }
 
     /// The frame loader of the open video (the status bar shows its seek proxy).
-    pub fn loader(&self) -> Option<&FrameLoader> {
+    pub(crate) fn loader(&self) -> Option<&FrameLoader> {
         self.loader.as_ref()
     }
 
     /// Number of frames of the open video or volume sequence (0 when none).
-    pub fn frame_count(&self) -> usize {
+    pub(crate) fn frame_count(&self) -> usize {
         match &self.volume {
             Some(v) => v.frame_count(),
             None => self.video_info().map_or(0, |i| i.frame_count),
@@ -35,7 +35,7 @@ impl State {
     }
 
     /// Frames per second of what is open (30 until known).
-    pub fn fps(&self) -> f64 {
+    pub(crate) fn fps(&self) -> f64 {
         match &self.volume {
             Some(v) => v.world.as_ref().map_or(30.0, |w| w.fps),
             None => self.video_info().map_or(30.0, |i| i.fps),
@@ -43,93 +43,93 @@ impl State {
     }
 
     /// Volume mode's state, when a point-volume sequence is open.
-    pub fn volume(&self) -> Option<&VolumeSequence> {
+    pub(crate) fn volume(&self) -> Option<&VolumeSequence> {
         self.volume.as_ref()
     }
 
     /// The frame the user is on.
-    pub fn current_frame(&self) -> usize {
+    pub(crate) fn current_frame(&self) -> usize {
         self.current
     }
 
     /// The status line.
-    pub fn status(&self) -> &str {
+    pub(crate) fn status(&self) -> &str {
         &self.status
     }
 
     /// The frame index the shown texture holds.
     #[cfg(test)]
-    pub fn shown(&self) -> Option<usize> {
+    pub(crate) fn shown(&self) -> Option<usize> {
         self.shown
     }
 
     /// Whether the texture is the seek proxy's preview of the current frame.
-    pub fn preview(&self) -> bool {
+    pub(crate) fn preview(&self) -> bool {
         self.preview
     }
 
     /// The picture of the current frame.
-    pub fn texture(&self) -> Option<&egui::TextureHandle> {
+    pub(crate) fn texture(&self) -> Option<&egui::TextureHandle> {
         self.texture.as_ref()
     }
 
     /// Whether a tracking, lifting or volume job runs.
-    pub fn busy(&self) -> bool {
+    pub(crate) fn busy(&self) -> bool {
         self.running.is_some()
     }
 
     /// The running job (the progress bar reads it).
-    pub fn job(&self) -> Option<&Job> {
+    pub(crate) fn job(&self) -> Option<&Job> {
         self.running.as_ref().map(|r| &r.job)
     }
 
     /// Whether dragging a joint moves the limb below it.
-    pub fn move_limb(&self) -> bool {
+    pub(crate) fn move_limb(&self) -> bool {
         self.move_limb
     }
 
     /// The edit undo would take back, if any.
-    pub fn undo_name(&self) -> Option<&str> {
+    pub(crate) fn undo_name(&self) -> Option<&str> {
         self.history.undo_name()
     }
 
     /// The edit redo would bring back, if any.
-    pub fn redo_name(&self) -> Option<&str> {
+    pub(crate) fn redo_name(&self) -> Option<&str> {
         self.history.redo_name()
     }
 
     /// The recent files (newest first).
-    pub fn recent(&self) -> &[PathBuf] {
+    pub(crate) fn recent(&self) -> &[PathBuf] {
         &self.recent
     }
 
     /// Whether playback runs.
-    pub fn playing(&self) -> bool {
+    pub(crate) fn playing(&self) -> bool {
         self.playing
     }
 
     /// Whether the shortcuts window shows.
-    pub fn show_help(&self) -> bool {
+    pub(crate) fn show_help(&self) -> bool {
         self.show_help
     }
 
     /// Whether the user guide window shows.
-    pub fn show_guide(&self) -> bool {
+    pub(crate) fn show_guide(&self) -> bool {
         self.show_guide
     }
 
     /// The reliability strips of the tracks.
-    pub fn strips(&self) -> Option<&Strips> {
+    pub(crate) fn strips(&self) -> Option<&Strips> {
         self.strips.as_ref()
     }
 
     /// The tracks' weak spans (fragments the user can jump to).
-    pub fn spans(&self) -> &[WeakSpan] {
+    pub(crate) fn spans(&self) -> &[WeakSpan] {
         &self.spans
     }
 
     /// How much of the tracks is weak: joint-frames in weak spans and all joint-frames.
-    pub fn weak_share(&self) -> Option<WeakShare> {
+    pub(crate) fn weak_share(&self) -> Option<WeakShare> {
         let tracks = self.project.as_ref()?.tracks.as_ref()?;
         Some(WeakShare {
             joint_frames: self.spans.iter().map(|s| s.frames()).sum(),
@@ -138,12 +138,12 @@ impl State {
     }
 
     /// What the last lift read of the subject.
-    pub fn subject_fit(&self) -> Option<&SubjectFit> {
+    pub(crate) fn subject_fit(&self) -> Option<&SubjectFit> {
         self.subject_fit.as_ref()
     }
 
     /// The 3D skeleton to show: the project's, or while a job makes the next one, the last.
-    pub fn shown_world(&self) -> Option<(&WorldSkeleton, &Skeleton3d)> {
+    pub(crate) fn shown_world(&self) -> Option<(&WorldSkeleton, &Skeleton3d)> {
         match &self.world {
             Some((w, s)) => Some((w, s.as_ref())),
             None if self.busy() => self.last_world.as_ref().map(|(w, s)| (w, s.as_ref())),
@@ -154,7 +154,7 @@ impl State {
     /// The bones whose depth choice the lift of the shown skeleton was unsure of on `frame`
     /// ([`BoneDepth::unsure`]: the other root explained the clip almost as well), worth a look
     /// and perhaps a flip. Empty when the lift's choices are not known (a loaded result).
-    pub fn unsure_bones(&self, frame: usize) -> Vec<Bone> {
+    pub(crate) fn unsure_bones(&self, frame: usize) -> Vec<Bone> {
         let Some((_, skeleton)) = self.shown_world() else {
             return Vec::new();
         };
@@ -178,48 +178,48 @@ impl State {
     }
 
     /// Whether the 3D skeleton shown is the last one, kept while a job makes the next.
-    pub fn world_is_stale(&self) -> bool {
+    pub(crate) fn world_is_stale(&self) -> bool {
         self.world.is_none() && self.busy() && self.last_world.is_some()
     }
 
     /// Whether a recovery prompt is showing.
-    pub fn offers_recovery(&self) -> bool {
+    pub(crate) fn offers_recovery(&self) -> bool {
         self.recovery.is_some()
     }
 
     /// A saved project of the video that was just opened without it, to offer.
-    pub fn project_beside(&self) -> Option<&Path> {
+    pub(crate) fn project_beside(&self) -> Option<&Path> {
         self.project_beside.as_deref()
     }
 
     /// Where the user is going once "save changes?" is answered (the prompt shows meanwhile).
-    pub fn leaving(&self) -> Option<&Leave> {
+    pub(crate) fn leaving(&self) -> Option<&Leave> {
         self.leaving.as_ref()
     }
 
     /// The app's own path field, when it shows.
-    pub fn path_request(&self) -> Option<&PathRequest> {
+    pub(crate) fn path_request(&self) -> Option<&PathRequest> {
         self.path_request.as_ref()
     }
 
     /// How many times something was opened (a change: the views fit the new frame).
-    pub fn opened(&self) -> u64 {
+    pub(crate) fn opened(&self) -> u64 {
         self.opened_count
     }
 
     /// Whether the user chose to quit and nothing is left to ask.
-    pub fn quitting(&self) -> bool {
+    pub(crate) fn quitting(&self) -> bool {
         self.quitting
     }
 
     /// Whether the project has changes not saved to a project file.
-    pub fn dirty(&self) -> bool {
+    pub(crate) fn dirty(&self) -> bool {
         self.dirty && self.project.is_some()
     }
 
     /// What to draw for a frame: keys win, then tracks arriving (a running job's, newer than the
     /// tracks it replaces), then the final tracks.
-    pub fn points(&self, frame: usize) -> PerJoint<Option<(Point2<f64>, PointState)>> {
+    pub(crate) fn points(&self, frame: usize) -> PerJoint<Option<(Point2<f64>, PointState)>> {
         let Some(p) = &self.project else {
             return PerJoint::from_fn(|_| None);
         };
@@ -243,7 +243,7 @@ impl State {
     }
 
     /// Why the pose network could not be loaded, when a tracking run found so.
-    pub fn network_problem(&self) -> Option<&str> {
+    pub(crate) fn network_problem(&self) -> Option<&str> {
         self.network_problem.as_deref()
     }
 }

@@ -8,12 +8,12 @@ use videomocap_core::skeleton::{JOINT_COUNT, Joint};
 use videomocap_core::track::KeyFrames;
 
 /// Runs of frames in one state: `(first, last, state)` as positions in the tracks.
-pub type Runs = Vec<(usize, usize, PointState)>;
+pub(super) type Runs = Vec<(usize, usize, PointState)>;
 
 /// Per joint, runs of frames in one state; and the same for the folded strip, each frame in
 /// the state of its most worrying joint.
 #[derive(Debug, Clone, Default)]
-pub struct Strips {
+pub(crate) struct Strips {
     runs: Vec<Runs>,
     worst: Runs,
 }
@@ -47,7 +47,7 @@ fn concern(state: PointState) -> u8 {
 
 impl Strips {
     /// Strips from tracks and the key frames; `weak` is the tracker's reliability threshold.
-    pub fn new(tracks: &Tracks2d, keys: &KeyFrames, weak: f32) -> Strips {
+    pub(crate) fn new(tracks: &Tracks2d, keys: &KeyFrames, weak: f32) -> Strips {
         let mut runs = vec![Runs::new(); JOINT_COUNT];
         let mut worst = Runs::new();
         for (k, f) in tracks.frames.iter().enumerate() {
@@ -69,22 +69,22 @@ impl Strips {
     }
 
     /// `joint`'s runs (the `row`th joint's).
-    pub fn runs(&self, row: usize) -> Option<&Runs> {
+    pub(crate) fn runs(&self, row: usize) -> Option<&Runs> {
         self.runs.get(row)
     }
 
     /// The folded strip's runs: each frame in the state of its most worrying joint.
-    pub fn worst(&self) -> &Runs {
+    pub(crate) fn worst(&self) -> &Runs {
         &self.worst
     }
 
     /// The state of `joint` at position `k` of the tracks.
-    pub fn state_at(&self, joint: Joint, k: usize) -> Option<PointState> {
+    pub(crate) fn state_at(&self, joint: Joint, k: usize) -> Option<PointState> {
         state_in(self.runs.get(joint.index())?, k)
     }
 
     /// The state of the most worrying joint at position `k`, and the joints in that state.
-    pub fn worst_at(&self, k: usize) -> Option<(PointState, Vec<Joint>)> {
+    pub(crate) fn worst_at(&self, k: usize) -> Option<(PointState, Vec<Joint>)> {
         let state = state_in(&self.worst, k)?;
         let joints = Joint::ALL
             .into_iter()

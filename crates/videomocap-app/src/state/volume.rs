@@ -7,7 +7,7 @@ use videomocap_core::export::WorldSkeleton;
 use videomocap_volume::Processed;
 
 /// What volume mode holds.
-pub struct VolumeSequence {
+pub(crate) struct VolumeSequence {
     /// The sequence directory.
     pub dir: PathBuf,
     /// The pipeline's output, once the job has finished.
@@ -22,7 +22,7 @@ pub struct VolumeSequence {
 
 /// The layers volume mode can draw (the skeleton always shows).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Layers {
+pub(crate) struct Layers {
     /// The points, coloured by body.
     pub points: bool,
     /// The skeleton curve.
@@ -43,7 +43,7 @@ impl Default for Layers {
 
 impl VolumeSequence {
     /// A sequence about to be processed.
-    pub fn new(dir: PathBuf) -> VolumeSequence {
+    pub(crate) fn new(dir: PathBuf) -> VolumeSequence {
         VolumeSequence {
             dir,
             processed: None,
@@ -54,19 +54,19 @@ impl VolumeSequence {
     }
 
     /// Number of frames (0 until processed).
-    pub fn frame_count(&self) -> usize {
+    pub(crate) fn frame_count(&self) -> usize {
         self.processed.as_ref().map_or(0, |p| p.files.len())
     }
 
     /// Takes the pipeline's result.
-    pub fn set(&mut self, processed: Processed) {
+    pub(crate) fn set(&mut self, processed: Processed) {
         self.world = WorldSkeleton::new(&processed.assembled.skeleton, None).ok();
         self.processed = Some(Arc::new(processed));
         self.failed = None;
     }
 
     /// Records why the pipeline failed on this sequence.
-    pub fn fail(&mut self, error: &str) {
+    pub(crate) fn fail(&mut self, error: &str) {
         // The pipeline's error starts with the folder, which the sentence names already.
         let prefix = format!("{}: ", self.dir.display());
         let error = error.strip_prefix(&prefix).unwrap_or(error);

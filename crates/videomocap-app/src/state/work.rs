@@ -86,7 +86,7 @@ impl State {
     }
 
     /// Takes in decoded frames and job events (once per drawn frame).
-    pub fn receive(&mut self) {
+    pub(crate) fn receive(&mut self) {
         if let Some(l) = &self.loader {
             l.pause_background(self.running.is_some());
         }

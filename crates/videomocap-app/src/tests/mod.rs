@@ -18,7 +18,7 @@ use nalgebra::Point2;
 use std::path::{Path, PathBuf};
 
 /// Steps the app until `done` holds (up to 30 s).
-pub fn wait(h: &mut Harness<'_, App>, what: &str, done: impl Fn(&State) -> bool) {
+pub(crate) fn wait(h: &mut Harness<'_, App>, what: &str, done: impl Fn(&State) -> bool) {
     for _ in 0..6000 {
         h.step();
         if done(h.state().state()) {
@@ -33,7 +33,7 @@ pub fn wait(h: &mut Harness<'_, App>, what: &str, done: impl Fn(&State) -> bool)
 }
 
 /// A press and release without moving.
-pub fn click(h: &mut Harness<'_, App>, pos: egui::Pos2) {
+pub(crate) fn click(h: &mut Harness<'_, App>, pos: egui::Pos2) {
     h.hover_at(pos);
     h.step();
     h.drag_at(pos);
@@ -44,7 +44,7 @@ pub fn click(h: &mut Harness<'_, App>, pos: egui::Pos2) {
 }
 
 /// A press, six moves and a release.
-pub fn drag(h: &mut Harness<'_, App>, from: egui::Pos2, to: egui::Pos2) {
+pub(crate) fn drag(h: &mut Harness<'_, App>, from: egui::Pos2, to: egui::Pos2) {
     h.hover_at(from);
     h.step();
     h.drag_at(from);
@@ -59,7 +59,7 @@ pub fn drag(h: &mut Harness<'_, App>, from: egui::Pos2, to: egui::Pos2) {
 }
 
 /// Where image point `p` is on the screen.
-pub fn screen(h: &Harness<'_, App>, p: Point2<f64>) -> egui::Pos2 {
+pub(crate) fn screen(h: &Harness<'_, App>, p: Point2<f64>) -> egui::Pos2 {
     h.state()
         .frame_view()
         .transform()
@@ -68,7 +68,7 @@ pub fn screen(h: &Harness<'_, App>, p: Point2<f64>) -> egui::Pos2 {
 }
 
 /// The app with prepared dialogs and its autosave in `state`, opening `video`.
-pub fn harness(
+pub(crate) fn harness(
     video: Option<PathBuf>,
     dialogs: &PreparedDialogs,
     state: &Path,
@@ -84,13 +84,13 @@ pub fn harness(
 }
 
 /// Flips `bone` on the current frame.
-pub fn flip(h: &mut Harness<'_, App>, bone: videomocap_core::skeleton::Bone) {
+pub(crate) fn flip(h: &mut Harness<'_, App>, bone: videomocap_core::skeleton::Bone) {
     h.state_mut().state_mut().apply(Intent::Flip(bone));
 }
 
 /// A camera of 640×480 pixels (focal 600 px) and a person standing 3 m in front of it, in
 /// camera space (metres, Y down).
-pub fn standing_person() -> (
+pub(crate) fn standing_person() -> (
     videomocap_core::camera::PinholeCamera,
     videomocap_core::skeleton::PerJoint<nalgebra::Point3<f64>>,
 ) {
@@ -125,7 +125,7 @@ pub fn standing_person() -> (
 
 /// A project on `video` with `n` frames tracked and lifted: the [`standing_person`] on every
 /// frame, frame 0 flagged with `flags_0`.
-pub fn lifted_project(
+pub(crate) fn lifted_project(
     video: PathBuf,
     n: usize,
     flags_0: &[&str],

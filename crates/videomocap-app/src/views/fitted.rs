@@ -11,7 +11,7 @@ const MIN_BAR: f32 = 40.0;
 const VALUE_SLACK: f32 = 24.0;
 
 /// Adds `slider` labelled `label`, its bar narrowed so the label fits in the width available.
-pub fn slider(ui: &mut egui::Ui, slider: egui::Slider<'_>, label: &str) -> egui::Response {
+pub(crate) fn slider(ui: &mut egui::Ui, slider: egui::Slider<'_>, label: &str) -> egui::Response {
     let label_w = egui::WidgetText::from(label)
         .into_galley(
             ui,
@@ -45,7 +45,7 @@ pub fn slider(ui: &mut egui::Ui, slider: egui::Slider<'_>, label: &str) -> egui:
 }
 
 /// Like [`slider`], greyed out unless `enabled`.
-pub fn slider_enabled(
+pub(crate) fn slider_enabled(
     ui: &mut egui::Ui,
     enabled: bool,
     s: egui::Slider<'_>,

@@ -10,7 +10,7 @@ use videomocap_core::skeleton::{Bone, Joint, PerJoint};
 
 /// How a drawn joint was obtained.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PointState {
+pub(crate) enum PointState {
     /// Placed by hand on this frame.
     Key,
     /// Tracked with good reliability.
@@ -28,7 +28,7 @@ pub enum PointState {
 impl PointState {
     /// The state of a tracked point that was not placed by hand; `weak` is the tracker's
     /// reliability threshold.
-    pub fn of(p: &TrackedPoint, weak: f32) -> PointState {
+    pub(crate) fn of(p: &TrackedPoint, weak: f32) -> PointState {
         match p.source {
             PointSource::Interpolated => PointState::Interpolated,
             PointSource::OffFrame => PointState::OffFrame,
@@ -39,7 +39,7 @@ impl PointState {
     }
 
     /// The state in words (the timeline's hover).
-    pub fn word(self) -> &'static str {
+    pub(crate) fn word(self) -> &'static str {
         match self {
             PointState::Key => "placed by you (white)",
             PointState::Tracked => "tracked (green)",
@@ -51,7 +51,7 @@ impl PointState {
     }
 
     /// Colour used in the frame view and the timeline.
-    pub fn colour(self) -> Color32 {
+    pub(crate) fn colour(self) -> Color32 {
         match self {
             PointState::Key => Color32::WHITE,
             PointState::Tracked => Color32::from_rgb(60, 200, 90),
@@ -64,7 +64,7 @@ impl PointState {
 }
 
 /// What to draw on the frame.
-pub struct Overlay {
+pub(crate) struct Overlay {
     /// Each joint's position and state, when known on this frame.
     pub points: PerJoint<Option<(Point2<f64>, PointState)>>,
     /// The joint the marking guide asks for next.
@@ -75,7 +75,7 @@ pub struct Overlay {
 
 /// What the user did in the view.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum ViewEvent {
+pub(crate) enum ViewEvent {
     /// A click (no drag) at this image position.
     Click(Point2<f64>),
     /// A joint dragged to a new image position (on release).
@@ -84,7 +84,7 @@ pub enum ViewEvent {
 
 /// Maps image pixels (centres at integers) to the screen and back.
 #[derive(Debug, Clone, Copy)]
-pub struct Transform {
+pub(crate) struct Transform {
     centre: Pos2,
     image_centre: Vec2,
     scale: f32,
@@ -92,12 +92,12 @@ pub struct Transform {
 
 impl Transform {
     /// Screen position of an image point.
-    pub fn to_screen(self, p: Point2<f64>) -> Pos2 {
+    pub(crate) fn to_screen(self, p: Point2<f64>) -> Pos2 {
         self.centre + (Vec2::new(p.x as f32, p.y as f32) - self.image_centre) * self.scale
     }
 
     /// Image point under a screen position.
-    pub fn to_image(self, s: Pos2) -> Point2<f64> {
+    pub(crate) fn to_image(self, s: Pos2) -> Point2<f64> {
         let v = (s - self.centre) / self.scale + self.image_centre;
         Point2::new(f64::from(v.x), f64::from(v.y))
     }
@@ -115,7 +115,7 @@ struct Grab {
 
 /// Zoom and pan of the frame view, and a joint being dragged.
 #[derive(Debug, Clone, Default)]
-pub struct FrameView {
+pub(crate) struct FrameView {
     /// 1 = the frame fits the view.
     zoom: f32,
     /// Image point at the view's centre (`None` = the image centre).
@@ -139,13 +139,13 @@ const DRAG_START_PX: f32 = 2.0;
 
 impl FrameView {
     /// Back to fitting the whole frame.
-    pub fn fit(&mut self) {
+    pub(crate) fn fit(&mut self) {
         self.zoom = 1.0;
         self.centre = None;
     }
 
     /// The zoom and the image point at the view's centre (kept across restarts per video).
-    pub fn zoom_state(&self) -> FrameZoom {
+    pub(crate) fn zoom_state(&self) -> FrameZoom {
         FrameZoom {
             zoom: if self.zoom > 0.0 { self.zoom } else { 1.0 },
             centre: self.centre.map(|c| [c.x, c.y]),
@@ -153,7 +153,7 @@ impl FrameView {
     }
 
     /// Zooms as `z` says (a zoom kept from an earlier session).
-    pub fn set_zoom_state(&mut self, z: FrameZoom) {
+    pub(crate) fn set_zoom_state(&mut self, z: FrameZoom) {
         self.zoom = if z.zoom.is_finite() {
             z.zoom.clamp(MIN_ZOOM, MAX_ZOOM)
         } else {
@@ -167,7 +167,7 @@ impl FrameView {
 
     /// The transform of the last frame drawn (tests use it to click on joints).
     #[cfg(test)]
-    pub fn transform(&self) -> Option<Transform> {
+    pub(crate) fn transform(&self) -> Option<Transform> {
         self.last
     }
 
@@ -183,7 +183,7 @@ impl FrameView {
 
     /// Draws the frame and the overlay; returns what the user did. `size` is the frame's size
     /// in pixels, which the texture is stretched over (a seek preview is smaller).
-    pub fn show(
+    pub(crate) fn show(
         &mut self,
         ui: &mut egui::Ui,
         texture: &egui::TextureHandle,
@@ -337,7 +337,7 @@ impl FrameView {
 }
 
 /// Bone colour by the side of the body (subject's left cyan, right orange, middle yellow).
-pub fn side_colour(j: Joint) -> Color32 {
+pub(crate) fn side_colour(j: Joint) -> Color32 {
     let name = j.name();
     if name.starts_with("left") {
         Color32::from_rgb(0, 200, 255)

@@ -6,12 +6,17 @@ use crate::state::State;
 
 /// Space's state between frames: a tap plays or pauses; held while dragging, it pans instead.
 #[derive(Debug, Default)]
-pub struct SpaceKey {
+pub(crate) struct SpaceKey {
     dragged: bool,
 }
 
 /// Reads this frame's keys; what they ask for goes to `out`.
-pub fn read(ctx: &egui::Context, state: &State, space: &mut SpaceKey, out: &mut Vec<Intent>) {
+pub(crate) fn read(
+    ctx: &egui::Context,
+    state: &State,
+    space: &mut SpaceKey,
+    out: &mut Vec<Intent>,
+) {
     if ctx.egui_wants_keyboard_input() {
         return;
     }

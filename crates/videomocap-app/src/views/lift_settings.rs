@@ -10,7 +10,7 @@ fn on_off(b: bool) -> &'static str {
 }
 
 /// Edits `l` in place; the caller records the change (undo, autosave).
-pub fn lift_settings_ui(ui: &mut egui::Ui, l: &mut LiftParams) {
+pub(crate) fn lift_settings_ui(ui: &mut egui::Ui, l: &mut LiftParams) {
     let d = LiftParams::default();
     ui.checkbox(&mut l.refine, "global refinement").on_hover_text(format!(
         "After the per-frame solve, one least-squares pass over the whole clip (reprojection, bone \

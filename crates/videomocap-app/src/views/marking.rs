@@ -6,7 +6,13 @@ use videomocap_core::skeleton::{Bone, Joint, MarkingView};
 
 /// Draws the guide for joint `k` of [`Joint::MARKING_ORDER`], in the words and with the diagram
 /// for a subject seen from the front or from behind; Skip, Done and the view go to `out`.
-pub fn show(ui: &mut egui::Ui, k: usize, joint: Joint, view: MarkingView, out: &mut Vec<Intent>) {
+pub(crate) fn show(
+    ui: &mut egui::Ui,
+    k: usize,
+    joint: Joint,
+    view: MarkingView,
+    out: &mut Vec<Intent>,
+) {
     let behind = view == MarkingView::Behind;
     ui.heading("Marking");
     ui.label(format!("{} of 16: {}", k + 1, joint_words(joint)));
@@ -46,12 +52,12 @@ pub fn show(ui: &mut egui::Ui, k: usize, joint: Joint, view: MarkingView, out: &
 }
 
 /// The joint in words: "left shoulder".
-pub fn joint_words(joint: Joint) -> String {
+pub(crate) fn joint_words(joint: Joint) -> String {
     joint.name().replace('_', " ")
 }
 
 /// Which side of the image the subject's own left or right lies on, for a side's joint.
-pub fn side_words(joint: Joint, behind: bool) -> Option<String> {
+pub(crate) fn side_words(joint: Joint, behind: bool) -> Option<String> {
     let name = joint.name();
     let left = name.starts_with("left");
     if !left && !name.starts_with("right") {

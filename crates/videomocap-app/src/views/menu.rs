@@ -5,7 +5,7 @@ use crate::intent::Intent;
 use crate::state::{Choose, ExportKind, State};
 
 /// Draws the menu bar; the user's choices go to `out`.
-pub fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
+pub(crate) fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
     egui::MenuBar::new().ui(ui, |ui| {
         ui.menu_button("File", |ui| file(ui, state, out));
         ui.menu_button("Edit", |ui| edit(ui, state, out));

@@ -7,16 +7,16 @@
 //! drawing what `scene` builds, `status_bar` (status line, job progress), `windows` (prompts,
 //! the path field, shortcuts, the user guide) and `keys` (keyboard shortcuts).
 
-pub mod fitted;
-pub mod frame_view;
-pub mod keys;
-pub mod lift_settings;
-pub mod marking;
-pub mod menu;
-pub mod scene;
-pub mod side_panel;
-pub mod status_bar;
-pub mod timeline;
-pub mod tracker_settings;
-pub mod view3d;
-pub mod windows;
+pub(crate) mod fitted;
+pub(crate) mod frame_view;
+pub(crate) mod keys;
+pub(crate) mod lift_settings;
+pub(crate) mod marking;
+pub(crate) mod menu;
+pub(crate) mod scene;
+pub(crate) mod side_panel;
+pub(crate) mod status_bar;
+pub(crate) mod timeline;
+pub(crate) mod tracker_settings;
+pub(crate) mod view3d;
+pub(crate) mod windows;

@@ -19,7 +19,7 @@ const MAX_POINTS: usize = 6000;
 
 /// The scene of the current frame: the skeleton (the last one, marked so, while a job makes the
 /// next), the camera's frustum, the bones that can be flipped and those the lift flagged.
-pub fn scene(state: &State) -> Scene {
+pub(crate) fn scene(state: &State) -> Scene {
     let current = state.current_frame();
     if let Some(v) = state.volume() {
         return volume_scene(v, current);
@@ -117,7 +117,7 @@ pub fn scene(state: &State) -> Scene {
 /// A lift flag of the frame in words: what it is, the bone or joint it concerns, and what to
 /// do about it. `marked` says which joints the user placed on this frame (their own marks are
 /// what to check, not the tracker). A planted foot is information, not a problem.
-pub fn flag_note(flag: &str, marked: &dyn Fn(Joint) -> bool) -> Note {
+pub(crate) fn flag_note(flag: &str, marked: &dyn Fn(Joint) -> bool) -> Note {
     use videomocap_core::formats::{
         LOST_FLAG, NO_IMAGE_DEPTH_FLAG, OFF_FRAME_FLAG, UNUSUAL_POSE_FLAG,
     };
@@ -189,7 +189,7 @@ fn foot_words(ankle: Joint) -> &'static str {
 }
 
 /// The scene of frame `index` of a point-volume sequence.
-pub fn volume_scene(v: &VolumeSequence, index: usize) -> Scene {
+pub(crate) fn volume_scene(v: &VolumeSequence, index: usize) -> Scene {
     let mut scene = Scene::default();
     let (Some(p), Some(world)) = (&v.processed, &v.world) else {
         scene.empty_text = Some(v.failed.clone().unwrap_or_else(|| {

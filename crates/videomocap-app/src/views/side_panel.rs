@@ -10,7 +10,7 @@ use crate::state::{Outdated, State};
 use videomocap_core::lift::default_focal;
 
 /// Draws the panel; what the user changed goes to `out`.
-pub fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
+pub(crate) fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
     if let Some(v) = state.volume() {
         volume(ui, v, state.current_frame(), out);
         return;

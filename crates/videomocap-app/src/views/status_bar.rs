@@ -7,10 +7,10 @@ use crate::state::State;
 use crate::state::frame_loader::ProxyStatus;
 
 /// The bar's height, points (the progress bar and the Cancel button fit in it).
-pub const HEIGHT: f32 = 26.0;
+pub(crate) const HEIGHT: f32 = 26.0;
 
 /// Draws the bar; Cancel goes to `out`.
-pub fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
+pub(crate) fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
     ui.horizontal_centered(|ui| {
         ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
             progress(ui, state, out);

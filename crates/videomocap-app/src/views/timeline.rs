@@ -14,7 +14,7 @@ use videomocap_core::skeleton::{JOINT_COUNT, Joint, PerJoint};
 use videomocap_core::track::KeyFrames;
 
 /// Width of the joint names left of the strips, points.
-pub const LABEL_W: f32 = 44.0;
+pub(crate) const LABEL_W: f32 = 44.0;
 /// Height of one joint's strip, points (and its label's font: at 9 the names read about 7 px
 /// tall, too small to read at a glance).
 pub(crate) const STRIP_H: f32 = 11.0;
@@ -23,10 +23,10 @@ const TICKS_H: f32 = 5.0;
 
 /// The height the unfolded strips take beyond the folded one, points: what folding gives back
 /// to the video.
-pub const UNFOLDED_EXTRA_H: f32 = STRIP_H * (JOINT_COUNT - 1) as f32;
+pub(crate) const UNFOLDED_EXTRA_H: f32 = STRIP_H * (JOINT_COUNT - 1) as f32;
 
 /// A joint's name short enough for the strip's label.
-pub fn short_name(j: Joint) -> &'static str {
+pub(crate) fn short_name(j: Joint) -> &'static str {
     match j {
         Joint::HeadTop => "head",
         Joint::Neck => "neck",
@@ -98,7 +98,12 @@ impl Geometry {
 
 /// Draws the timeline, a strip per joint when `each_joint`, else the folded strip; Play and
 /// jumps go to `out`. Returns `true` when the user asked to fold or unfold the strips.
-pub fn show(ui: &mut egui::Ui, state: &State, each_joint: bool, out: &mut Vec<Intent>) -> bool {
+pub(crate) fn show(
+    ui: &mut egui::Ui,
+    state: &State,
+    each_joint: bool,
+    out: &mut Vec<Intent>,
+) -> bool {
     let marked = marked(state);
     let (rail, fold) = scrubber(ui, state, each_joint, out);
     // Before tracking there is nothing to show in the strips: the ticks alone, and the frame

@@ -10,7 +10,7 @@ fn on_off(b: bool) -> &'static str {
 }
 
 /// Edits `t` in place; the caller turns the change into an undoable edit.
-pub fn tracker_settings_ui(ui: &mut egui::Ui, t: &mut TrackerParams) {
+pub(crate) fn tracker_settings_ui(ui: &mut egui::Ui, t: &mut TrackerParams) {
     let d = TrackerParams::default();
     ui.checkbox(&mut t.network, "use the pose network")
         .on_hover_text(format!("A pose network (BlazePose, run on this computer) looks at every frame around the person you marked; where it sees a joint elsewhere than the tracker and is sure, its place is taken. Your marks and corrections always win. Off: the tracker alone; default {}", on_off(d.network)));

@@ -11,7 +11,7 @@ use videomocap_core::skeleton::{Bone, Joint, PerJoint};
 
 /// What the viewport shows.
 #[derive(Default)]
-pub struct Scene {
+pub(crate) struct Scene {
     /// The skeleton of the current frame, world metres.
     pub joints: Option<PerJoint<Point3<f64>>>,
     /// The camera's centre and its image corners at 0.5 m depth, world metres.
@@ -41,7 +41,7 @@ pub struct Scene {
 
 /// Whether a note over the 3D view is a problem to look at or information.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-pub enum NoteKind {
+pub(crate) enum NoteKind {
     /// Something to check or act on (orange).
     Warning,
     /// A state worth knowing, nothing to do (grey).
@@ -50,7 +50,7 @@ pub enum NoteKind {
 
 /// A line written over the 3D view.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Note {
+pub(crate) struct Note {
     /// The words.
     pub text: String,
     /// Problem or information.
@@ -59,7 +59,7 @@ pub struct Note {
 
 impl Note {
     /// Something to check or act on.
-    pub fn warning(text: String) -> Note {
+    pub(crate) fn warning(text: String) -> Note {
         Note {
             text,
             kind: NoteKind::Warning,
@@ -67,7 +67,7 @@ impl Note {
     }
 
     /// A state worth knowing.
-    pub fn info(text: String) -> Note {
+    pub(crate) fn info(text: String) -> Note {
         Note {
             text,
             kind: NoteKind::Info,
@@ -83,19 +83,19 @@ impl Note {
 }
 
 /// Colour of a bone the lift flagged.
-pub const FLAGGED: Color32 = Color32::from_rgb(230, 60, 60);
+pub(crate) const FLAGGED: Color32 = Color32::from_rgb(230, 60, 60);
 
 /// Colour of a bone whose depth the lift was unsure of: magenta, the hue farthest from every
 /// other colour of the view (the sides' cyan and orange, the middle's yellow, the flagged red,
 /// the frustum's lavender); the amber it replaced sat next to the middle's yellow.
-pub const DOUBT: Color32 = Color32::from_rgb(255, 40, 255);
+pub(crate) const DOUBT: Color32 = Color32::from_rgb(255, 40, 255);
 
 /// Width of an unsure bone, points (a normal bone is 2.5: a short hip segment drawn thin in
 /// a doubt colour went unseen).
 const DOUBT_WIDTH: f32 = 6.0;
 
 /// Colour of a planted foot (the 3D view's ring under the ankle and the timeline's bar).
-pub const PLANTED: Color32 = Color32::from_rgb(150, 100, 50);
+pub(crate) const PLANTED: Color32 = Color32::from_rgb(150, 100, 50);
 
 /// The orbit's default lens: the focal length over the view's height (about 45° seen top to
 /// bottom).
@@ -103,7 +103,7 @@ const DEFAULT_LENS: f32 = 1.2;
 
 /// An orbiting view around a target point.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Orbit {
+pub(crate) struct Orbit {
     /// Turn about the vertical, radians.
     pub yaw: f32,
     /// Tilt above the horizon, radians.
@@ -136,7 +136,7 @@ impl Orbit {
     /// The view from the video camera's centre `eye` (world metres) towards `target`, so the
     /// 3D skeleton first reads as the video does (a one-leg balance seen from an arbitrary
     /// side read as standing with legs apart).
-    pub fn from_camera(eye: &Point3<f64>, target: Vector3<f32>) -> Orbit {
+    pub(crate) fn from_camera(eye: &Point3<f64>, target: Vector3<f32>) -> Orbit {
         let eye = Vector3::new(eye.x as f32, eye.y as f32, eye.z as f32);
         let back = eye - target;
         let distance = back.norm().max(1.0);
@@ -157,7 +157,7 @@ impl Orbit {
     /// video, so the skeleton lies as it does over the video. `depth_m` is how far along the
     /// axis the view turns about (the subject's distance). Not following: the camera stands.
     /// `None` for a degenerate frustum.
-    pub fn through_camera(
+    pub(crate) fn through_camera(
         eye: &Point3<f64>,
         corners: &[Point3<f64>; 4],
         depth_m: f64,
@@ -201,7 +201,7 @@ impl Orbit {
     }
 
     /// Screen position of a world point (`None` behind the eye).
-    pub fn project(&self, rect: Rect, p: &Point3<f64>) -> Option<Pos2> {
+    pub(crate) fn project(&self, rect: Rect, p: &Point3<f64>) -> Option<Pos2> {
         let (eye, right, up, forward) = self.basis();
         let d = Vector3::new(p.x as f32, p.y as f32, p.z as f32) - eye;
         let z = d.dot(&forward);
@@ -213,7 +213,7 @@ impl Orbit {
     }
 
     /// Draws the scene; returns a bone the user clicked.
-    pub fn show(&mut self, ui: &mut egui::Ui, scene: &Scene) -> Option<Bone> {
+    pub(crate) fn show(&mut self, ui: &mut egui::Ui, scene: &Scene) -> Option<Bone> {
         let rect = ui.available_rect_before_wrap();
         let response = ui.allocate_rect(rect, Sense::click_and_drag());
         if response.dragged_by(egui::PointerButton::Primary) {

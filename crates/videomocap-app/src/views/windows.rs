@@ -26,7 +26,7 @@ static GUIDE_SHOWN: std::sync::LazyLock<String> = std::sync::LazyLock::new(|| {
 });
 
 /// The keyboard and mouse shortcuts listed in the F1 window.
-pub const SHORTCUTS: &[(&str, &str)] = &[
+pub(crate) const SHORTCUTS: &[(&str, &str)] = &[
     ("Left / Right", "previous / next frame"),
     ("Shift + Left / Right", "ten frames back / forward"),
     ("Home / End", "first / last frame"),
@@ -46,7 +46,7 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
 
 /// Draws whichever windows the state asks for; answers go to `out`. `guide` keeps the guide's
 /// rendering between frames.
-pub fn show(
+pub(crate) fn show(
     ctx: &egui::Context,
     state: &State,
     guide: &mut egui_commonmark::CommonMarkCache,

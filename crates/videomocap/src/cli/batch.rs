@@ -29,7 +29,7 @@ use videomocap_core::formats::write_atomically;
 use videomocap_core::track::TrackerParams;
 
 /// `batch`.
-pub fn run(a: &BatchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+pub(super) fn run(a: &BatchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let rows = read_manifest(&a.manifest)?;
     let shard = a.shard.as_deref().map(shard::parse_shard).transpose()?;
     if a.jobs == 0 {

@@ -9,7 +9,7 @@ use std::sync::atomic::AtomicBool;
 use videomocap_volume::VolumeError;
 use videomocap_volume::carve::{carve_sequence, open_setup};
 
-pub fn run(a: &CarveArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+pub(super) fn run(a: &CarveArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     if !(a.voxel_mm.is_finite() && a.voxel_mm >= 5.0) {
         return Err(ExitError::bad_input(anyhow!(
             "--voxel-mm must be at least 5, got {}",

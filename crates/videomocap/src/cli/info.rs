@@ -5,7 +5,7 @@ use super::args::GlobalArgs;
 use std::path::Path;
 use videomocap_core::video::{OpenOptions, Video};
 
-pub fn run(path: &Path, global: &GlobalArgs) -> Result<(), ExitError> {
+pub(super) fn run(path: &Path, global: &GlobalArgs) -> Result<(), ExitError> {
     let video = Video::open(path, &OpenOptions::default()).map_err(ExitError::bad_input)?;
     let info = video.info();
     if global.json {

@@ -9,15 +9,15 @@ use videomocap_core::skeleton::Joint;
 use videomocap_core::track::{SpanKind, TrackerParams};
 
 /// File names `run` writes in its output directory.
-pub const TRACKS_JSON: &str = "tracks2d.json";
-pub const TRACKS_CSV: &str = "tracks2d.csv";
-pub const SKELETON_JSON: &str = "skeleton3d.json";
-pub const BVH: &str = "motion.bvh";
-pub const JOINTS_CSV: &str = "joints3d.csv";
-pub const TRC: &str = "motion.trc";
+pub(super) const TRACKS_JSON: &str = "tracks2d.json";
+pub(super) const TRACKS_CSV: &str = "tracks2d.csv";
+pub(super) const SKELETON_JSON: &str = "skeleton3d.json";
+pub(super) const BVH: &str = "motion.bvh";
+pub(super) const JOINTS_CSV: &str = "joints3d.csv";
+pub(super) const TRC: &str = "motion.trc";
 
 /// `run`.
-pub fn run(a: &RunArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+pub(super) fn run(a: &RunArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let threads = super::cpus::thread_budget(a.threads)?.threads;
     super::cpus::limit_global_pool(threads);
     run_into(
@@ -37,7 +37,7 @@ pub fn run(a: &RunArgs, global: &GlobalArgs) -> Result<(), ExitError> {
 }
 
 /// What one `run` works from.
-pub struct RunInput<'a> {
+pub(super) struct RunInput<'a> {
     /// The video (or image folder).
     pub video: &'a Path,
     /// A marks file, or
@@ -56,7 +56,7 @@ pub struct RunInput<'a> {
 
 /// What one `run` found, for reports.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RunReport {
+pub(super) struct RunReport {
     /// Frames of the clip.
     pub frames: usize,
     /// Joint-frames left weak, lost or off the frame (not interpolated), percent.
@@ -66,7 +66,7 @@ pub struct RunReport {
 }
 
 /// Tracks, lifts and exports into `out_dir` (created if missing).
-pub fn run_into(
+pub(super) fn run_into(
     input: &RunInput,
     out_dir: &Path,
     global: &GlobalArgs,

@@ -9,7 +9,7 @@ use anyhow::anyhow;
 use std::sync::atomic::AtomicBool;
 use videomocap_volume::{SequenceError, VolumeParams, process_directory};
 
-pub fn run(a: &VolumeArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+pub(super) fn run(a: &VolumeArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let meta = std::fs::metadata(&a.input)
         .map_err(|e| ExitError::bad_input(anyhow!("{}: cannot open: {e}", a.input.display())))?;
     if !meta.is_dir() {

@@ -8,17 +8,17 @@ use videomocap_core::skeleton::{Joint, PerJoint};
 
 /// Radii of the body's primitives as fractions of stature (a slim adult in clothes).
 mod radius {
-    pub const NECK: f64 = 0.030;
-    pub const SPINE_CHEST: f64 = 0.080;
-    pub const SPINE_PELVIS: f64 = 0.070;
-    pub const SHOULDER_GIRDLE: f64 = 0.045;
-    pub const HIP_GIRDLE: f64 = 0.060;
-    pub const UPPER_ARM: (f64, f64) = (0.032, 0.026);
-    pub const FOREARM: (f64, f64) = (0.025, 0.019);
-    pub const THIGH: (f64, f64) = (0.050, 0.034);
-    pub const SHANK: (f64, f64) = (0.033, 0.024);
+    pub(super) const NECK: f64 = 0.030;
+    pub(super) const SPINE_CHEST: f64 = 0.080;
+    pub(super) const SPINE_PELVIS: f64 = 0.070;
+    pub(super) const SHOULDER_GIRDLE: f64 = 0.045;
+    pub(super) const HIP_GIRDLE: f64 = 0.060;
+    pub(super) const UPPER_ARM: (f64, f64) = (0.032, 0.026);
+    pub(super) const FOREARM: (f64, f64) = (0.025, 0.019);
+    pub(super) const THIGH: (f64, f64) = (0.050, 0.034);
+    pub(super) const SHANK: (f64, f64) = (0.033, 0.024);
     /// Head semi-axes: up, across, front-back.
-    pub const HEAD: (f64, f64, f64) = (0.068, 0.050, 0.058);
+    pub(super) const HEAD: (f64, f64, f64) = (0.068, 0.050, 0.058);
 }
 
 /// A tapered capsule: the union of spheres swept from `a` (radius `ra`) to `b` (radius `rb`).
@@ -110,12 +110,16 @@ pub(super) fn v(p: &Point3<f64>) -> Vector3<f64> {
 impl Body {
     /// Builds the primitives for joints given in camera space, for a subject of `stature_m`
     /// in the default clothes.
-    pub fn new(points: &PerJoint<Point3<f64>>, stature_m: f64) -> Body {
+    pub(super) fn new(points: &PerJoint<Point3<f64>>, stature_m: f64) -> Body {
         Body::dressed(points, stature_m, Appearance::default())
     }
 
     /// [`Body::new`] in the given clothes (loose clothes widen the clothed parts).
-    pub fn dressed(points: &PerJoint<Point3<f64>>, stature_m: f64, appearance: Appearance) -> Body {
+    pub(super) fn dressed(
+        points: &PerJoint<Point3<f64>>,
+        stature_m: f64,
+        appearance: Appearance,
+    ) -> Body {
         use Joint::*;
         let s = stature_m;
         let p = |j: Joint| v(&points[j]);
@@ -251,7 +255,7 @@ impl Body {
     }
 
     /// Whether `p` lies inside the body (for voxelising it: `synth --volume`).
-    pub fn contains(&self, p: &Point3<f64>) -> bool {
+    pub(super) fn contains(&self, p: &Point3<f64>) -> bool {
         let p = v(p);
         (self.head.to_unit * (p - self.head.centre)).norm_squared() <= 1.0
             || self.cones.iter().any(|c| {
@@ -261,7 +265,7 @@ impl Body {
     }
 
     /// An axis-aligned box holding the whole body: (lowest corner, highest corner).
-    pub fn bounds(&self) -> (Point3<f64>, Point3<f64>) {
+    pub(super) fn bounds(&self) -> (Point3<f64>, Point3<f64>) {
         let (mut lo, mut hi) = (
             Vector3::repeat(f64::INFINITY),
             Vector3::repeat(f64::NEG_INFINITY),

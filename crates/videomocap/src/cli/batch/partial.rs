@@ -50,7 +50,7 @@ pub(super) struct Partial {
 
 impl Partial {
     /// Creates this process's temporary folder for row `id` in `out_dir`, with its owner file.
-    pub fn create(out_dir: &Path, id: &str) -> std::io::Result<Partial> {
+    pub(super) fn create(out_dir: &Path, id: &str) -> std::io::Result<Partial> {
         let owner = Owner {
             id: id.to_owned(),
             host: host_name(),
@@ -71,7 +71,7 @@ impl Partial {
     }
 
     /// Runs `work` while a thread rewrites the owner file every [`HEARTBEAT`].
-    pub fn with_heartbeat<T>(&self, work: impl FnOnce() -> T) -> T {
+    pub(super) fn with_heartbeat<T>(&self, work: impl FnOnce() -> T) -> T {
         let (stop, stopped) = mpsc::channel::<()>();
         std::thread::scope(|s| {
             s.spawn(move || {
@@ -86,12 +86,12 @@ impl Partial {
     }
 
     /// Removes the owner file: the folder holds the row's results only, ready to be renamed.
-    pub fn seal(&self) -> std::io::Result<()> {
+    pub(super) fn seal(&self) -> std::io::Result<()> {
         std::fs::remove_file(self.path.join(OWNER))
     }
 
     /// Removes the folder (a failed row, or one that could not be renamed).
-    pub fn discard(&self) {
+    pub(super) fn discard(&self) {
         let _ = std::fs::remove_dir_all(&self.path);
     }
 }

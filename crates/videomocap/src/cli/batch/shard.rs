@@ -25,7 +25,7 @@ pub(super) struct Shard {
 
 impl Shard {
     /// Whether the row at `position` (0-based, in manifest order) belongs to this shard.
-    pub fn holds(&self, position: usize) -> bool {
+    pub(super) fn holds(&self, position: usize) -> bool {
         position % self.count == self.index
     }
 }

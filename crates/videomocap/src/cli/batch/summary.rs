@@ -10,9 +10,9 @@ use std::path::Path;
 use videomocap_core::track::TrackerParams;
 
 /// Each row's status file, in its folder.
-pub const STATUS_JSON: &str = "status.json";
+pub(super) const STATUS_JSON: &str = "status.json";
 /// The batch's summary, in the output folder.
-pub const SUMMARY_CSV: &str = "summary.csv";
+pub(super) const SUMMARY_CSV: &str = "summary.csv";
 /// Skipped rows named in the report before the rest are only counted.
 const SKIPPED_NAMED: usize = 10;
 
@@ -54,7 +54,7 @@ pub(super) struct Status {
 
 impl Status {
     /// A status of `row` with nothing filled in yet.
-    pub fn blank(row: &Row) -> Status {
+    pub(super) fn blank(row: &Row) -> Status {
         Status {
             format: "videomocap.batch-status".into(),
             version: 1,

@@ -46,7 +46,7 @@ pub(super) struct BoneAxes {
 
 impl BoneAxes {
     /// Metres along the bone and angle around it (radians) of the rest point `p`.
-    pub fn pattern_coordinates(&self, p: &Vector3<f64>) -> (f64, f64) {
+    pub(super) fn pattern_coordinates(&self, p: &Vector3<f64>) -> (f64, f64) {
         let d = p - self.head;
         (
             d.dot(&self.axis),
@@ -108,7 +108,7 @@ fn bad(what: impl std::fmt::Display) -> MeshError {
 
 impl RestMesh {
     /// Reads the bundled mesh, rig and weights.
-    pub fn load() -> Result<RestMesh, MeshError> {
+    pub(super) fn load() -> Result<RestMesh, MeshError> {
         let mut obj = String::new();
         GzDecoder::new(OBJ_GZ)
             .read_to_string(&mut obj)
