@@ -216,6 +216,32 @@ impl Orbit {
     pub(crate) fn show(&mut self, ui: &mut egui::Ui, scene: &Scene) -> Option<Bone> {
         let rect = ui.available_rect_before_wrap();
         let response = ui.allocate_rect(rect, Sense::click_and_drag());
+        self.steer(ui, &response, rect, scene);
+        let painter = ui.painter_at(rect);
+        painter.rect_filled(rect, 0.0, Color32::from_gray(24));
+        let pen = Pen {
+            orbit: self,
+            painter: &painter,
+            rect,
+        };
+        pen.floor();
+        pen.camera_cloud_and_segments(scene);
+        let clicked = match &scene.joints {
+            Some(joints) => pen.skeleton(scene, joints, &response),
+            None => {
+                if scene.cloud.is_empty() {
+                    pen.empty_text(scene);
+                }
+                None
+            }
+        };
+        pen.notes(scene);
+        clicked
+    }
+
+    /// Turns (left drag), pans (middle or right drag, which stops following the pelvis),
+    /// follows the pelvis, and zooms (scroll over the view).
+    fn steer(&mut self, ui: &egui::Ui, response: &egui::Response, rect: Rect, scene: &Scene) {
         if response.dragged_by(egui::PointerButton::Primary) {
             let d = response.drag_delta();
             self.yaw -= d.x * 0.01;
@@ -240,142 +266,180 @@ impl Orbit {
             let scroll = ui.input(|i| i.smooth_scroll_delta.y);
             self.distance = (self.distance * (-scroll * 0.002).exp()).clamp(0.5, 50.0);
         }
-        let painter = ui.painter_at(rect);
-        painter.rect_filled(rect, 0.0, Color32::from_gray(24));
-        let line = |a: &Point3<f64>, b: &Point3<f64>, stroke: Stroke| {
-            if let (Some(p), Some(q)) = (self.project(rect, a), self.project(rect, b)) {
-                painter.line_segment([p, q], stroke);
-            }
-        };
-        // 6 m of floor in half-metre squares around the target, fixed to the world (it slides
-        // by as a followed walker moves).
+    }
+}
+
+/// What draws the scene: the orbit's projection onto the view's rectangle.
+struct Pen<'a> {
+    orbit: &'a Orbit,
+    painter: &'a egui::Painter,
+    rect: Rect,
+}
+
+impl Pen<'_> {
+    fn project(&self, p: &Point3<f64>) -> Option<Pos2> {
+        self.orbit.project(self.rect, p)
+    }
+
+    fn line(&self, a: &Point3<f64>, b: &Point3<f64>, stroke: Stroke) {
+        if let (Some(p), Some(q)) = (self.project(a), self.project(b)) {
+            self.painter.line_segment([p, q], stroke);
+        }
+    }
+
+    /// 6 m of floor in half-metre squares around the target, fixed to the world (it slides by as
+    /// a followed walker moves).
+    fn floor(&self) {
         let grid = Stroke::new(1.0, Color32::from_gray(70));
         let snap = |v: f32| (f64::from(v) / 0.5).round() * 0.5;
-        let (gx, gz) = (snap(self.target.x), snap(self.target.z));
+        let (gx, gz) = (snap(self.orbit.target.x), snap(self.orbit.target.z));
         for k in -6..=6 {
             let v = f64::from(k) * 0.5;
-            line(
+            self.line(
                 &Point3::new(gx + v, 0.0, gz - 3.0),
                 &Point3::new(gx + v, 0.0, gz + 3.0),
                 grid,
             );
-            line(
+            self.line(
                 &Point3::new(gx - 3.0, 0.0, gz + v),
                 &Point3::new(gx + 3.0, 0.0, gz + v),
                 grid,
             );
         }
+    }
+
+    /// The camera's frustum, the point cloud and the scene's own segments.
+    fn camera_cloud_and_segments(&self, scene: &Scene) {
         if let Some((c, corners)) = &scene.camera {
             let s = Stroke::new(1.0, Color32::from_rgb(180, 180, 255));
             for k in 0..4 {
-                line(c, &corners[k], s);
-                line(&corners[k], &corners[(k + 1) % 4], s);
+                self.line(c, &corners[k], s);
+                self.line(&corners[k], &corners[(k + 1) % 4], s);
             }
         }
         for (p, colour) in &scene.cloud {
-            if let Some(s) = self.project(rect, p) {
-                painter.circle_filled(s, 1.5, *colour);
+            if let Some(s) = self.project(p) {
+                self.painter.circle_filled(s, 1.5, *colour);
             }
         }
         for (a, b, stroke) in &scene.segments {
-            line(a, b, *stroke);
+            self.line(a, b, *stroke);
         }
-        let mut clicked = None;
-        if let Some(joints) = &scene.joints {
-            let hover = response.hover_pos();
-            let near_bone = |pos: Pos2| -> Option<Bone> {
-                scene
-                    .flippable
-                    .iter()
-                    .filter_map(|b| {
-                        let p = self.project(rect, &joints[b.parent])?;
-                        let q = self.project(rect, &joints[b.child])?;
-                        let d = distance_to_segment(pos, p, q);
-                        (d < 8.0).then_some((*b, d))
-                    })
-                    .min_by(|a, b| a.1.total_cmp(&b.1))
-                    .map(|(b, _)| b)
-            };
-            let hovered = hover.and_then(near_bone);
-            if let Some(ghost) = &scene.ghost {
-                let grey = Stroke::new(2.0, Color32::from_gray(110));
-                for b in Bone::ALL {
-                    line(&ghost[b.parent], &ghost[b.child], grey);
-                }
-            }
-            for ankle in &scene.planted {
-                let a = joints[*ankle];
-                let ring = |t: f64| Point3::new(a.x + 0.12 * t.cos(), 0.0, a.z + 0.12 * t.sin());
-                for k in 0..12 {
-                    let t = std::f64::consts::TAU * f64::from(k) / 12.0;
-                    let dt = std::f64::consts::TAU / 12.0;
-                    line(&ring(t), &ring(t + dt), Stroke::new(2.5, PLANTED));
-                }
-            }
+    }
+
+    /// The flippable bone nearest `pos` on screen (within 8 px).
+    fn near_bone(&self, scene: &Scene, joints: &PerJoint<Point3<f64>>, pos: Pos2) -> Option<Bone> {
+        scene
+            .flippable
+            .iter()
+            .filter_map(|b| {
+                let p = self.project(&joints[b.parent])?;
+                let q = self.project(&joints[b.child])?;
+                let d = distance_to_segment(pos, p, q);
+                (d < 8.0).then_some((*b, d))
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(b, _)| b)
+    }
+
+    /// The ghost, the planted feet's rings, the bones (flagged, unsure, hovered) and the joints;
+    /// returns the flippable bone clicked.
+    fn skeleton(
+        &self,
+        scene: &Scene,
+        joints: &PerJoint<Point3<f64>>,
+        response: &egui::Response,
+    ) -> Option<Bone> {
+        let hovered = response
+            .hover_pos()
+            .and_then(|pos| self.near_bone(scene, joints, pos));
+        if let Some(ghost) = &scene.ghost {
+            let grey = Stroke::new(2.0, Color32::from_gray(110));
             for b in Bone::ALL {
-                let (mut width, colour) = if scene.flagged.contains(&b) {
-                    (2.5, FLAGGED)
-                } else if scene.unsure.contains(&b) {
-                    (DOUBT_WIDTH, DOUBT)
-                } else {
-                    (2.5, side_colour(b.child))
-                };
-                if hovered == Some(b) || scene.highlight == Some(b) {
-                    width += 3.0;
-                    line(
-                        &joints[b.parent],
-                        &joints[b.child],
-                        Stroke::new(width + 4.0, Color32::WHITE),
-                    );
-                }
-                line(
+                self.line(&ghost[b.parent], &ghost[b.child], grey);
+            }
+        }
+        for ankle in &scene.planted {
+            let a = joints[*ankle];
+            let ring = |t: f64| Point3::new(a.x + 0.12 * t.cos(), 0.0, a.z + 0.12 * t.sin());
+            for k in 0..12 {
+                let t = std::f64::consts::TAU * f64::from(k) / 12.0;
+                let dt = std::f64::consts::TAU / 12.0;
+                self.line(&ring(t), &ring(t + dt), Stroke::new(2.5, PLANTED));
+            }
+        }
+        for b in Bone::ALL {
+            let (mut width, colour) = if scene.flagged.contains(&b) {
+                (2.5, FLAGGED)
+            } else if scene.unsure.contains(&b) {
+                (DOUBT_WIDTH, DOUBT)
+            } else {
+                (2.5, side_colour(b.child))
+            };
+            if hovered == Some(b) || scene.highlight == Some(b) {
+                width += 3.0;
+                self.line(
                     &joints[b.parent],
                     &joints[b.child],
-                    Stroke::new(width, colour),
+                    Stroke::new(width + 4.0, Color32::WHITE),
                 );
             }
-            for (_, p) in joints.iter() {
-                if let Some(s) = self.project(rect, p) {
-                    painter.circle_filled(s, 3.0, Color32::WHITE);
-                }
-            }
-            if hovered.is_some() {
-                response
-                    .clone()
-                    .on_hover_text("click to flip this limb's depth on this frame");
-            }
-            if response.clicked() {
-                clicked = response.interact_pointer_pos().and_then(near_bone);
-            }
-        } else if scene.cloud.is_empty() {
-            let text = scene
-                .empty_text
-                .clone()
-                .unwrap_or_else(|| "no 3D skeleton yet: mark, then Track".to_owned());
-            let galley = painter.layout(
-                text,
-                egui::FontId::proportional(14.0),
-                Color32::GRAY,
-                (rect.width() - 32.0).clamp(100.0, 640.0),
+            self.line(
+                &joints[b.parent],
+                &joints[b.child],
+                Stroke::new(width, colour),
             );
-            let at = rect.center() - galley.size() / 2.0;
-            painter.galley(at, galley, Color32::GRAY);
         }
-        // Notes wrap to the view's width (a narrow 3D panel cut them off).
+        for (_, p) in joints.iter() {
+            if let Some(s) = self.project(p) {
+                self.painter.circle_filled(s, 3.0, Color32::WHITE);
+            }
+        }
+        if hovered.is_some() {
+            response
+                .clone()
+                .on_hover_text("click to flip this limb's depth on this frame");
+        }
+        if response.clicked() {
+            return response
+                .interact_pointer_pos()
+                .and_then(|pos| self.near_bone(scene, joints, pos));
+        }
+        None
+    }
+
+    /// What the view says when it has nothing to draw.
+    fn empty_text(&self, scene: &Scene) {
+        let text = scene
+            .empty_text
+            .clone()
+            .unwrap_or_else(|| "no 3D skeleton yet: mark, then Track".to_owned());
+        let galley = self.painter.layout(
+            text,
+            egui::FontId::proportional(14.0),
+            Color32::GRAY,
+            (self.rect.width() - 32.0).clamp(100.0, 640.0),
+        );
+        let at = self.rect.center() - galley.size() / 2.0;
+        self.painter.galley(at, galley, Color32::GRAY);
+    }
+
+    /// The notes, wrapped to the view's width (a narrow 3D panel cut them off).
+    fn notes(&self, scene: &Scene) {
         let mut y = 8.0;
         for note in &scene.notes {
             let colour = note.colour();
-            let galley = painter.layout(
+            let galley = self.painter.layout(
                 note.text.clone(),
                 egui::FontId::proportional(13.0),
                 colour,
-                (rect.width() - 16.0).max(60.0),
+                (self.rect.width() - 16.0).max(60.0),
             );
             let height = galley.size().y;
-            painter.galley(rect.left_top() + Vec2::new(8.0, y), galley, colour);
+            self.painter
+                .galley(self.rect.left_top() + Vec2::new(8.0, y), galley, colour);
             y += height + 3.0;
         }
-        clicked
     }
 }
 
