@@ -192,8 +192,38 @@ impl FrameView {
     ) -> Option<ViewEvent> {
         let rect = ui.available_rect_before_wrap();
         let response = ui.allocate_rect(rect, Sense::click_and_drag());
+        let panning = self.zoom_and_pan(ui, &response, rect, size);
+        let t = self.transform_for(rect, size);
+        self.last = Some(t);
+        let painter = ui.painter_at(rect);
+        let image_rect = Rect::from_min_max(
+            t.to_screen(Point2::new(-0.5, -0.5)),
+            t.to_screen(Point2::new(
+                f64::from(size.x) - 0.5,
+                f64::from(size.y) - 0.5,
+            )),
+        );
+        painter.image(
+            texture.id(),
+            image_rect,
+            Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)),
+            Color32::WHITE,
+        );
+        let event = self.grab_or_click(ui, &response, &t, overlay, panning);
+        self.draw_overlay(&painter, &response, &t, overlay);
+        event
+    }
+
+    /// Zooms at the cursor (the image point under it stays put) and pans (middle drag, or
+    /// Space with a left drag); returns whether the view is panning.
+    fn zoom_and_pan(
+        &mut self,
+        ui: &egui::Ui,
+        response: &egui::Response,
+        rect: Rect,
+        size: Vec2,
+    ) -> bool {
         let space = ui.input(|i| i.key_down(egui::Key::Space));
-        // Zoom at the cursor: the image point under it stays put.
         if let Some(hover) = response.hover_pos() {
             let scroll = ui.input(|i| i.smooth_scroll_delta.y);
             if scroll != 0.0 {
@@ -213,35 +243,18 @@ impl FrameView {
             let c = self.centre.unwrap_or(t.image_centre);
             self.centre = Some(c - response.drag_delta() / t.scale);
         }
-        let t = self.transform_for(rect, size);
-        self.last = Some(t);
-        let painter = ui.painter_at(rect);
-        let image_rect = Rect::from_min_max(
-            t.to_screen(Point2::new(-0.5, -0.5)),
-            t.to_screen(Point2::new(
-                f64::from(size.x) - 0.5,
-                f64::from(size.y) - 0.5,
-            )),
-        );
-        painter.image(
-            texture.id(),
-            image_rect,
-            Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)),
-            Color32::WHITE,
-        );
+        panning
+    }
 
-        let nearest = |pos: Pos2| -> Option<Joint> {
-            Joint::ALL
-                .into_iter()
-                .filter_map(|j| {
-                    let (p, _) = overlay.points[j]?;
-                    let d = t.to_screen(p).distance(pos);
-                    (d <= PICK_PX).then_some((j, d))
-                })
-                .min_by(|a, b| a.1.total_cmp(&b.1))
-                .map(|(j, _)| j)
-        };
-        let mut event = None;
+    /// A joint grabbed, dragged and let go (moved), or a click on the image.
+    fn grab_or_click(
+        &mut self,
+        ui: &egui::Ui,
+        response: &egui::Response,
+        t: &Transform,
+        overlay: &Overlay,
+        panning: bool,
+    ) -> Option<ViewEvent> {
         let (pressed, down, released, pointer) = ui.input(|i| {
             (
                 i.pointer.primary_pressed(),
@@ -252,7 +265,7 @@ impl FrameView {
         });
         if !panning && pressed && response.hovered() {
             self.grab = pointer.and_then(|pos| {
-                nearest(pos).map(|joint| Grab {
+                nearest_joint(overlay, t, pos).map(|joint| Grab {
                     joint,
                     pressed_at: pos,
                     at: t.to_image(pos),
@@ -267,21 +280,33 @@ impl FrameView {
             g.moved = true;
             g.at = t.to_image(pos);
         }
-        if released {
-            match self.grab.take() {
-                Some(g) if g.moved => event = Some(ViewEvent::Moved(g.joint, g.at)),
-                _ => {
-                    if !panning
-                        && response.clicked()
-                        && let Some(pos) = response.interact_pointer_pos()
-                    {
-                        event = Some(ViewEvent::Click(t.to_image(pos)));
-                    }
+        if !released {
+            return None;
+        }
+        match self.grab.take() {
+            Some(g) if g.moved => Some(ViewEvent::Moved(g.joint, g.at)),
+            _ => {
+                if !panning
+                    && response.clicked()
+                    && let Some(pos) = response.interact_pointer_pos()
+                {
+                    Some(ViewEvent::Click(t.to_image(pos)))
+                } else {
+                    None
                 }
             }
         }
+    }
 
-        // The skeleton: bones, then joints (the dragged one where it is being dragged).
+    /// The skeleton (bones, then joints; the dragged one where it is being dragged), the hovered
+    /// joint's name, the hint's cross and what the marking asks for.
+    fn draw_overlay(
+        &self,
+        painter: &egui::Painter,
+        response: &egui::Response,
+        t: &Transform,
+        overlay: &Overlay,
+    ) {
         let at = |j: Joint| -> Option<(Point2<f64>, PointState)> {
             match self.grab {
                 Some(g) if g.joint == j && g.moved => Some((g.at, PointState::Key)),
@@ -296,7 +321,9 @@ impl FrameView {
                 );
             }
         }
-        let hovered = response.hover_pos().and_then(nearest);
+        let hovered = response
+            .hover_pos()
+            .and_then(|pos| nearest_joint(overlay, t, pos));
         for j in Joint::ALL {
             if let Some((p, state)) = at(j) {
                 let s = t.to_screen(p);
@@ -332,8 +359,20 @@ impl FrameView {
                 Color32::YELLOW,
             );
         }
-        event
     }
+}
+
+/// The overlay's joint nearest `pos` on screen, within [`PICK_PX`].
+fn nearest_joint(overlay: &Overlay, t: &Transform, pos: Pos2) -> Option<Joint> {
+    Joint::ALL
+        .into_iter()
+        .filter_map(|j| {
+            let (p, _) = overlay.points[j]?;
+            let d = t.to_screen(p).distance(pos);
+            (d <= PICK_PX).then_some((j, d))
+        })
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(j, _)| j)
 }
 
 /// Bone colour by the side of the body (subject's left cyan, right orange, middle yellow).
