@@ -9,7 +9,8 @@ use crate::state::State;
 use crate::state::volume::VolumeSequence;
 use egui::{Color32, Stroke};
 use nalgebra::{Point3, Vector3};
-use videomocap_core::formats::{CONTACT_FLAG, FrameIndex};
+use videomocap_core::export::WorldSkeleton;
+use videomocap_core::formats::{CONTACT_FLAG, FrameIndex, Skeleton3d};
 use videomocap_core::skeleton::{Bone, Joint};
 use videomocap_volume::Part;
 use videomocap_volume::bodies::Cylinder;
@@ -32,25 +33,7 @@ pub(crate) fn scene(state: &State) -> Scene {
         .binary_search(&FrameIndex(current))
         .ok()
         .map(|k| world.frames[k]);
-    let cam = &skeleton.camera;
-    let corner = |x: f64, y: f64| {
-        let depth = 0.5;
-        world.world.to_world(&Point3::new(
-            (x - cam.cx) / cam.focal_px * depth,
-            (y - cam.cy) / cam.focal_px * depth,
-            depth,
-        ))
-    };
-    let (w, h) = (f64::from(cam.width), f64::from(cam.height));
-    let camera = (
-        world.world.to_world(&Point3::origin()),
-        [
-            corner(0.0, 0.0),
-            corner(w, 0.0),
-            corner(w, h),
-            corner(0.0, h),
-        ],
-    );
+    let camera = frustum(world, skeleton);
     let key = videomocap_core::lift::KEY_JOINTS;
     let mut scene = Scene {
         joints,
@@ -66,6 +49,45 @@ pub(crate) fn scene(state: &State) -> Scene {
             "the last 3D result: a new one is on its way".to_owned(),
         ));
     }
+    add_flags(&mut scene, state, skeleton, current);
+    // Problems first, what is merely so (a planted foot) after.
+    scene.notes.sort_by_key(|n| n.kind);
+    add_unsure(&mut scene, state, current);
+    if let Some(ghost) = state.flip_ghost().filter(|g| g.frame == current) {
+        scene.notes.push(Note::info(format!(
+            "grey: the pose before you flipped the {} (Ctrl+Z takes the flip back)",
+            ghost.bone.plain_name()
+        )));
+        scene.ghost = Some(ghost.joints);
+    }
+    scene
+}
+
+/// The camera's centre and the corners of its image half a metre in front, in the world.
+fn frustum(world: &WorldSkeleton, skeleton: &Skeleton3d) -> (Point3<f64>, [Point3<f64>; 4]) {
+    let cam = &skeleton.camera;
+    let corner = |x: f64, y: f64| {
+        let depth = 0.5;
+        world.world.to_world(&Point3::new(
+            (x - cam.cx) / cam.focal_px * depth,
+            (y - cam.cy) / cam.focal_px * depth,
+            depth,
+        ))
+    };
+    let (w, h) = (f64::from(cam.width), f64::from(cam.height));
+    (
+        world.world.to_world(&Point3::origin()),
+        [
+            corner(0.0, 0.0),
+            corner(w, 0.0),
+            corner(w, h),
+            corner(0.0, h),
+        ],
+    )
+}
+
+/// The frame's lift flags: bones drawn flagged, planted feet ringed, each flag a note in words.
+fn add_flags(scene: &mut Scene, state: &State, skeleton: &Skeleton3d, current: usize) {
     let frame = skeleton
         .frames
         .binary_search_by_key(&FrameIndex(current), |f| f.index)
@@ -85,8 +107,10 @@ pub(crate) fn scene(state: &State) -> Scene {
         }
         scene.notes.push(flag_note(flag, &marked));
     }
-    // Problems first, what is merely so (a planted foot) after.
-    scene.notes.sort_by_key(|n| n.kind);
+}
+
+/// The flippable bones whose depth choice is unsure on the frame, drawn magenta with a note.
+fn add_unsure(scene: &mut Scene, state: &State, current: usize) {
     let unsure: Vec<Bone> = state
         .unsure_bones(current)
         .into_iter()
@@ -104,14 +128,6 @@ pub(crate) fn scene(state: &State) -> Scene {
         )));
         scene.unsure = unsure;
     }
-    if let Some(ghost) = state.flip_ghost().filter(|g| g.frame == current) {
-        scene.notes.push(Note::info(format!(
-            "grey: the pose before you flipped the {} (Ctrl+Z takes the flip back)",
-            ghost.bone.plain_name()
-        )));
-        scene.ghost = Some(ghost.joints);
-    }
-    scene
 }
 
 /// A lift flag of the frame in words: what it is, the bone or joint it concerns, and what to
