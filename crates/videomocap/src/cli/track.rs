@@ -183,41 +183,10 @@ fn is_project(path: &Path) -> bool {
 
 /// `track`.
 pub fn run(a: &TrackArgs, global: &GlobalArgs) -> Result<(), ExitError> {
-    let mut project = if is_project(&a.video) {
-        if a.marks.is_some() || a.keys.is_some() {
-            return Err(ExitError::bad_input(anyhow!(
-                "{}: a project brings its own keys; leave out --marks and --keys",
-                a.video.display()
-            )));
-        }
-        Some(Project::load(&a.video).map_err(ExitError::bad_input)?)
-    } else {
-        None
-    };
+    let mut project = load_project(a)?;
     let threads = super::cpus::thread_budget(a.threads)?.threads;
     super::cpus::limit_global_pool(threads);
-    let (mut video, keys, settings) = match &project {
-        Some(p) => {
-            // A relative video path is relative to the project's folder.
-            let video_path = match a.video.parent() {
-                Some(dir) if p.video.is_relative() => dir.join(&p.video),
-                _ => p.video.clone(),
-            };
-            let v =
-                Video::open(&video_path, &decoding_on(threads)).map_err(ExitError::bad_input)?;
-            check_keys(&v, &p.keys, &a.video)?;
-            (v, p.keys.clone(), Some(p.settings.tracker))
-        }
-        None => {
-            if a.output.is_none() {
-                return Err(ExitError::bad_input(anyhow!(
-                    "give --output tracks2d.json (only a project keeps its tracks itself)"
-                )));
-            }
-            let (v, k) = open_checked(&a.video, a.marks.as_deref(), a.keys.as_deref(), threads)?;
-            (v, k, None)
-        }
-    };
+    let (mut video, keys, settings) = open_input(a, project.as_ref(), threads)?;
     let mut params = match (&a.tracker_settings, settings) {
         (Some(p), _) => load_settings(p)?,
         (None, Some(s)) => s,
@@ -228,21 +197,7 @@ pub fn run(a: &TrackArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let t0 = std::time::Instant::now();
     let out = track_with_progress(&mut video, &keys, threads, params, global)?;
     let seconds = t0.elapsed().as_secs_f64();
-    let mut written = Vec::new();
-    if let Some(output) = &a.output {
-        out.tracks.save(output).map_err(ExitError::failed)?;
-        written.push(output.display().to_string());
-    }
-    if let Some(p) = project.as_mut() {
-        // The new tracks replace the old, and the 3D lifted from the old ones goes.
-        p.tracks = Some(Arc::new(out.tracks.clone()));
-        p.skeleton = None;
-        p.save(&a.video).map_err(ExitError::failed)?;
-        written.push(format!(
-            "{} (its tracks; lift again for 3D)",
-            a.video.display()
-        ));
-    }
+    let written = write_outputs(a, project.as_mut(), &out)?;
     report(&out, global);
     say(
         global,
@@ -264,4 +219,73 @@ pub fn run(a: &TrackArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         println!("{summary:#}");
     }
     Ok(())
+}
+
+/// The project `track PROJECT.json` names (which brings its own keys), or `None` for a video.
+fn load_project(a: &TrackArgs) -> Result<Option<Project>, ExitError> {
+    if !is_project(&a.video) {
+        return Ok(None);
+    }
+    if a.marks.is_some() || a.keys.is_some() {
+        return Err(ExitError::bad_input(anyhow!(
+            "{}: a project brings its own keys; leave out --marks and --keys",
+            a.video.display()
+        )));
+    }
+    Ok(Some(Project::load(&a.video).map_err(ExitError::bad_input)?))
+}
+
+/// The video, its keys checked against it, and the project's tracker settings if a project
+/// named it (a relative video path is relative to the project's folder).
+fn open_input(
+    a: &TrackArgs,
+    project: Option<&Project>,
+    threads: usize,
+) -> Result<(Video, KeyFrames, Option<TrackerParams>), ExitError> {
+    match project {
+        Some(p) => {
+            let video_path = match a.video.parent() {
+                Some(dir) if p.video.is_relative() => dir.join(&p.video),
+                _ => p.video.clone(),
+            };
+            let v =
+                Video::open(&video_path, &decoding_on(threads)).map_err(ExitError::bad_input)?;
+            check_keys(&v, &p.keys, &a.video)?;
+            Ok((v, p.keys.clone(), Some(p.settings.tracker)))
+        }
+        None => {
+            if a.output.is_none() {
+                return Err(ExitError::bad_input(anyhow!(
+                    "give --output tracks2d.json (only a project keeps its tracks itself)"
+                )));
+            }
+            let (v, k) = open_checked(&a.video, a.marks.as_deref(), a.keys.as_deref(), threads)?;
+            Ok((v, k, None))
+        }
+    }
+}
+
+/// Saves the tracks to `--output` and into the project (whose old 3D goes); returns what was
+/// written, for the user.
+fn write_outputs(
+    a: &TrackArgs,
+    project: Option<&mut Project>,
+    out: &TrackOutput,
+) -> Result<Vec<String>, ExitError> {
+    let mut written = Vec::new();
+    if let Some(output) = &a.output {
+        out.tracks.save(output).map_err(ExitError::failed)?;
+        written.push(output.display().to_string());
+    }
+    if let Some(p) = project {
+        // The new tracks replace the old, and the 3D lifted from the old ones goes.
+        p.tracks = Some(Arc::new(out.tracks.clone()));
+        p.skeleton = None;
+        p.save(&a.video).map_err(ExitError::failed)?;
+        written.push(format!(
+            "{} (its tracks; lift again for 3D)",
+            a.video.display()
+        ));
+    }
+    Ok(written)
 }
