@@ -8,6 +8,7 @@ use crate::intent::Intent;
 use crate::state::volume::VolumeSequence;
 use crate::state::{Outdated, State};
 use videomocap_core::lift::default_focal;
+use videomocap_core::project::Settings;
 
 /// Draws the panel; what the user changed goes to `out`.
 pub(crate) fn show(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
@@ -58,6 +59,43 @@ fn parameters(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
         return;
     };
     let mut settings = before;
+    camera_and_height(ui, state, &mut settings);
+    known_lengths(ui, state, &mut settings);
+    ui.collapsing("Tracker", |ui| {
+        if let Some(why) = state.network_problem() {
+            ui.colored_label(
+                ui.visuals().warn_fg_color,
+                format!("The pose network could not load ({why}): tracking uses VBA alone."),
+            );
+        }
+        tracker_settings::tracker_settings_ui(ui, &mut settings.tracker);
+    });
+    for o in state.outdated() {
+        if let Outdated::Tracks(what) = o {
+            offer(ui, &what, "Track again (T)", Intent::Track, out);
+        }
+    }
+    ui.collapsing("Lift", |ui| {
+        lift_settings::lift_settings_ui(ui, &mut settings.lift);
+    });
+    for o in state.outdated() {
+        if let Outdated::Skeleton(what) = o {
+            offer(ui, &what, "Lift again", Intent::Lift, out);
+        }
+    }
+    let dragging = ui.ctx().dragged_id().is_some();
+    if settings != before {
+        out.push(Intent::Settings {
+            settings: Box::new(settings),
+            dragging,
+        });
+    } else if !dragging {
+        out.push(Intent::SettingsReleased);
+    }
+}
+
+/// The focal length (known or the default 60°) and the subject's height.
+fn camera_and_height(ui: &mut egui::Ui, state: &State, settings: &mut Settings) {
     let default_f = state
         .video_info()
         .map_or(1000.0, |i| default_focal(i.width, i.height));
@@ -75,6 +113,10 @@ fn parameters(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
     settings.focal_px = given.then_some(f);
     fitted::slider(ui, egui::Slider::new(&mut settings.height_m, 1.0..=2.3), "subject height (m)")
         .on_hover_text("The subject's stature (default 1.70 m): every length is read from the video and this fixes their overall scale, so the 3D skeleton's size and depth follow it. Lengths you know (below) set the scale instead.");
+}
+
+/// What the lift read of the body, and the lengths the user knows.
+fn known_lengths(ui: &mut egui::Ui, state: &State, settings: &mut Settings) {
     let fit = state.subject_fit();
     // One line whether or not a lift has read the lengths (the whole reading on hover), so the
     // panel below does not jump when it arrives.
@@ -108,37 +150,6 @@ fn parameters(ui: &mut egui::Ui, state: &State, out: &mut Vec<Intent>) {
             }
         });
     });
-    ui.collapsing("Tracker", |ui| {
-        if let Some(why) = state.network_problem() {
-            ui.colored_label(
-                ui.visuals().warn_fg_color,
-                format!("The pose network could not load ({why}): tracking uses VBA alone."),
-            );
-        }
-        tracker_settings::tracker_settings_ui(ui, &mut settings.tracker);
-    });
-    for o in state.outdated() {
-        if let Outdated::Tracks(what) = o {
-            offer(ui, &what, "Track again (T)", Intent::Track, out);
-        }
-    }
-    ui.collapsing("Lift", |ui| {
-        lift_settings::lift_settings_ui(ui, &mut settings.lift);
-    });
-    for o in state.outdated() {
-        if let Outdated::Skeleton(what) = o {
-            offer(ui, &what, "Lift again", Intent::Lift, out);
-        }
-    }
-    let dragging = ui.ctx().dragged_id().is_some();
-    if settings != before {
-        out.push(Intent::Settings {
-            settings: Box::new(settings),
-            dragging,
-        });
-    } else if !dragging {
-        out.push(Intent::SettingsReleased);
-    }
 }
 
 /// A result out of date under the settings: what changed, and a button to make it again.
