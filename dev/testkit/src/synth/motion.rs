@@ -162,144 +162,24 @@ pub fn procedural(
 ) -> Motion {
     let leg_len = subject.length_to(Joint::LeftKnee) + subject.length_to(Joint::LeftAnkle);
     let ankle_height = 0.039 * subject.height_m;
-    let stand = leg_len + ankle_height;
+    let body = Body {
+        subject,
+        leg_len,
+        ankle_height,
+        stand: leg_len + ankle_height,
+    };
     let out = (0..frames)
         .map(|i| {
             let t = i as f64 / fps;
             let w = 2.0 * PI * t; // one cycle per second
             match kind {
-                ProceduralMotion::Walk | ProceduralMotion::Treadmill => {
-                    let hip = 0.42 * w.sin();
-                    let legs = [
-                        LimbAngles {
-                            flexion: hip,
-                            bend: 0.1 + 0.55 * (w + 0.9 * PI).sin().max(0.0),
-                            ..Default::default()
-                        },
-                        LimbAngles {
-                            flexion: -hip,
-                            bend: 0.1 + 0.55 * (w - 0.1 * PI).sin().max(0.0),
-                            ..Default::default()
-                        },
-                    ];
-                    let arms = [
-                        LimbAngles {
-                            abduction: 0.12,
-                            flexion: -0.35 * w.sin(),
-                            bend: 0.3,
-                        },
-                        LimbAngles {
-                            abduction: 0.12,
-                            flexion: 0.35 * w.sin(),
-                            bend: 0.3,
-                        },
-                    ];
-                    let speed = if kind == ProceduralMotion::Walk {
-                        1.2
-                    } else {
-                        0.0
-                    };
-                    let pelvis = Point3::new(0.0, stand - 0.03 + 0.02 * (2.0 * w).cos(), speed * t);
-                    pose(subject, pelvis, arms, legs)
-                }
-                ProceduralMotion::Wave => {
-                    let arms = [
-                        LimbAngles {
-                            abduction: 0.15,
-                            flexion: 0.1,
-                            bend: 0.2,
-                        },
-                        LimbAngles {
-                            abduction: 2.3,
-                            flexion: 0.2,
-                            bend: 0.5 + 0.45 * (1.5 * w).sin(),
-                        },
-                    ];
-                    let legs = [LimbAngles {
-                        abduction: 0.06,
-                        ..Default::default()
-                    }; 2];
-                    let pelvis = Point3::new(0.03 * (0.5 * w).sin(), stand - 0.01, 0.0);
-                    pose(subject, pelvis, arms, legs)
-                }
-                ProceduralMotion::SitDown => {
-                    // 0 standing … 1 seated, smooth, one cycle per 4 s
-                    let s = 0.5 - 0.5 * (w / 4.0).cos();
-                    let legs = [LimbAngles {
-                        abduction: 0.08,
-                        flexion: 1.45 * s,
-                        bend: 1.5 * s,
-                    }; 2];
-                    let arms = [LimbAngles {
-                        abduction: 0.15,
-                        flexion: 0.6 * s,
-                        bend: 0.4 + 0.6 * s,
-                    }; 2];
-                    let p = pose(subject, Point3::origin(), arms, legs);
-                    let p = pitch_upper_body(p, 0.35 * (PI * s).sin() + 0.1 * s);
-                    on_ground(p, ankle_height)
-                }
-                ProceduralMotion::Bend => {
-                    let pitch = 1.25 * (0.5 - 0.5 * (w / 3.0).cos());
-                    let legs = [LimbAngles {
-                        abduction: 0.06,
-                        flexion: -0.1 * pitch,
-                        bend: 0.15 * pitch,
-                    }; 2];
-                    let arms = [LimbAngles {
-                        abduction: 0.1,
-                        flexion: pitch,
-                        bend: 0.2,
-                    }; 2];
-                    let p = pose(subject, Point3::origin(), arms, legs);
-                    on_ground(pitch_upper_body(p, pitch), ankle_height)
-                }
-                ProceduralMotion::March => {
-                    let lift = |phase: f64| (phase.sin().max(0.0)).powf(0.8);
-                    let (a, b) = (lift(w), lift(w + PI));
-                    let legs = [
-                        LimbAngles {
-                            abduction: 0.05,
-                            flexion: 1.3 * a,
-                            bend: 0.1 + 1.6 * a,
-                        },
-                        LimbAngles {
-                            abduction: 0.05,
-                            flexion: 1.3 * b,
-                            bend: 0.1 + 1.6 * b,
-                        },
-                    ];
-                    let arms = [
-                        LimbAngles {
-                            abduction: 0.35,
-                            flexion: 0.6 * (w + PI).sin(),
-                            bend: 0.5 + 0.4 * b,
-                        },
-                        LimbAngles {
-                            abduction: 0.35,
-                            flexion: 0.6 * w.sin(),
-                            bend: 0.5 + 0.4 * a,
-                        },
-                    ];
-                    let pelvis = Point3::new(0.0, stand - 0.01, 0.0);
-                    pose(subject, pelvis, arms, legs)
-                }
-                ProceduralMotion::JumpingJacks => {
-                    let phase = 0.5 - 0.5 * w.cos(); // 0 closed … 1 open
-                    let arms = [LimbAngles {
-                        abduction: 0.15 + 2.55 * phase,
-                        flexion: 0.0,
-                        bend: 0.15,
-                    }; 2];
-                    let legs = [LimbAngles {
-                        abduction: 0.04 + 0.3 * phase,
-                        ..Default::default()
-                    }; 2];
-                    let hop = 0.08 * (2.0 * w).sin().max(0.0);
-                    let drop = leg_len * (1.0 - (0.04 + 0.3 * phase).cos());
-                    let pelvis = Point3::new(0.0, stand - drop + hop, 0.0);
-                    pose(subject, pelvis, arms, legs)
-                }
+                ProceduralMotion::Walk => walk(&body, w, t, 1.2),
+                ProceduralMotion::Treadmill => walk(&body, w, t, 0.0),
+                ProceduralMotion::Wave => wave(&body, w),
+                ProceduralMotion::SitDown => sit_down(&body, w),
+                ProceduralMotion::Bend => bend(&body, w),
+                ProceduralMotion::March => march(&body, w),
+                ProceduralMotion::JumpingJacks => jumping_jacks(&body, w),
             }
         })
         .collect();
@@ -308,6 +188,160 @@ pub fn procedural(
         fps,
         origin: kind.name().to_owned(),
     }
+}
+
+/// The body a procedural motion poses: the subject, its leg's length, the ankle's height above
+/// the floor, and the pelvis's height standing.
+struct Body<'a> {
+    subject: &'a SubjectModel,
+    leg_len: f64,
+    ankle_height: f64,
+    stand: f64,
+}
+
+/// A walk at `speed` m/s along +Z (0: on a treadmill), at phase `w` and time `t`.
+fn walk(body: &Body<'_>, w: f64, t: f64, speed: f64) -> PerJoint<Point3<f64>> {
+    let (subject, stand) = (body.subject, body.stand);
+    let hip = 0.42 * w.sin();
+    let legs = [
+        LimbAngles {
+            flexion: hip,
+            bend: 0.1 + 0.55 * (w + 0.9 * PI).sin().max(0.0),
+            ..Default::default()
+        },
+        LimbAngles {
+            flexion: -hip,
+            bend: 0.1 + 0.55 * (w - 0.1 * PI).sin().max(0.0),
+            ..Default::default()
+        },
+    ];
+    let arms = [
+        LimbAngles {
+            abduction: 0.12,
+            flexion: -0.35 * w.sin(),
+            bend: 0.3,
+        },
+        LimbAngles {
+            abduction: 0.12,
+            flexion: 0.35 * w.sin(),
+            bend: 0.3,
+        },
+    ];
+    let pelvis = Point3::new(0.0, stand - 0.03 + 0.02 * (2.0 * w).cos(), speed * t);
+    pose(subject, pelvis, arms, legs)
+}
+
+/// The right arm waving overhead.
+fn wave(body: &Body<'_>, w: f64) -> PerJoint<Point3<f64>> {
+    let (subject, stand) = (body.subject, body.stand);
+    let arms = [
+        LimbAngles {
+            abduction: 0.15,
+            flexion: 0.1,
+            bend: 0.2,
+        },
+        LimbAngles {
+            abduction: 2.3,
+            flexion: 0.2,
+            bend: 0.5 + 0.45 * (1.5 * w).sin(),
+        },
+    ];
+    let legs = [LimbAngles {
+        abduction: 0.06,
+        ..Default::default()
+    }; 2];
+    let pelvis = Point3::new(0.03 * (0.5 * w).sin(), stand - 0.01, 0.0);
+    pose(subject, pelvis, arms, legs)
+}
+
+/// Sitting down and standing up again, once per 4 s.
+fn sit_down(body: &Body<'_>, w: f64) -> PerJoint<Point3<f64>> {
+    let (subject, ankle_height) = (body.subject, body.ankle_height);
+    // 0 standing … 1 seated, smooth, one cycle per 4 s
+    let s = 0.5 - 0.5 * (w / 4.0).cos();
+    let legs = [LimbAngles {
+        abduction: 0.08,
+        flexion: 1.45 * s,
+        bend: 1.5 * s,
+    }; 2];
+    let arms = [LimbAngles {
+        abduction: 0.15,
+        flexion: 0.6 * s,
+        bend: 0.4 + 0.6 * s,
+    }; 2];
+    let p = pose(subject, Point3::origin(), arms, legs);
+    let p = pitch_upper_body(p, 0.35 * (PI * s).sin() + 0.1 * s);
+    on_ground(p, ankle_height)
+}
+
+/// Bending forwards and up again, once per 3 s.
+fn bend(body: &Body<'_>, w: f64) -> PerJoint<Point3<f64>> {
+    let (subject, ankle_height) = (body.subject, body.ankle_height);
+    let pitch = 1.25 * (0.5 - 0.5 * (w / 3.0).cos());
+    let legs = [LimbAngles {
+        abduction: 0.06,
+        flexion: -0.1 * pitch,
+        bend: 0.15 * pitch,
+    }; 2];
+    let arms = [LimbAngles {
+        abduction: 0.1,
+        flexion: pitch,
+        bend: 0.2,
+    }; 2];
+    let p = pose(subject, Point3::origin(), arms, legs);
+    on_ground(pitch_upper_body(p, pitch), ankle_height)
+}
+
+/// Marching on the spot, knees high.
+fn march(body: &Body<'_>, w: f64) -> PerJoint<Point3<f64>> {
+    let (subject, stand) = (body.subject, body.stand);
+    let lift = |phase: f64| (phase.sin().max(0.0)).powf(0.8);
+    let (a, b) = (lift(w), lift(w + PI));
+    let legs = [
+        LimbAngles {
+            abduction: 0.05,
+            flexion: 1.3 * a,
+            bend: 0.1 + 1.6 * a,
+        },
+        LimbAngles {
+            abduction: 0.05,
+            flexion: 1.3 * b,
+            bend: 0.1 + 1.6 * b,
+        },
+    ];
+    let arms = [
+        LimbAngles {
+            abduction: 0.35,
+            flexion: 0.6 * (w + PI).sin(),
+            bend: 0.5 + 0.4 * b,
+        },
+        LimbAngles {
+            abduction: 0.35,
+            flexion: 0.6 * w.sin(),
+            bend: 0.5 + 0.4 * a,
+        },
+    ];
+    let pelvis = Point3::new(0.0, stand - 0.01, 0.0);
+    pose(subject, pelvis, arms, legs)
+}
+
+/// Jumping jacks.
+fn jumping_jacks(body: &Body<'_>, w: f64) -> PerJoint<Point3<f64>> {
+    let (subject, stand, leg_len) = (body.subject, body.stand, body.leg_len);
+    let phase = 0.5 - 0.5 * w.cos(); // 0 closed … 1 open
+    let arms = [LimbAngles {
+        abduction: 0.15 + 2.55 * phase,
+        flexion: 0.0,
+        bend: 0.15,
+    }; 2];
+    let legs = [LimbAngles {
+        abduction: 0.04 + 0.3 * phase,
+        ..Default::default()
+    }; 2];
+    let hop = 0.08 * (2.0 * w).sin().max(0.0);
+    let drop = leg_len * (1.0 - (0.04 + 0.3 * phase).cos());
+    let pelvis = Point3::new(0.0, stand - drop + hop, 0.0);
+    pose(subject, pelvis, arms, legs)
 }
 
 /// Reads a BVH, maps it onto the 16 joints, resamples it to `fps` from `start_s` seconds for
