@@ -212,10 +212,58 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         }
         views.add(clip, &row);
     }
+    lines.extend(tables(&tally, a.reuse, mediapipe.is_some(), &views));
+    lines.push(String::new());
+    lines.extend(opencv_table(&clips, a, global)?);
+    if settings.len() > 1 {
+        lines.push(String::new());
+        lines.push("together, each setting swept (13 limb joints, PCK@0.2 / lost)".to_owned());
+        for (k, p) in settings.iter().enumerate() {
+            lines.push(format!("{p:?}"));
+            lines.extend(tally.lines(WIDTH, |s| cell(&s.0, 0, 3 + k)));
+        }
+    }
+    lines.push(String::new());
+    lines.push(format!(
+        "the network (crops following the subject, one after the other): {:.1} ms a frame ({:.1} frames/s), crops 256×256",
+        1000.0 * net_seconds / net_frames.max(1) as f64,
+        net_frames as f64 / net_seconds.max(1e-9)
+    ));
+    for l in lines {
+        println!("{l}");
+    }
+    Ok(())
+}
+
+/// OpenCV's trackers from the same clicked marks (all 16 joints), as a table.
+fn opencv_table(
+    clips: &[BenchClip],
+    a: &BenchArgs,
+    global: &GlobalArgs,
+) -> Result<Vec<String>, ExitError> {
+    let clicked = clips
+        .iter()
+        .map(|clip| {
+            let marks = Marks::load(&clip.dir.join("marks.json")).map_err(ExitError::failed)?;
+            Ok(clicked_marks(&marks, CLICK_NOISE_PX, &clip.name))
+        })
+        .collect::<Result<Vec<_>, ExitError>>()?;
+    let opencv = crate::bench_baselines::opencv(clips, &clicked, &a.suite_dir, global)?;
+    Ok(crate::bench_baselines::opencv_lines(opencv.as_ref()))
+}
+
+/// The split and family tables: limbs, all joints, reliability, per view.
+fn tables(
+    tally: &Tally<Scores>,
+    reuse: bool,
+    mediapipe: bool,
+    views: &crate::bench_views::ViewTable,
+) -> Vec<String> {
+    let mut lines = Vec::new();
     lines.push(String::new());
     lines.push(format!(
         "13 limb joints, PCK@0.2 / lost; marks clicked with {CLICK_NOISE_PX} px of noise; together: {}",
-        if a.reuse {
+        if reuse {
             "the default weighing of the cached tracks"
         } else {
             "track_video with the network (the product)"
@@ -242,41 +290,10 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     lines.push(String::new());
     lines.push(format!(
         "per view (clicked marks; MediaPipe Pose 0.10.21 with its own detector, no marks{})",
-        if mediapipe.is_some() {
-            ""
-        } else {
-            ": not found"
-        }
+        if mediapipe { "" } else { ": not found" }
     ));
     lines.extend(views.lines());
-    let clicked = clips
-        .iter()
-        .map(|clip| {
-            let marks = Marks::load(&clip.dir.join("marks.json")).map_err(ExitError::failed)?;
-            Ok(clicked_marks(&marks, CLICK_NOISE_PX, &clip.name))
-        })
-        .collect::<Result<Vec<_>, ExitError>>()?;
-    let opencv = crate::bench_baselines::opencv(&clips, &clicked, &a.suite_dir, global)?;
-    lines.push(String::new());
-    lines.extend(crate::bench_baselines::opencv_lines(opencv.as_ref()));
-    if settings.len() > 1 {
-        lines.push(String::new());
-        lines.push("together, each setting swept (13 limb joints, PCK@0.2 / lost)".to_owned());
-        for (k, p) in settings.iter().enumerate() {
-            lines.push(format!("{p:?}"));
-            lines.extend(tally.lines(WIDTH, |s| cell(&s.0, 0, 3 + k)));
-        }
-    }
-    lines.push(String::new());
-    lines.push(format!(
-        "the network (crops following the subject, one after the other): {:.1} ms a frame ({:.1} frames/s), crops 256×256",
-        1000.0 * net_seconds / net_frames.max(1) as f64,
-        net_frames as f64 / net_seconds.max(1e-9)
-    ));
-    for l in lines {
-        println!("{l}");
-    }
-    Ok(())
+    lines
 }
 
 /// Width of [`cell`].
@@ -317,20 +334,17 @@ fn count_frames(clip: &BenchClip) -> Result<usize, ExitError> {
         .len())
 }
 
-fn score_clip(
+/// VBA's tracks, the network beside them and the network alone for a clip (from the clip's
+/// caches with `--reuse` when there, kept there when made), and the seconds the network ran.
+fn vba_and_network(
     clip: &BenchClip,
     threads: usize,
     params: videomocap_core::track::TrackerParams,
-    network: Arc<PoseNetwork>,
-    settings: &[EvidenceParams],
+    network: &Arc<PoseNetwork>,
+    clicked: &Marks,
+    keys: &KeyFrames,
     reuse: bool,
-    dump: Option<&mut Vec<String>>,
-) -> Result<(Scores, [ClipScore; 3], f64), ExitError> {
-    let mut net_seconds = 0.0;
-    let gt = GroundTruth::load(&clip.dir.join("gt.json")).map_err(ExitError::failed)?;
-    let marks = Marks::load(&clip.dir.join("marks.json")).map_err(ExitError::failed)?;
-    let clicked = clicked_marks(&marks, CLICK_NOISE_PX, &clip.name);
-    let keys = KeyFrames::from_marks(&clicked);
+) -> Result<(Tracks2d, Cached, f64), ExitError> {
     let (vba_path, net_path) = (
         clip.dir.join("learned-vba.json"),
         clip.dir.join("learned-net.json"),
@@ -343,25 +357,26 @@ fn score_clip(
             Some((vba, c))
         })
         .flatten();
-    let (vba, Cached { net, alone }) = match cached {
+    let mut net_seconds = 0.0;
+    let (vba, cached) = match cached {
         Some(c) => c,
         None => {
             let mut video = Video::open(&clip.dir.join("video.mp4"), &OpenOptions::default())
                 .map_err(ExitError::failed)?;
-            let vba: Tracks2d = track_opened(&mut video, &clicked, threads, params)?;
+            let vba: Tracks2d = track_opened(&mut video, clicked, threads, params)?;
             let t0 = Instant::now();
             let net = run_network(
                 &mut video,
                 &vba,
-                &network,
-                &keys,
+                network,
+                keys,
                 None,
                 &mut || {},
                 &AtomicBool::new(false),
             )
             .map_err(ExitError::failed)?;
             net_seconds += t0.elapsed().as_secs_f64();
-            let alone = network_alone(&mut video, &clicked, &network)?;
+            let alone = network_alone(&mut video, clicked, network)?;
             let c = Cached { net, alone };
             if reuse {
                 vba.save(&vba_path).map_err(ExitError::failed)?;
@@ -371,6 +386,58 @@ fn score_clip(
             (vba, c)
         }
     };
+    Ok((vba, cached, net_seconds))
+}
+
+/// Each non-key joint-frame's doubt features and whether it is over 0.2 torso off, as CSV rows
+/// (`--doubt-dump`, for `scripts/fit_doubt.py`).
+fn dump_doubt(
+    dump: &mut Vec<String>,
+    clip: &BenchClip,
+    gt: &GroundTruth,
+    vba: &Tracks2d,
+    net: &NetworkFrames,
+    keys: &KeyFrames,
+    product: &Tracks2d,
+) {
+    let x = videomocap_core::track::doubt_features(vba, net, keys, product);
+    let derived = gt.derived();
+    for ((g, f), row) in gt.frames.iter().zip(&product.frames).zip(&x) {
+        let at = |j: Joint| Point2::new(g.points2d[j.index()][0], g.points2d[j.index()][1]);
+        let torso = (at(Joint::Neck) - at(Joint::Pelvis)).norm().max(1.0);
+        for j in Joint::ALL {
+            if keys.is_key(f.index, j) || derived.contains(&j) {
+                continue;
+            }
+            let off = (f.points[j].pos - at(j)).norm() > 0.2 * torso;
+            let values: Vec<String> = row[j].iter().map(|v| format!("{v:.4}")).collect();
+            dump.push(format!(
+                "{},{},{},{},{}",
+                clip.name,
+                f.index.get(),
+                j.name(),
+                values.join(","),
+                u8::from(off)
+            ));
+        }
+    }
+}
+
+fn score_clip(
+    clip: &BenchClip,
+    threads: usize,
+    params: videomocap_core::track::TrackerParams,
+    network: Arc<PoseNetwork>,
+    settings: &[EvidenceParams],
+    reuse: bool,
+    dump: Option<&mut Vec<String>>,
+) -> Result<(Scores, [ClipScore; 3], f64), ExitError> {
+    let gt = GroundTruth::load(&clip.dir.join("gt.json")).map_err(ExitError::failed)?;
+    let marks = Marks::load(&clip.dir.join("marks.json")).map_err(ExitError::failed)?;
+    let clicked = clicked_marks(&marks, CLICK_NOISE_PX, &clip.name);
+    let keys = KeyFrames::from_marks(&clicked);
+    let (vba, Cached { net, alone }, net_seconds) =
+        vba_and_network(clip, threads, params, &network, &clicked, &keys, reuse)?;
     // Together as the product tracks (`track_video` with the network), unless only the
     // weighing is swept from the caches.
     let product = if reuse {
@@ -384,27 +451,7 @@ fn score_clip(
             .tracks
     };
     if let Some(dump) = dump {
-        let x = videomocap_core::track::doubt_features(&vba, &net, &keys, &product);
-        let derived = gt.derived();
-        for ((g, f), row) in gt.frames.iter().zip(&product.frames).zip(&x) {
-            let at = |j: Joint| Point2::new(g.points2d[j.index()][0], g.points2d[j.index()][1]);
-            let torso = (at(Joint::Neck) - at(Joint::Pelvis)).norm().max(1.0);
-            for j in Joint::ALL {
-                if keys.is_key(f.index, j) || derived.contains(&j) {
-                    continue;
-                }
-                let off = (f.points[j].pos - at(j)).norm() > 0.2 * torso;
-                let values: Vec<String> = row[j].iter().map(|v| format!("{v:.4}")).collect();
-                dump.push(format!(
-                    "{},{},{},{},{}",
-                    clip.name,
-                    f.index.get(),
-                    j.name(),
-                    values.join(","),
-                    u8::from(off)
-                ));
-            }
-        }
+        dump_doubt(dump, clip, &gt, &vba, &net, &keys, &product);
     }
     let weak = params.weak_reliability;
     let pointing = [
