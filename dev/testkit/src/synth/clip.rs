@@ -4,6 +4,9 @@
 
 use super::*;
 
+/// The second person: their joints per frame in the camera's space, stature and clothes.
+type Distractor = (Vec<PerJoint<Point3<f64>>>, f64, Appearance);
+
 /// The second person of a clip ([`SynthParams::distractor`]), in camera space per frame: a
 /// procedural walk on a body drawn from `seed`, crossing the view 2.5 m behind the subject's
 /// mean position, from the camera's left to its right (or back, by the seed).
@@ -12,7 +15,7 @@ fn distractor_frames(
     params: &SynthParams,
     target: &Vector3<f64>,
     placement: &Placement,
-) -> (Vec<PerJoint<Point3<f64>>>, f64, Appearance) {
+) -> Distractor {
     let body = BodyShape::drawn(seed, 0.12);
     let fps = f64::from(params.fps);
     let walk = retarget(
@@ -63,20 +66,7 @@ pub fn render_clip(
     let camera = PinholeCamera::centred(params.focal_px, params.width, params.height);
     let (camera_from_world, centre) = place_camera(&motion, params, &camera);
     let stature = subject_stature(params, &motion);
-    let bg = match &params.background_image {
-        Some(path) => image::open(path)
-            .map_err(|e| SynthError::Background {
-                path: path.clone(),
-                message: e.to_string(),
-            })?
-            .resize_to_fill(
-                params.width,
-                params.height,
-                image::imageops::FilterType::Triangle,
-            )
-            .to_rgb8(),
-        None => background(params.width, params.height, params.background_seed),
-    };
+    let bg = load_background(params)?;
     let placement = Placement {
         camera_from_world,
         centre,
@@ -85,10 +75,7 @@ pub fn render_clip(
         .distractor
         .map(|seed| distractor_frames(seed, params, &mean_pelvis(&motion), &placement));
 
-    let video_path = match params.output {
-        VideoOutput::Mp4 => out_dir.join("video.mp4"),
-        VideoOutput::PngSequence => out_dir.join("frames"),
-    };
+    let video_path = video_path_in(out_dir, params.output);
     let mut sink = FrameSink::open(params, &video_path)?;
     let mut gt_frames = Vec::with_capacity(motion.frames.len());
     let mut bone_sums = vec![0.0; Bone::ALL.len()];
@@ -101,17 +88,7 @@ pub fn render_clip(
             return Err(SynthError::Cancelled);
         }
         let cam_pts = to_camera(world);
-        let others: Vec<Figure> = distractor
-            .iter()
-            .filter_map(|(frames, stature, appearance)| {
-                frames.get(i).map(|points| Figure {
-                    points,
-                    stature_m: *stature,
-                    appearance: *appearance,
-                    surface: params.surface,
-                })
-            })
-            .collect();
+        let others = distractor_figures(distractor.as_ref(), i, params);
         let subject = Figure {
             points: &cam_pts,
             stature_m: stature,
@@ -131,30 +108,133 @@ pub fn render_clip(
         // The ground truth's joints as the clip's annotator defines them.
         let truth = to_camera(&params.joint_definitions.apply(world));
         let points2d = truth.map(|_, p| camera.project(p).unwrap_or(Point2::new(-1e6, -1e6)));
-        for (k, b) in Bone::ALL.iter().enumerate() {
-            bone_sums[k] += (truth[b.child] - truth[b.parent]).norm();
-        }
+        add_bone_lengths(&mut bone_sums, &truth);
         if i == 0 {
             first_points2d = Some(points2d);
         }
-        gt_frames.push(GroundTruthFrame {
-            index: i,
-            points2d: points2d
-                .0
-                .iter()
-                .map(|p| [round4(p.x), round4(p.y)])
-                .collect(),
-            points3d: truth
-                .0
-                .iter()
-                .map(|p| [round6(p.x), round6(p.y), round6(p.z)])
-                .collect(),
-            visible: r.visible.0.to_vec(),
-        });
+        gt_frames.push(truth_frame(i, &points2d, &truth, &r.visible.0));
         progress(i + 1, total);
     }
     sink.finish()?;
-    let gt = GroundTruth {
+    let gt = ground_truth(params, &motion, &camera, stature, &bone_sums, gt_frames);
+    let gt_path = out_dir.join("gt.json");
+    gt.save(&gt_path)?;
+    let marks_path = write_marks(out_dir, first_points2d)?;
+    Ok(SynthResult {
+        video: video_path,
+        ground_truth: gt_path,
+        marks: marks_path,
+        frames: total,
+        camera,
+        render_s_per_frame: render_s / total.max(1) as f64,
+        framing: framing_of(&motion, stature, &camera, &camera_from_world, &centre),
+    })
+}
+
+/// Where the video goes: `video.mp4`, or a `frames/` folder of PNGs.
+fn video_path_in(out_dir: &Path, output: VideoOutput) -> std::path::PathBuf {
+    match output {
+        VideoOutput::Mp4 => out_dir.join("video.mp4"),
+        VideoOutput::PngSequence => out_dir.join("frames"),
+    }
+}
+
+/// Adds each bone's length on this frame to its running sum.
+fn add_bone_lengths(bone_sums: &mut [f64], truth: &PerJoint<Point3<f64>>) {
+    for (k, b) in Bone::ALL.iter().enumerate() {
+        bone_sums[k] += (truth[b.child] - truth[b.parent]).norm();
+    }
+}
+
+/// The second person on frame `i`, when the clip has one walking behind.
+fn distractor_figures<'a>(
+    distractor: Option<&'a Distractor>,
+    i: usize,
+    params: &SynthParams,
+) -> Vec<Figure<'a>> {
+    distractor
+        .iter()
+        .filter_map(|(frames, stature, appearance)| {
+            frames.get(i).map(|points| Figure {
+                points,
+                stature_m: *stature,
+                appearance: *appearance,
+                surface: params.surface,
+            })
+        })
+        .collect()
+}
+
+/// The first frame's true joints as the user's marks (`marks.json`), rounded as a file keeps
+/// them.
+fn write_marks(
+    out_dir: &Path,
+    first_points2d: Option<PerJoint<Point2<f64>>>,
+) -> Result<std::path::PathBuf, SynthError> {
+    let marks_path = out_dir.join("marks.json");
+    if let Some(points) = first_points2d {
+        Marks {
+            frame: FrameIndex(0),
+            points: points.map(|_, p| nalgebra::Point2::new(round4(p.x), round4(p.y))),
+        }
+        .save(&marks_path)?;
+    }
+    Ok(marks_path)
+}
+
+/// The background: the clip's photograph resized to fill the frame, or a generated one.
+fn load_background(params: &SynthParams) -> Result<image::RgbImage, SynthError> {
+    Ok(match &params.background_image {
+        Some(path) => image::open(path)
+            .map_err(|e| SynthError::Background {
+                path: path.clone(),
+                message: e.to_string(),
+            })?
+            .resize_to_fill(
+                params.width,
+                params.height,
+                image::imageops::FilterType::Triangle,
+            )
+            .to_rgb8(),
+        None => background(params.width, params.height, params.background_seed),
+    })
+}
+
+/// One frame of the ground truth, rounded as the file keeps it.
+fn truth_frame(
+    index: usize,
+    points2d: &PerJoint<Point2<f64>>,
+    truth: &PerJoint<Point3<f64>>,
+    visible: &[bool],
+) -> GroundTruthFrame {
+    GroundTruthFrame {
+        index,
+        points2d: points2d
+            .0
+            .iter()
+            .map(|p| [round4(p.x), round4(p.y)])
+            .collect(),
+        points3d: truth
+            .0
+            .iter()
+            .map(|p| [round6(p.x), round6(p.y), round6(p.z)])
+            .collect(),
+        visible: visible.to_vec(),
+    }
+}
+
+/// The clip's ground truth: the camera, the stated height, each bone's mean length over the
+/// clip (`bone_sums` over its frames) and the frames.
+fn ground_truth(
+    params: &SynthParams,
+    motion: &Motion,
+    camera: &PinholeCamera,
+    stature: f64,
+    bone_sums: &[f64],
+    frames: Vec<GroundTruthFrame>,
+) -> GroundTruth {
+    let total = motion.frames.len();
+    GroundTruth {
         source: format!(
             "videomocap synth: motion {}, view {:?}, {} frames at {} fps",
             motion.origin, params.view, total, params.fps
@@ -173,27 +253,8 @@ pub fn render_clip(
             .enumerate()
             .map(|(k, b)| (b.key(), round6(bone_sums[k] / total as f64)))
             .collect(),
-        frames: gt_frames,
-    };
-    let gt_path = out_dir.join("gt.json");
-    gt.save(&gt_path)?;
-    let marks_path = out_dir.join("marks.json");
-    if let Some(points) = first_points2d {
-        Marks {
-            frame: FrameIndex(0),
-            points: points.map(|_, p| nalgebra::Point2::new(round4(p.x), round4(p.y))),
-        }
-        .save(&marks_path)?;
+        frames,
     }
-    Ok(SynthResult {
-        video: video_path,
-        ground_truth: gt_path,
-        marks: marks_path,
-        frames: total,
-        camera,
-        render_s_per_frame: render_s / total.max(1) as f64,
-        framing: framing_of(&motion, stature, &camera, &camera_from_world, &centre),
-    })
 }
 
 /// Where the camera stands: world → camera rotation and the camera's centre in the world.
