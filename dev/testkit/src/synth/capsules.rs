@@ -107,6 +107,115 @@ pub(super) fn v(p: &Point3<f64>) -> Vector3<f64> {
     p.coords
 }
 
+/// The trunk's, the girdles' and the limbs' round cones, in drawing order (each cone's texture
+/// seed is its place): joints, radii over stature at each end, and material.
+const LIMB_CONES: [(Joint, Joint, f64, f64, Material); 12] = {
+    use Joint::*;
+    [
+        (
+            Chest,
+            Pelvis,
+            radius::SPINE_CHEST,
+            radius::SPINE_PELVIS,
+            Material::Shirt,
+        ),
+        (
+            Neck,
+            Chest,
+            radius::SPINE_CHEST * 0.8,
+            radius::SPINE_CHEST,
+            Material::Shirt,
+        ),
+        (
+            LeftShoulder,
+            RightShoulder,
+            radius::SHOULDER_GIRDLE,
+            radius::SHOULDER_GIRDLE,
+            Material::Shirt,
+        ),
+        (
+            LeftHip,
+            RightHip,
+            radius::HIP_GIRDLE,
+            radius::HIP_GIRDLE,
+            Material::Trousers,
+        ),
+        (
+            LeftShoulder,
+            LeftElbow,
+            radius::UPPER_ARM.0,
+            radius::UPPER_ARM.1,
+            Material::Shirt,
+        ),
+        (
+            LeftElbow,
+            LeftWrist,
+            radius::FOREARM.0,
+            radius::FOREARM.1,
+            Material::Skin,
+        ),
+        (
+            RightShoulder,
+            RightElbow,
+            radius::UPPER_ARM.0,
+            radius::UPPER_ARM.1,
+            Material::Shirt,
+        ),
+        (
+            RightElbow,
+            RightWrist,
+            radius::FOREARM.0,
+            radius::FOREARM.1,
+            Material::Skin,
+        ),
+        (
+            LeftHip,
+            LeftKnee,
+            radius::THIGH.0,
+            radius::THIGH.1,
+            Material::Trousers,
+        ),
+        (
+            LeftKnee,
+            LeftAnkle,
+            radius::SHANK.0,
+            radius::SHANK.1,
+            Material::Trousers,
+        ),
+        (
+            RightHip,
+            RightKnee,
+            radius::THIGH.0,
+            radius::THIGH.1,
+            Material::Trousers,
+        ),
+        (
+            RightKnee,
+            RightAnkle,
+            radius::SHANK.0,
+            radius::SHANK.1,
+            Material::Trousers,
+        ),
+    ]
+};
+
+/// Each joint's radius over stature (the cone end it sits in).
+fn joint_radius(j: Joint) -> f64 {
+    use Joint::*;
+    match j {
+        HeadTop => radius::HEAD.2,
+        Neck => radius::SPINE_CHEST * 0.8,
+        Chest => radius::SPINE_CHEST,
+        Pelvis => radius::SPINE_PELVIS,
+        LeftShoulder | RightShoulder => radius::SHOULDER_GIRDLE,
+        LeftElbow | RightElbow => radius::UPPER_ARM.1,
+        LeftWrist | RightWrist => radius::FOREARM.1,
+        LeftHip | RightHip => radius::HIP_GIRDLE,
+        LeftKnee | RightKnee => radius::THIGH.1,
+        LeftAnkle | RightAnkle => radius::SHANK.1,
+    }
+}
+
 impl Body {
     /// Builds the primitives for joints given in camera space, for a subject of `stature_m`
     /// in the default clothes.
@@ -156,59 +265,8 @@ impl Body {
                 seed: cones.len() as f64 * 1.7,
             });
         };
-        cone(
-            Chest,
-            Pelvis,
-            radius::SPINE_CHEST,
-            radius::SPINE_PELVIS,
-            Material::Shirt,
-        );
-        cone(
-            Neck,
-            Chest,
-            radius::SPINE_CHEST * 0.8,
-            radius::SPINE_CHEST,
-            Material::Shirt,
-        );
-        cone(
-            LeftShoulder,
-            RightShoulder,
-            radius::SHOULDER_GIRDLE,
-            radius::SHOULDER_GIRDLE,
-            Material::Shirt,
-        );
-        cone(
-            LeftHip,
-            RightHip,
-            radius::HIP_GIRDLE,
-            radius::HIP_GIRDLE,
-            Material::Trousers,
-        );
-        for (sh, el, wr) in [
-            (LeftShoulder, LeftElbow, LeftWrist),
-            (RightShoulder, RightElbow, RightWrist),
-        ] {
-            cone(
-                sh,
-                el,
-                radius::UPPER_ARM.0,
-                radius::UPPER_ARM.1,
-                Material::Shirt,
-            );
-            cone(el, wr, radius::FOREARM.0, radius::FOREARM.1, Material::Skin);
-        }
-        for (hip, kn, an) in [
-            (LeftHip, LeftKnee, LeftAnkle),
-            (RightHip, RightKnee, RightAnkle),
-        ] {
-            cone(
-                hip,
-                kn,
-                radius::THIGH.0,
-                radius::THIGH.1,
-                Material::Trousers,
-            );
-            cone(kn, an, radius::SHANK.0, radius::SHANK.1, Material::Trousers);
+        for (a, b, ra, rb, material) in LIMB_CONES {
+            cone(a, b, ra, rb, material);
         }
         // Neck column from the neck joint to the base of the skull.
         let head_up = (p(HeadTop) - p(Neck)).try_normalize(1e-9).unwrap_or(up);
@@ -227,20 +285,7 @@ impl Body {
             (side / (hs * s)).transpose(),
             (hfront / (hf * s)).transpose(),
         ]);
-        let joint_radius = PerJoint::from_fn(|j| {
-            s * match j {
-                HeadTop => radius::HEAD.2,
-                Neck => radius::SPINE_CHEST * 0.8,
-                Chest => radius::SPINE_CHEST,
-                Pelvis => radius::SPINE_PELVIS,
-                LeftShoulder | RightShoulder => radius::SHOULDER_GIRDLE,
-                LeftElbow | RightElbow => radius::UPPER_ARM.1,
-                LeftWrist | RightWrist => radius::FOREARM.1,
-                LeftHip | RightHip => radius::HIP_GIRDLE,
-                LeftKnee | RightKnee => radius::THIGH.1,
-                LeftAnkle | RightAnkle => radius::SHANK.1,
-            }
-        });
+        let joint_radius = PerJoint::from_fn(|j| s * joint_radius(j));
         Body {
             cones,
             appearance,
