@@ -134,18 +134,66 @@ fn stretch(axis: &Vector3<f64>, along: f64, across: f64) -> Matrix3<f64> {
 /// rest mesh.
 fn bone_poses(rest: &RestMesh, p: &PerJoint<Point3<f64>>, width: f64) -> HashMap<Bone, BonePose> {
     use Joint::*;
-    let r = &rest.joints;
-    let q = |j: Joint| p[j].coords;
-    let ratio = |a: f64, b: f64| {
-        if b > 1e-9 {
-            (a / b).clamp(0.3, 3.0)
-        } else {
-            1.0
-        }
-    };
+    let fit = Fit { rest, p, width };
     let mut poses = HashMap::new();
-    // The trunk below the chest: up pelvis → chest, left from the hips.
-    let trunk = |lo: Joint, hi: Joint, left_a: Joint, left_b: Joint, side_scale: Option<f64>| {
+    let hips_scale = ratio(
+        (fit.q(LeftHip) - fit.q(RightHip)).norm(),
+        (rest.joints[LeftHip] - rest.joints[RightHip]).norm(),
+    );
+    let lower = fit.trunk(Pelvis, Chest, LeftHip, RightHip, Some(hips_scale));
+    let upper = fit.trunk(Chest, Neck, LeftShoulder, RightShoulder, None);
+    for b in [
+        Bone::Hips,
+        Bone::LeftHipJoint,
+        Bone::RightHipJoint,
+        Bone::LowerBack,
+    ] {
+        poses.insert(b, lower);
+    }
+    for b in [Bone::Spine, Bone::Chest] {
+        poses.insert(b, upper);
+    }
+    let head = fit.head(&upper);
+    poses.insert(Bone::Neck, head);
+    poses.insert(Bone::Head, head);
+    fit.arms(&upper, &mut poses);
+    fit.legs(&lower, &mut poses);
+    poses
+}
+
+/// `a / b` held within 0.3–3 (1 when `b` is nothing).
+fn ratio(a: f64, b: f64) -> f64 {
+    if b > 1e-9 {
+        (a / b).clamp(0.3, 3.0)
+    } else {
+        1.0
+    }
+}
+
+/// The rest mesh's joints fitted onto posed joints `p` for a subject `width` times as wide.
+struct Fit<'a> {
+    rest: &'a RestMesh,
+    p: &'a PerJoint<Point3<f64>>,
+    width: f64,
+}
+
+impl Fit<'_> {
+    fn q(&self, j: Joint) -> Vector3<f64> {
+        self.p[j].coords
+    }
+
+    /// A trunk part: up `lo` → `hi`, left from `left_b` → `left_a`, scaled across by
+    /// `side_scale` (else the width).
+    fn trunk(
+        &self,
+        lo: Joint,
+        hi: Joint,
+        left_a: Joint,
+        left_b: Joint,
+        side_scale: Option<f64>,
+    ) -> BonePose {
+        let (r, width) = (&self.rest.joints, self.width);
+        let q = |j: Joint| self.q(j);
         let fr = frame(r[hi] - r[lo], r[left_a] - r[left_b]);
         let fp = frame(q(hi) - q(lo), q(left_a) - q(left_b));
         let rot = fp * fr.transpose();
@@ -158,26 +206,13 @@ fn bone_poses(rest: &RestMesh, p: &PerJoint<Point3<f64>>, width: f64) -> HashMap
             anchor_rest: r[lo],
             anchor_posed: q(lo),
         }
-    };
-    let hips_scale = ratio(
-        (q(LeftHip) - q(RightHip)).norm(),
-        (r[LeftHip] - r[RightHip]).norm(),
-    );
-    let lower = trunk(Pelvis, Chest, LeftHip, RightHip, Some(hips_scale));
-    let upper = trunk(Chest, Neck, LeftShoulder, RightShoulder, None);
-    for b in [
-        Bone::Hips,
-        Bone::LeftHipJoint,
-        Bone::RightHipJoint,
-        Bone::LowerBack,
-    ] {
-        poses.insert(b, lower);
     }
-    for b in [Bone::Spine, Bone::Chest] {
-        poses.insert(b, upper);
-    }
-    // The head: up neck → head top, left carried from the chest.
-    let head = {
+
+    /// The head: up neck → head top, left carried from the chest (`upper`).
+    fn head(&self, upper: &BonePose) -> BonePose {
+        use Joint::*;
+        let (r, width) = (&self.rest.joints, self.width);
+        let q = |j: Joint| self.q(j);
         let fr = frame(r[HeadTop] - r[Neck], Vector3::x());
         let fp = frame(q(HeadTop) - q(Neck), upper.rotation * Vector3::x());
         let rot = fp * fr.transpose();
@@ -189,82 +224,101 @@ fn bone_poses(rest: &RestMesh, p: &PerJoint<Point3<f64>>, width: f64) -> HashMap
             anchor_rest: r[Neck],
             anchor_posed: q(Neck),
         }
-    };
-    poses.insert(Bone::Neck, head);
-    poses.insert(Bone::Head, head);
-    // A limb bone from `head_rest` to `tail_rest` onto `head_posed` → `tail_posed`, turned from
-    // its parent's rotation by the shortest arc.
-    let limb = |parent: &BonePose,
-                head_rest: Vector3<f64>,
-                tail_rest: Vector3<f64>,
-                head_posed: Vector3<f64>,
-                tail_posed: Vector3<f64>| {
+    }
+
+    /// A limb bone from `head_rest` to `tail_rest` onto `head_posed` → `tail_posed`, turned from
+    /// its parent's rotation by the shortest arc.
+    fn limb(
+        &self,
+        parent: &BonePose,
+        head_rest: Vector3<f64>,
+        tail_rest: Vector3<f64>,
+        head_posed: Vector3<f64>,
+        tail_posed: Vector3<f64>,
+    ) -> BonePose {
         let dr = tail_rest - head_rest;
         let dp = tail_posed - head_posed;
         let rot = swing(&(parent.rotation * dr), &dp) * parent.rotation;
         let axis = dr.try_normalize(1e-9).unwrap_or(Vector3::y());
         BonePose {
-            linear: rot * stretch(&axis, ratio(dp.norm(), dr.norm()), width),
+            linear: rot * stretch(&axis, ratio(dp.norm(), dr.norm()), self.width),
             rotation: rot,
             anchor_rest: head_rest,
             anchor_posed: head_posed,
         }
-    };
-    let rigid = |parent: &BonePose, at_rest: Vector3<f64>, at_posed: Vector3<f64>| BonePose {
-        linear: parent.rotation * width,
-        rotation: parent.rotation,
-        anchor_rest: at_rest,
-        anchor_posed: at_posed,
-    };
-    for (k, [clav, arm, fore, hand], [sh, el, wr]) in [
-        (
-            0,
-            [
-                Bone::LeftClavicle,
-                Bone::LeftArm,
-                Bone::LeftForeArm,
-                Bone::LeftHand,
-            ],
-            [LeftShoulder, LeftElbow, LeftWrist],
-        ),
-        (
-            1,
-            [
-                Bone::RightClavicle,
-                Bone::RightArm,
-                Bone::RightForeArm,
-                Bone::RightHand,
-            ],
-            [RightShoulder, RightElbow, RightWrist],
-        ),
-    ] {
-        let clav_rest = rest.clavicles[k];
-        let clav_posed = upper.anchor_posed + upper.linear * (clav_rest - upper.anchor_rest);
-        let c = limb(&upper, clav_rest, r[sh], clav_posed, q(sh));
-        let a = limb(&c, r[sh], r[el], q(sh), q(el));
-        let f = limb(&a, r[el], r[wr], q(el), q(wr));
-        poses.insert(hand, rigid(&f, r[wr], q(wr)));
-        poses.insert(clav, c);
-        poses.insert(arm, a);
-        poses.insert(fore, f);
     }
-    for ([up, leg, foot], [hip, knee, ankle]) in [
-        (
-            [Bone::LeftUpLeg, Bone::LeftLeg, Bone::LeftFoot],
-            [LeftHip, LeftKnee, LeftAnkle],
-        ),
-        (
-            [Bone::RightUpLeg, Bone::RightLeg, Bone::RightFoot],
-            [RightHip, RightKnee, RightAnkle],
-        ),
-    ] {
-        let u = limb(&lower, r[hip], r[knee], q(hip), q(knee));
-        let l = limb(&u, r[knee], r[ankle], q(knee), q(ankle));
-        poses.insert(foot, rigid(&l, r[ankle], q(ankle)));
-        poses.insert(up, u);
-        poses.insert(leg, l);
+
+    /// A bone carried rigidly by its parent (hands, feet).
+    fn rigid(&self, parent: &BonePose, at_rest: Vector3<f64>, at_posed: Vector3<f64>) -> BonePose {
+        BonePose {
+            linear: parent.rotation * self.width,
+            rotation: parent.rotation,
+            anchor_rest: at_rest,
+            anchor_posed: at_posed,
+        }
     }
-    poses
+
+    /// Each arm from its clavicle (carried by the chest, `upper`) to its hand.
+    fn arms(&self, upper: &BonePose, poses: &mut HashMap<Bone, BonePose>) {
+        use Joint::*;
+        let r = &self.rest.joints;
+        let q = |j: Joint| self.q(j);
+        for (k, [clav, arm, fore, hand], [sh, el, wr]) in [
+            (
+                0,
+                [
+                    Bone::LeftClavicle,
+                    Bone::LeftArm,
+                    Bone::LeftForeArm,
+                    Bone::LeftHand,
+                ],
+                [LeftShoulder, LeftElbow, LeftWrist],
+            ),
+            (
+                1,
+                [
+                    Bone::RightClavicle,
+                    Bone::RightArm,
+                    Bone::RightForeArm,
+                    Bone::RightHand,
+                ],
+                [RightShoulder, RightElbow, RightWrist],
+            ),
+        ] {
+            let clav_rest = self.rest.clavicles[k];
+            let clav_posed = upper.anchor_posed + upper.linear * (clav_rest - upper.anchor_rest);
+            let c = self.limb(upper, clav_rest, r[sh], clav_posed, q(sh));
+            let a = self.limb(&c, r[sh], r[el], q(sh), q(el));
+            let f = self.limb(&a, r[el], r[wr], q(el), q(wr));
+            poses.insert(hand, self.rigid(&f, r[wr], q(wr)));
+            poses.insert(clav, c);
+            poses.insert(arm, a);
+            poses.insert(fore, f);
+        }
+    }
+
+    /// Each leg from the hips (`lower`) to its foot.
+    fn legs(&self, lower: &BonePose, poses: &mut HashMap<Bone, BonePose>) {
+        use Joint::*;
+        let r = &self.rest.joints;
+        let q = |j: Joint| self.q(j);
+        for ([up, leg, foot], [hip, knee, ankle]) in [
+            (
+                [Bone::LeftUpLeg, Bone::LeftLeg, Bone::LeftFoot],
+                [LeftHip, LeftKnee, LeftAnkle],
+            ),
+            (
+                [Bone::RightUpLeg, Bone::RightLeg, Bone::RightFoot],
+                [RightHip, RightKnee, RightAnkle],
+            ),
+        ] {
+            let u = self.limb(lower, r[hip], r[knee], q(hip), q(knee));
+            let l = self.limb(&u, r[knee], r[ankle], q(knee), q(ankle));
+            poses.insert(foot, self.rigid(&l, r[ankle], q(ankle)));
+            poses.insert(up, u);
+            poses.insert(leg, l);
+        }
+    }
 }
 
 /// The mesh posed on joints `points` (camera space, metres) for a subject of `stature_m`:

@@ -6,7 +6,7 @@ use super::Bone;
 use flate2::read::GzDecoder;
 use nalgebra::Vector3;
 use serde::Deserialize;
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::io::Read;
 use videomocap_core::skeleton::{Joint, PerJoint};
 
@@ -76,7 +76,10 @@ pub(super) struct RestMesh {
 
 #[derive(Deserialize)]
 struct Weights {
-    weights: HashMap<String, Vec<(usize, f32)>>,
+    /// By bone name, read in name order: a vertex's bones of equal weight then keep one order,
+    /// so the same clip renders the same pixels on every run (a hash map's order changed from
+    /// process to process and with it a few grey levels on a couple of hundred pixels a frame).
+    weights: BTreeMap<String, Vec<(usize, f32)>>,
 }
 
 #[derive(Deserialize)]
@@ -258,7 +261,9 @@ type BoneEnds = HashMap<Bone, (Vector3<f64>, Vector3<f64>)>;
 fn bone_ends(
     cube: &dyn Fn(&str) -> Result<Vector3<f64>, MeshError>,
 ) -> Result<BoneEnds, MeshError> {
-    let rig: HashMap<String, RigBone> =
+    // In name order: where two of the rig's bones map onto one of ours, the same one is kept
+    // on every run (see `Weights`).
+    let rig: BTreeMap<String, RigBone> =
         serde_json::from_str(RIG).map_err(|e| bad(format!("rig: {e}")))?;
     let mut ends = HashMap::new();
     for (name, b) in &rig {

@@ -92,3 +92,23 @@ fn the_posed_mesh_keeps_the_clips_stature_and_its_joints() {
         .fold(0.0, f64::max);
     assert!(worst < 1e-6, "moved {worst} m");
 }
+
+/// The rest mesh reads the same every time (skinning weights and bone axes): two loads, each
+/// with its own hash maps inside, give identical weights and regions, so a clip renders the same
+/// pixels on every run.
+#[test]
+fn the_rest_mesh_reads_the_same_every_time() {
+    let a = RestMesh::load().unwrap();
+    for _ in 0..3 {
+        let b = RestMesh::load().unwrap();
+        assert!(a.weights == b.weights, "skinning weights differ between loads");
+        let axes = |m: &RestMesh| -> Vec<(f64, f64)> {
+            let p = Vector3::new(0.1, 0.9, 0.05);
+            m.regions
+                .iter()
+                .map(|(_, x)| x.pattern_coordinates(&p))
+                .collect()
+        };
+        assert!(axes(&a) == axes(&b), "bone axes differ between loads");
+    }
+}
