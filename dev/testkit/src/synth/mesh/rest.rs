@@ -123,32 +123,7 @@ impl RestMesh {
                 .map_err(|e| bad(format!("vertex group {name}: {e}")))
         };
         let skin_end = range("body")?.first().map_or(0, |r| r.1 + 1);
-        let mut all = Vec::new();
-        let mut triangles = Vec::new();
-        for line in obj.lines() {
-            let mut it = line.split_whitespace();
-            match it.next() {
-                Some("v") => {
-                    let c: Vec<f64> = it.filter_map(|t| t.parse().ok()).collect();
-                    if c.len() < 3 {
-                        return Err(bad(format!("vertex line {line:?}")));
-                    }
-                    all.push(Vector3::new(c[0], c[1], c[2]) * OBJ_UNIT_M);
-                }
-                Some("f") => {
-                    let idx: Vec<u32> = it
-                        .filter_map(|t| t.split('/').next()?.parse::<u32>().ok())
-                        .map(|i| i - 1)
-                        .collect();
-                    if idx.iter().all(|&i| (i as usize) < skin_end) {
-                        for k in 1..idx.len().saturating_sub(1) {
-                            triangles.push([idx[0], idx[k], idx[k + 1]]);
-                        }
-                    }
-                }
-                _ => {}
-            }
-        }
+        let (all, triangles) = parse_obj(&obj, skin_end)?;
         if all.len() < skin_end || triangles.is_empty() {
             return Err(bad("base.obj.gz holds no skin"));
         }
@@ -167,27 +142,9 @@ impl RestMesh {
         let top = positions.iter().map(|p| p.y).fold(f64::MIN, f64::max);
         let sole = positions.iter().map(|p| p.y).fold(f64::MAX, f64::min);
         let head = cube("joint-head")?;
-        let joints = PerJoint::from_fn(|j| {
-            use Joint::*;
-            let name = match j {
-                HeadTop => return Ok(Vector3::new(head.x, top, head.z)),
-                Neck => "joint-neck",
-                Chest => "joint-spine-1",
-                Pelvis => "joint-pelvis",
-                LeftShoulder => "joint-l-shoulder",
-                LeftElbow => "joint-l-elbow",
-                LeftWrist => "joint-l-hand",
-                RightShoulder => "joint-r-shoulder",
-                RightElbow => "joint-r-elbow",
-                RightWrist => "joint-r-hand",
-                LeftHip => "joint-l-upper-leg",
-                LeftKnee => "joint-l-knee",
-                LeftAnkle => "joint-l-ankle",
-                RightHip => "joint-r-upper-leg",
-                RightKnee => "joint-r-knee",
-                RightAnkle => "joint-r-ankle",
-            };
-            cube(name)
+        let joints = PerJoint::from_fn(|j| match joint_cube(j) {
+            None => Ok(Vector3::new(head.x, top, head.z)),
+            Some(name) => cube(name),
         });
         let mut js = PerJoint::from_fn(|_| Vector3::zeros());
         for (j, p) in joints.iter() {
@@ -212,6 +169,65 @@ impl RestMesh {
             stature_m: top - sole,
         })
     }
+}
+
+/// An OBJ's vertices (metres) and its skin's triangles.
+type ObjMesh = (Vec<Vector3<f64>>, Vec<[u32; 3]>);
+
+/// The OBJ's vertices (metres) and the skin's triangles (faces whose vertices all lie below
+/// `skin_end`, quads and polygons fanned).
+fn parse_obj(obj: &str, skin_end: usize) -> Result<ObjMesh, MeshError> {
+    let mut all = Vec::new();
+    let mut triangles = Vec::new();
+    for line in obj.lines() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => {
+                let c: Vec<f64> = it.filter_map(|t| t.parse().ok()).collect();
+                if c.len() < 3 {
+                    return Err(bad(format!("vertex line {line:?}")));
+                }
+                all.push(Vector3::new(c[0], c[1], c[2]) * OBJ_UNIT_M);
+            }
+            Some("f") => {
+                let idx: Vec<u32> = it
+                    .filter_map(|t| t.split('/').next()?.parse::<u32>().ok())
+                    .map(|i| i - 1)
+                    .collect();
+                if idx.iter().all(|&i| (i as usize) < skin_end) {
+                    for k in 1..idx.len().saturating_sub(1) {
+                        triangles.push([idx[0], idx[k], idx[k + 1]]);
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok((all, triangles))
+}
+
+/// The rig's joint cube that places each of our joints (`None`: the head top, on the top of the
+/// head above the head's cube).
+fn joint_cube(j: Joint) -> Option<&'static str> {
+    use Joint::*;
+    Some(match j {
+        HeadTop => return None,
+        Neck => "joint-neck",
+        Chest => "joint-spine-1",
+        Pelvis => "joint-pelvis",
+        LeftShoulder => "joint-l-shoulder",
+        LeftElbow => "joint-l-elbow",
+        LeftWrist => "joint-l-hand",
+        RightShoulder => "joint-r-shoulder",
+        RightElbow => "joint-r-elbow",
+        RightWrist => "joint-r-hand",
+        LeftHip => "joint-l-upper-leg",
+        LeftKnee => "joint-l-knee",
+        LeftAnkle => "joint-l-ankle",
+        RightHip => "joint-r-upper-leg",
+        RightKnee => "joint-r-knee",
+        RightAnkle => "joint-r-ankle",
+    })
 }
 
 /// Each vertex's four strongest bones (ours), normalised.

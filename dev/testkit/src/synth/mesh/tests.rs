@@ -101,7 +101,10 @@ fn the_rest_mesh_reads_the_same_every_time() {
     let a = RestMesh::load().unwrap();
     for _ in 0..3 {
         let b = RestMesh::load().unwrap();
-        assert!(a.weights == b.weights, "skinning weights differ between loads");
+        assert!(
+            a.weights == b.weights,
+            "skinning weights differ between loads"
+        );
         let axes = |m: &RestMesh| -> Vec<(f64, f64)> {
             let p = Vector3::new(0.1, 0.9, 0.05);
             m.regions
