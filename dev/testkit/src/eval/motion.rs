@@ -111,8 +111,38 @@ fn scored(gt: &GroundTruth) -> Vec<Joint> {
 /// Scores `skeleton` against the reference over the longest run of consecutive frames both
 /// hold; `None` when the reference's floor cannot be found or no run is four frames long.
 pub fn score_motion(gt: &GroundTruth, skeleton: &Skeleton3d) -> Option<MotionScore> {
-    // The frames both have, in order, in runs of consecutive indices.
-    let pairs: Vec<(usize, Pose, Pose, PerJoint<bool>)> = skeleton
+    let pairs = longest_common_run(gt, skeleton);
+    if pairs.len() < 4 {
+        return None;
+    }
+    let est: Vec<_> = pairs.iter().map(|p| p.1).collect();
+    let truth: Vec<_> = pairs.iter().map(|p| p.2).collect();
+    let contacts: Vec<_> = pairs.iter().map(|p| p.3).collect();
+    let world = WorldFrame::estimate(&truth, &[]).ok()?;
+    let est_world = WorldFrame::estimate(&est, &contacts).ok()?;
+    let (fps, joints) = (gt.fps, scored(gt));
+    let mut s = MotionScore::default();
+    jitter_and_acceleration(&mut s, &est, &truth, &joints, fps);
+    // The root's path after aligning the first frame.
+    for t in 0..est.len() {
+        let e = est[t][Joint::Pelvis] - est[0][Joint::Pelvis];
+        let r = truth[t][Joint::Pelvis] - truth[0][Joint::Pelvis];
+        s.root_m += (e - r).norm();
+        s.root_n += 1;
+        let height = |w: &WorldFrame, p: &Point3<f64>| w.to_world(p).y;
+        let truth_height = height(&world, &truth[t][Joint::Pelvis]);
+        s.root_height_m += (height(&est_world, &est[t][Joint::Pelvis]) - truth_height).abs();
+    }
+    foot_sliding(&mut s, &est, &truth, &world, fps);
+    Some(s)
+}
+
+/// A frame both hold: its index, the estimate, the reference, the estimate's planted joints.
+type Pair = (usize, Pose, Pose, PerJoint<bool>);
+
+/// The frames both hold over the longest run of consecutive indices.
+fn longest_common_run(gt: &GroundTruth, skeleton: &Skeleton3d) -> Vec<Pair> {
+    let pairs: Vec<Pair> = skeleton
         .frames
         .iter()
         .filter_map(|f| {
@@ -124,59 +154,54 @@ pub fn score_motion(gt: &GroundTruth, skeleton: &Skeleton3d) -> Option<MotionSco
     let start = (0..pairs.len())
         .filter(|&k| k == 0 || pairs[k].0 != pairs[k - 1].0 + 1)
         .collect::<Vec<_>>();
-    let run = start
+    let Some(run) = start
         .iter()
         .enumerate()
         .map(|(i, &s)| s..start.get(i + 1).copied().unwrap_or(pairs.len()))
-        .max_by_key(|r| r.len())?;
-    let pairs = &pairs[run];
-    if pairs.len() < 4 {
-        return None;
-    }
-    let est: Vec<_> = pairs.iter().map(|p| p.1).collect();
-    let truth: Vec<_> = pairs.iter().map(|p| p.2).collect();
-    let contacts: Vec<_> = pairs.iter().map(|p| p.3).collect();
-    let world = WorldFrame::estimate(&truth, &[]).ok()?;
-    let est_world = WorldFrame::estimate(&est, &contacts).ok()?;
-    let fps = gt.fps;
-    let joints = scored(gt);
-    let mut s = MotionScore::default();
-    // Jitter: third differences.
+        .max_by_key(|r| r.len())
+    else {
+        return Vec::new();
+    };
+    pairs[run].to_vec()
+}
+
+/// Jitter (third differences, the estimate's and the reference's own) and the acceleration
+/// error of the pelvis-aligned joints.
+fn jitter_and_acceleration(
+    s: &mut MotionScore,
+    est: &[Pose],
+    truth: &[Pose],
+    joints: &[Joint],
+    fps: f64,
+) {
     for t in 0..est.len() - 3 {
-        for &j in &joints {
+        for &j in joints {
             let third = |p: &[PerJoint<Point3<f64>>]| {
                 (p[t + 3][j].coords - 3.0 * p[t + 2][j].coords + 3.0 * p[t + 1][j].coords
                     - p[t][j].coords)
                     .norm()
                     * fps.powi(3)
             };
-            s.jitter += third(&est);
-            s.ref_jitter += third(&truth);
+            s.jitter += third(est);
+            s.ref_jitter += third(truth);
             s.jitter_n += 1;
         }
     }
-    // Acceleration error of the pelvis-aligned joints.
     for t in 1..est.len() - 1 {
-        for &j in &joints {
+        for &j in joints {
             let accel = |p: &[PerJoint<Point3<f64>>]| -> Vector3<f64> {
                 let q = |k: usize| p[k][j] - p[k][Joint::Pelvis];
                 (q(t + 1) - 2.0 * q(t) + q(t - 1)) * fps * fps
             };
-            s.accel += (accel(&est) - accel(&truth)).norm();
+            s.accel += (accel(est) - accel(truth)).norm();
             s.accel_n += 1;
         }
     }
-    // The root's path after aligning the first frame.
-    for t in 0..est.len() {
-        let e = est[t][Joint::Pelvis] - est[0][Joint::Pelvis];
-        let r = truth[t][Joint::Pelvis] - truth[0][Joint::Pelvis];
-        s.root_m += (e - r).norm();
-        s.root_n += 1;
-        let height = |w: &WorldFrame, p: &Point3<f64>| w.to_world(p).y;
-        let truth_height = height(&world, &truth[t][Joint::Pelvis]);
-        s.root_height_m += (height(&est_world, &est[t][Joint::Pelvis]) - truth_height).abs();
-    }
-    // Foot sliding over the reference's contact phases.
+}
+
+/// Foot sliding over the reference's contact phases: each ankle's horizontal travel while the
+/// reference's ankle is low and slow, the estimate's and the reference's own.
+fn foot_sliding(s: &mut MotionScore, est: &[Pose], truth: &[Pose], world: &WorldFrame, fps: f64) {
     let up = |v: Vector3<f64>| (world.rotation * v).y;
     let horizontal = |v: Vector3<f64>| {
         let w = world.rotation * v;
@@ -211,12 +236,11 @@ pub fn score_motion(gt: &GroundTruth, skeleton: &Skeleton3d) -> Option<MotionSco
                     .map(|k| horizontal(p[k][ankle] - p[k - 1][ankle]))
                     .sum()
             };
-            s.slide_m += travel(&est);
-            s.ref_slide_m += travel(&truth);
+            s.slide_m += travel(est);
+            s.ref_slide_m += travel(truth);
             s.phases += 1;
         }
     }
-    Some(s)
 }
 
 #[cfg(test)]
