@@ -237,6 +237,30 @@ fn person_mask(
     }
 }
 
+/// The box to carve: every frame's body (and the second person `second` to its side, when
+/// there is one), 20 cm around.
+fn carving_box(
+    motion: &Motion,
+    stature: f64,
+    second: Option<Vector3<f64>>,
+) -> (Point3<f64>, Point3<f64>) {
+    let (mut lo, mut hi) = (
+        Point3::from(Vector3::repeat(f64::MAX)),
+        Point3::from(Vector3::repeat(f64::MIN)),
+    );
+    for j in &motion.frames {
+        let (a, b) = Body::new(j, stature).bounds();
+        lo = lo.inf(&a);
+        hi = hi.sup(&b);
+        if let Some(second) = second {
+            lo = lo.inf(&(a + second));
+            hi = hi.sup(&(b + second));
+        }
+    }
+    let margin = Vector3::repeat(0.2);
+    (lo - margin, hi + margin)
+}
+
 /// [`write_carving_setup`] with the person drawn as `surface`: the capsule body, or MakeHuman's
 /// skinned mesh (suite v4's people) rasterised into each view.
 pub fn write_carving_setup_of(
@@ -249,22 +273,8 @@ pub fn write_carving_setup_of(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(), VolumeError> {
     let stature = stature_of(motion);
-    let (mut lo, mut hi) = (
-        Point3::from(Vector3::repeat(f64::MAX)),
-        Point3::from(Vector3::repeat(f64::MIN)),
-    );
     let second = Vector3::x() * faults.second_person_m.unwrap_or(0.0);
-    for j in &motion.frames {
-        let (a, b) = Body::new(j, stature).bounds();
-        lo = lo.inf(&a);
-        hi = hi.sup(&b);
-        if faults.second_person_m.is_some() {
-            lo = lo.inf(&(a + second));
-            hi = hi.sup(&(b + second));
-        }
-    }
-    let margin = Vector3::repeat(0.2);
-    let (lo, hi) = (lo - margin, hi + margin);
+    let (lo, hi) = carving_box(motion, stature, faults.second_person_m.map(|_| second));
     let centre = nalgebra::center(&lo, &hi);
     // Far enough that the box's bounding sphere fills at most 90 % of the shorter image side.
     let radius = (hi - lo).norm() / 2.0;
