@@ -137,6 +137,25 @@ fn length_errors(gt: &GroundTruth, read: &std::collections::BTreeMap<String, f64
         .collect()
 }
 
+/// Seconds the per-frame solve takes on `tracks` with the true lengths.
+fn time_per_frame_solve(
+    tracks: &Tracks2d,
+    camera: videomocap_core::camera::PinholeCamera,
+    gt: &GroundTruth,
+    params: &LiftParams,
+) -> Result<f64, ExitError> {
+    let job = LiftJob {
+        tracks,
+        camera,
+        subject: subject_from_truth(gt),
+        params: *params,
+        overrides: Default::default(),
+    };
+    let t0 = Instant::now();
+    lift_per_frame(&job).map_err(ExitError::failed)?;
+    Ok(t0.elapsed().as_secs_f64())
+}
+
 /// Lifts one clip in every case; returns its cases, the per-frame solve's (frames, seconds) on
 /// (a) with true lengths and focal, and the whole lift's seconds (reading the lengths, the
 /// per-frame solve, the refinement) on (a) from the stated height with the true focal.
@@ -179,16 +198,7 @@ fn run_clip(
             ];
             for (l, subject) in subjects.iter().enumerate() {
                 if (*i, l, f) == (0, 0, 0) {
-                    let job = LiftJob {
-                        tracks,
-                        camera,
-                        subject: subject_from_truth(&gt),
-                        params: *params,
-                        overrides: Default::default(),
-                    };
-                    let t0 = Instant::now();
-                    lift_per_frame(&job).map_err(ExitError::failed)?;
-                    solve_s += t0.elapsed().as_secs_f64();
+                    solve_s += time_per_frame_solve(tracks, camera, &gt, params)?;
                     solve_frames += tracks.frames.len();
                 }
                 let t0 = Instant::now();
@@ -225,44 +235,9 @@ fn run_clip(
     Ok((cases, solve_frames, solve_s, whole_s))
 }
 
-/// Runs the lift benchmark and prints its tables.
-pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
-    let threads = crate::bench_suite::machine_threads();
-    let params = crate::bench_suite::lift_settings(a)?;
-    let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;
-    let mut tally: Tally<Cases> = Tally::default();
-    let mut per_clip = vec![format!(
-        "{:<26} {:<5} {:<11} {:>8} {:>8} {:>8} {:>8} {:>8}",
-        "per clip (true focal)", "split", "family", "(a) true", "(a) mm", "cut", "(c) mm", "cut"
-    )];
-    let (mut solve_frames, mut solve_s, mut whole_s) = (0, 0.0, 0.0);
-    let mut rows_json = Vec::new();
-    for clip in &clips {
-        say(global, &format!("lifting {} …", clip.name));
-        let (cases, n, s, w) = run_clip(clip, threads, &params, !a.no_tracker)?;
-        solve_frames += n;
-        solve_s += s;
-        whole_s += w;
-        let (ex, tr) = (&cases.0[0][1][0], &cases.0[2][1][0]);
-        per_clip.push(format!(
-            "{:<26} {:<5} {:<11} {:>8.1} {:>8.1} {:>8.1} {:>8.1} {:>8.1}",
-            clip.name,
-            clip.split.name(),
-            clip.family.name(),
-            cases.0[0][0][0].0.mpjpe_mm(),
-            ex.0.mpjpe_mm(),
-            ex.1.mpjpe_mm(),
-            tr.0.mpjpe_mm(),
-            tr.1.mpjpe_mm()
-        ));
-        rows_json.push(serde_json::json!({
-            "clip": clip.name, "split": clip.split.name(), "family": clip.family.name(),
-            "exact_2d_true_lengths_mm": cases.0[0][0][0].0.mpjpe_mm(),
-            "exact_2d_stated_height_mm": ex.0.mpjpe_mm(), "exact_2d_cutout_mm": ex.1.mpjpe_mm(),
-            "tracker_stated_height_mm": tr.0.mpjpe_mm(), "tracker_cutout_mm": tr.1.mpjpe_mm(),
-        }));
-        tally.add(clip, &cases);
-    }
+/// The tables over splits and families: every input, lengths and camera; per family; lengths
+/// and mirrored frames; flags and margins.
+fn lift_tables(tally: &Tally<Cases>) -> Vec<String> {
     let mut out = vec![
         "lift after refinement: MPJPE (pelvis aligned), the flat cut-out's on the same input (true rays at the true pelvis depth), MPJPE ÷ cut-out, PA-MPJPE, wrong depth roots; mm".to_owned(),
         String::new(),
@@ -323,6 +298,76 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         out.extend(Tally::<Cases>::heading(doubt_width, &doubt_columns));
         out.extend(tally.lines(doubt_width, |c: &Cases| doubt_cell(&c.1[i].1)));
     }
+    out
+}
+
+/// Every case's figures per split and family, the clips' rows and the printed table, as JSON.
+fn lift_json(
+    tally: &Tally<Cases>,
+    rows_json: Vec<serde_json::Value>,
+    out: &[String],
+) -> serde_json::Value {
+    let mut cases_json = serde_json::Map::new();
+    for (i, input) in INPUTS.iter().enumerate() {
+        for (l, lengths) in LENGTHS.iter().enumerate() {
+            for (f, focal) in FOCALS.iter().enumerate() {
+                cases_json.insert(
+                    format!("{input}, {lengths}, {focal}"),
+                    tally.json(|c| {
+                        let p = &c.0[i][l][f];
+                        serde_json::json!({
+                            "mpjpe_mm": p.0.mpjpe_mm(), "pa_mpjpe_mm": p.0.pa_mpjpe_mm(),
+                            "cutout_mm": p.1.mpjpe_mm(), "wrong_roots": p.0.wrong_share(),
+                            "facing_mirrored": p.0.facing_mirrored_share(),
+                            "length_median_error": ((l, f) == (1, 0)).then(|| c.1[i].0.median()),
+                        })
+                    }),
+                );
+            }
+        }
+    }
+    serde_json::json!({"cases": cases_json, "clips": rows_json, "table": out})
+}
+
+/// Runs the lift benchmark and prints its tables.
+pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+    let threads = crate::bench_suite::machine_threads();
+    let params = crate::bench_suite::lift_settings(a)?;
+    let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;
+    let mut tally: Tally<Cases> = Tally::default();
+    let mut per_clip = vec![format!(
+        "{:<26} {:<5} {:<11} {:>8} {:>8} {:>8} {:>8} {:>8}",
+        "per clip (true focal)", "split", "family", "(a) true", "(a) mm", "cut", "(c) mm", "cut"
+    )];
+    let (mut solve_frames, mut solve_s, mut whole_s) = (0, 0.0, 0.0);
+    let mut rows_json = Vec::new();
+    for clip in &clips {
+        say(global, &format!("lifting {} …", clip.name));
+        let (cases, n, s, w) = run_clip(clip, threads, &params, !a.no_tracker)?;
+        solve_frames += n;
+        solve_s += s;
+        whole_s += w;
+        let (ex, tr) = (&cases.0[0][1][0], &cases.0[2][1][0]);
+        per_clip.push(format!(
+            "{:<26} {:<5} {:<11} {:>8.1} {:>8.1} {:>8.1} {:>8.1} {:>8.1}",
+            clip.name,
+            clip.split.name(),
+            clip.family.name(),
+            cases.0[0][0][0].0.mpjpe_mm(),
+            ex.0.mpjpe_mm(),
+            ex.1.mpjpe_mm(),
+            tr.0.mpjpe_mm(),
+            tr.1.mpjpe_mm()
+        ));
+        rows_json.push(serde_json::json!({
+            "clip": clip.name, "split": clip.split.name(), "family": clip.family.name(),
+            "exact_2d_true_lengths_mm": cases.0[0][0][0].0.mpjpe_mm(),
+            "exact_2d_stated_height_mm": ex.0.mpjpe_mm(), "exact_2d_cutout_mm": ex.1.mpjpe_mm(),
+            "tracker_stated_height_mm": tr.0.mpjpe_mm(), "tracker_cutout_mm": tr.1.mpjpe_mm(),
+        }));
+        tally.add(clip, &cases);
+    }
+    let mut out = lift_tables(&tally);
     out.push(String::new());
     out.extend(per_clip);
     out.push(String::new());
@@ -335,29 +380,7 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         1000.0 * whole_s / solve_frames.max(1) as f64
     ));
     if global.json {
-        let mut cases_json = serde_json::Map::new();
-        for (i, input) in INPUTS.iter().enumerate() {
-            for (l, lengths) in LENGTHS.iter().enumerate() {
-                for (f, focal) in FOCALS.iter().enumerate() {
-                    cases_json.insert(
-                        format!("{input}, {lengths}, {focal}"),
-                        tally.json(|c| {
-                            let p = &c.0[i][l][f];
-                            serde_json::json!({
-                                "mpjpe_mm": p.0.mpjpe_mm(), "pa_mpjpe_mm": p.0.pa_mpjpe_mm(),
-                                "cutout_mm": p.1.mpjpe_mm(), "wrong_roots": p.0.wrong_share(),
-                                "facing_mirrored": p.0.facing_mirrored_share(),
-                                "length_median_error": ((l, f) == (1, 0)).then(|| c.1[i].0.median()),
-                            })
-                        }),
-                    );
-                }
-            }
-        }
-        println!(
-            "{}",
-            serde_json::json!({"cases": cases_json, "clips": rows_json, "table": out})
-        );
+        println!("{}", lift_json(&tally, rows_json, &out));
     } else {
         for l in out {
             println!("{l}");
