@@ -53,6 +53,22 @@ fn next_to(frame: usize, n: usize) -> std::ops::Range<usize> {
     frame.saturating_sub(REDRAW_SPAN)..(frame + REDRAW_SPAN + 1).min(n)
 }
 
+/// The fixed-template baseline's accuracy from the same clicked marks, uncorrected.
+fn template_score(
+    video: &mut Video,
+    gt: &GroundTruth,
+    marks: &videomocap_core::formats::Marks,
+) -> Result<Accuracy, ExitError> {
+    let stature = videomocap_core::track::stature_px(
+        &marks.points,
+        &videomocap_core::skeleton::Proportions::default(),
+    );
+    let base = fixed_template_track(video, &marks.points, stature)?;
+    Ok(score_positions(gt, base.into_iter().enumerate())
+        .map_err(ExitError::failed)?
+        .overall)
+}
+
 /// Tracks a clip and corrects it for `rounds` rounds at most (fewer when nothing is left
 /// visibly wrong).
 fn correct_clip(
@@ -84,17 +100,10 @@ fn correct_clip(
             .map(|s| s.overall)
             .map_err(ExitError::failed)
     };
-    let stature = videomocap_core::track::stature_px(
-        &marks.points,
-        &videomocap_core::skeleton::Proportions::default(),
-    );
-    let base = fixed_template_track(&mut video, &marks.points, stature)?;
     let mut out = Rounds {
         scores: vec![score(&tracks)?],
         drags: vec![0],
-        template: score_positions(&gt, base.into_iter().enumerate())
-            .map_err(ExitError::failed)?
-            .overall,
+        template: template_score(&mut video, &gt, &marks)?,
         redraw_s: Vec::new(),
         moved_out: 0,
     };
@@ -106,8 +115,7 @@ fn correct_clip(
             keys.set(FrameIndex(c.frame), *joint, *pos);
         }
         done.insert(c.frame);
-        let n = tracks.frames.len();
-        let before = tracks.clone();
+        let (n, before) = (tracks.frames.len(), tracks.clone());
         let job = TrackJob {
             keys: keys.clone(),
             params,
@@ -174,6 +182,97 @@ fn cell(s: &[Accuracy; 3]) -> String {
     )
 }
 
+/// Each clip's row (before, after, rounds, drags, rounds to 0.97, joint-frames moved out) and
+/// how soon the real clips' frames near a correction were drawn.
+fn clip_lines(clips: &[BenchClip], results: &[(usize, Rounds)]) -> Vec<String> {
+    let mut lines = Vec::new();
+    lines.push(String::new());
+    lines.push(format!(
+        "{:<26} {:<5} {:>8} {:>8} {:>8} {:>7} {:>14} {:>16} {:>9}",
+        "clip",
+        "split",
+        "PCK@0.2",
+        "→ after",
+        "lost",
+        "rounds",
+        "joints dragged",
+        "rounds to 0.97",
+        "moved out"
+    ));
+    for (clip, (budget, r)) in clips.iter().zip(results) {
+        let last = at_round(r, *budget);
+        lines.push(format!(
+            "{:<26} {:<5} {:>8.3} {:>8.3} {:>7.1}% {:>7} {:>14} {:>16} {:>9}",
+            clip.name,
+            clip.split.name(),
+            r.scores[0].pck02(),
+            last.pck02(),
+            100.0 * last.lost(),
+            r.scores.len() - 1,
+            r.drags.iter().sum::<usize>(),
+            rounds_to_goal(r),
+            r.moved_out
+        ));
+    }
+    let redraw: Vec<String> = clips
+        .iter()
+        .zip(results)
+        .filter(|(_, (_, r))| !r.redraw_s.is_empty())
+        .filter(|(clip, _)| clip.family == videomocap_testkit::eval::suite::Family::Real)
+        .map(|(clip, (_, r))| {
+            let mut t = r.redraw_s.clone();
+            t.sort_by(f64::total_cmp);
+            format!(
+                "{} median {:.2} s, worst {:.2} s ({} re-tracks)",
+                clip.name,
+                t[t.len() / 2],
+                t[t.len() - 1],
+                t.len()
+            )
+        })
+        .collect();
+    if !redraw.is_empty() {
+        lines.push(String::new());
+        lines.push(format!(
+            "after a correction, every frame within {REDRAW_SPAN} of it re-tracked (1080×1920): {}",
+            redraw.join("; ")
+        ));
+    }
+    lines
+}
+
+/// The clips' rows and the splits' tallies as JSON, with the printed table.
+fn correct_json(
+    clips: &[BenchClip],
+    results: &[(usize, Rounds)],
+    tally: &Tally<[Accuracy; 3]>,
+    lines: &[String],
+) -> serde_json::Value {
+    let rows: Vec<_> = clips
+        .iter()
+        .zip(results)
+        .map(|(clip, (budget, r))| {
+            serde_json::json!({
+                "clip": clip.name, "split": clip.split.name(), "family": clip.family.name(),
+                "budget": budget,
+                "pck02": r.scores.iter().map(Accuracy::pck02).collect::<Vec<_>>(),
+                "lost": r.scores.iter().map(Accuracy::lost).collect::<Vec<_>>(),
+                "drags": r.drags,
+                "moved_out": r.moved_out,
+                "redraw_s": r.redraw_s,
+            })
+        })
+        .collect();
+    let split = tally.json(|s| {
+        serde_json::json!({
+            "before": crate::bench_track::accuracy_json(&s[0]),
+            "after": crate::bench_track::accuracy_json(&s[1]),
+        "fixed_template": crate::bench_track::accuracy_json(&s[2]),
+        })
+    });
+    serde_json::json!({"clips": rows, "splits": split, "table": lines})
+}
+
 /// Runs the correction benchmark and prints its table.
 pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let (threads, params) = threads_and_settings(a)?;
@@ -223,85 +322,9 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             "{split}: joint-frames within {KEPT_TORSO} torso that a correction moved out of it: {moved} (of {samples} joint-frames, summed over the re-tracks)"
         ));
     }
-    lines.push(String::new());
-    lines.push(format!(
-        "{:<26} {:<5} {:>8} {:>8} {:>8} {:>7} {:>14} {:>16} {:>9}",
-        "clip",
-        "split",
-        "PCK@0.2",
-        "→ after",
-        "lost",
-        "rounds",
-        "joints dragged",
-        "rounds to 0.97",
-        "moved out"
-    ));
-    for (clip, (budget, r)) in clips.iter().zip(&results) {
-        let last = at_round(r, *budget);
-        lines.push(format!(
-            "{:<26} {:<5} {:>8.3} {:>8.3} {:>7.1}% {:>7} {:>14} {:>16} {:>9}",
-            clip.name,
-            clip.split.name(),
-            r.scores[0].pck02(),
-            last.pck02(),
-            100.0 * last.lost(),
-            r.scores.len() - 1,
-            r.drags.iter().sum::<usize>(),
-            rounds_to_goal(r),
-            r.moved_out
-        ));
-    }
-    let redraw: Vec<String> = clips
-        .iter()
-        .zip(&results)
-        .filter(|(_, (_, r))| !r.redraw_s.is_empty())
-        .filter(|(clip, _)| clip.family == videomocap_testkit::eval::suite::Family::Real)
-        .map(|(clip, (_, r))| {
-            let mut t = r.redraw_s.clone();
-            t.sort_by(f64::total_cmp);
-            format!(
-                "{} median {:.2} s, worst {:.2} s ({} re-tracks)",
-                clip.name,
-                t[t.len() / 2],
-                t[t.len() - 1],
-                t.len()
-            )
-        })
-        .collect();
-    if !redraw.is_empty() {
-        lines.push(String::new());
-        lines.push(format!(
-            "after a correction, every frame within {REDRAW_SPAN} of it re-tracked (1080×1920): {}",
-            redraw.join("; ")
-        ));
-    }
+    lines.extend(clip_lines(&clips, &results));
     if global.json {
-        let rows: Vec<_> = clips
-            .iter()
-            .zip(&results)
-            .map(|(clip, (budget, r))| {
-                serde_json::json!({
-                    "clip": clip.name, "split": clip.split.name(), "family": clip.family.name(),
-                    "budget": budget,
-                    "pck02": r.scores.iter().map(Accuracy::pck02).collect::<Vec<_>>(),
-                    "lost": r.scores.iter().map(Accuracy::lost).collect::<Vec<_>>(),
-                    "drags": r.drags,
-                    "moved_out": r.moved_out,
-                    "redraw_s": r.redraw_s,
-                })
-            })
-            .collect();
-        let split = tally.json(|s| {
-            serde_json::json!({
-                "before": crate::bench_track::accuracy_json(&s[0]),
-                "after": crate::bench_track::accuracy_json(&s[1]),
-            "fixed_template": crate::bench_track::accuracy_json(&s[2]),
-            })
-        });
-        println!(
-            "{}",
-            serde_json::json!({"clips": rows, "splits": split, "table": lines})
-        );
+        println!("{}", correct_json(&clips, &results, &tally, &lines));
     } else {
         for l in lines {
             println!("{l}");
