@@ -1,8 +1,8 @@
-//! The subject's body read from the clip: first from the skeleton curve's joints on the frames
-//! whose curve showed all five limbs (median lengths; the shoulders and hips where they sit in
-//! the chest's and pelvis's frames), the radii from a typical body scaled to that height; then
-//! the lengths, widths and radii fitted to the points of a few of those frames, spread over the
-//! clip, and the median of each kept.
+//! The subject's body read from the clip: the project's typical body scaled to the clip's
+//! height (the points' extent), then its lengths, widths and radii fitted to the points of a
+//! few frames whose curve showed all five limbs, spread over the clip, the median of each kept
+//! and held near the typical proportions (the skeleton curve's own lengths are not read: on a
+//! real body's volume its legs end at the toes and its pose may face backwards).
 
 use super::model::{Pose, RADII, SubjectBody};
 use super::solve;
@@ -11,10 +11,14 @@ use nalgebra::{Point3, Vector3};
 use videomocap_core::skeleton::{Joint, PerJoint, SubjectModel, standing_pose};
 
 /// The capsules' radii of a typical body 1.75 m tall (measured on the proportions of the
-/// project's default subject: trunk, girdles, head, limbs), scaled to the subject's height.
-const TYPICAL_RADII_M: [f64; RADII] = [0.13, 0.12, 0.06, 0.09, 0.1, 0.05, 0.04, 0.075, 0.055];
+/// project's default subject: trunk, girdles, head, limbs; the foot's from a foot about 10 cm
+/// wide and 7 cm high), scaled to the subject's height.
+const TYPICAL_RADII_M: [f64; RADII] = [0.13, 0.12, 0.06, 0.09, 0.1, 0.05, 0.04, 0.075, 0.055, 0.04];
 /// The height [`TYPICAL_RADII_M`] belong to.
 const TYPICAL_HEIGHT_M: f64 = 1.75;
+/// A typical foot's capsule (ankle → the toes' round end less its radius) as a share of the
+/// height: a foot is about 15 % of the height, about 3/4 of it ahead of the ankle.
+const TYPICAL_FOOT_SHARE: f64 = 0.09;
 
 fn median(mut v: Vec<f64>) -> Option<f64> {
     v.retain(|x| x.is_finite());
@@ -28,18 +32,9 @@ fn median(mut v: Vec<f64>) -> Option<f64> {
 /// Picks a frame's left and right offsets (in a part's frame) from its pose and joints.
 type Offsets = dyn Fn(&Pose, &PerJoint<Point3<f64>>) -> [Vector3<f64>; 2];
 
-/// The first reading: from the curve's joints on the clean frames (`clean[i]`: frame i's curve
-/// showed all five limbs; every posed frame when none did).
-fn from_curve(curve: &[Option<PerJoint<Point3<f64>>>], clean: &[bool]) -> Option<SubjectBody> {
-    let mut frames: Vec<&PerJoint<Point3<f64>>> = curve
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| clean.get(*i).copied().unwrap_or(false))
-        .filter_map(|(_, p)| p.as_ref())
-        .collect();
-    if frames.is_empty() {
-        frames = curve.iter().flatten().collect();
-    }
+/// A body read from sets of joint positions (medians over the sets; the shoulders and hips
+/// where they sit in the chest's and pelvis's frames), the radii the typical ones at its height.
+fn of_joints(frames: &[PerJoint<Point3<f64>>]) -> Option<SubjectBody> {
     if frames.is_empty() {
         return None;
     }
@@ -95,6 +90,7 @@ fn from_curve(curve: &[Option<PerJoint<Point3<f64>>>], clean: &[bool]) -> Option
         limb_m,
         shoulder: Vector3::new(shoulder.x.abs().max(0.05), shoulder.y, shoulder.z),
         hip: Vector3::new(hip.x.abs().max(0.04), hip.y, hip.z),
+        foot_m: TYPICAL_FOOT_SHARE * height,
         radius_m: TYPICAL_RADII_M.map(|r| r * scale),
     })
 }
@@ -110,7 +106,7 @@ pub(super) fn typical(height_m: f64) -> Option<SubjectBody> {
         Point3::origin(),
         |_| [down; 4],
     );
-    from_curve(&[Some(joints)], &[true])
+    of_joints(&[joints])
 }
 
 /// The clip's height: the median over frames of the points' extent along +Y (the project's
@@ -130,47 +126,27 @@ pub(super) fn clip_height(points: &[FitPoints]) -> Option<f64> {
     )
 }
 
-/// The curve's reading checked against the typical body of the clip's height: a length more
-/// than [`PLAUSIBLE`] times off the typical one (the curve misnamed a limb on most frames) is
-/// the typical one.
-fn plausible(curve: SubjectBody, typical: &SubjectBody) -> SubjectBody {
-    let fix = |v: f64, t: f64| {
-        if v.is_finite() && v < PLAUSIBLE * t && v > t / PLAUSIBLE {
-            v
-        } else {
-            t
-        }
-    };
-    let mut b = curve;
-    for k in 0..3 {
-        b.spine_m[k] = fix(b.spine_m[k], typical.spine_m[k]);
-    }
-    for k in 0..4 {
-        b.limb_m[k] = fix(b.limb_m[k], typical.limb_m[k]);
-    }
-    b.shoulder.x = fix(b.shoulder.x, typical.shoulder.x);
-    b.hip.x = fix(b.hip.x, typical.hip.x);
-    b.radius_m = typical.radius_m;
-    b
-}
+/// How far (a factor) a refined length or width may be from the typical body's at the
+/// subject's scale: the body model has no hands and a capsule for a head, so refined freely on
+/// a real body's volume the forearm swallows the hand and the head grows (a mesh take's
+/// forearm read 0.35–0.43 m, its head 0.39–0.52).
+const LENGTH_BOUND: f64 = 1.15;
+/// See [`LENGTH_BOUND`]: the same for the capsules' radii (bodies differ more in girth).
+const RADIUS_BOUND: f64 = 1.3;
 
-/// How far (a factor) a length the curve read may be from the typical body's.
-const PLAUSIBLE: f64 = 1.4;
-
-/// The subject's body: the curve's reading refined on the points of up to
+/// The subject's body: the typical body at the clip's height refined on the points of up to
 /// `params.body_frames` clean frames spread over the clip (each fitted pose first, then pose
-/// and body together; the median of each quantity kept).
+/// and body together; the median of each quantity kept), then held within [`LENGTH_BOUND`]
+/// and [`RADIUS_BOUND`] of the typical body's proportions at the refined body's own scale
+/// (the median of its lengths' ratios to the typical ones: the clip's height is the points'
+/// extent, too short for a clip that bends or sits through most of its frames).
 pub(super) fn read_body(
     points: &[FitPoints],
     curve: &[Option<PerJoint<Point3<f64>>>],
     clean: &[bool],
     params: &ArticulatedParams,
 ) -> Option<SubjectBody> {
-    let typical = clip_height(points).and_then(typical);
-    let start = match (from_curve(curve, clean), &typical) {
-        (Some(c), Some(t)) => plausible(c, t),
-        (c, t) => c.or_else(|| t.clone())?,
-    };
+    let start = clip_height(points).and_then(typical)?;
     let usable: Vec<usize> = (0..points.len())
         .filter(|&i| {
             curve[i].is_some()
@@ -202,15 +178,72 @@ pub(super) fn read_body(
     }
     body.shoulder.x = med(&|b| b.shoulder.x, start.shoulder.x);
     body.hip.x = med(&|b| b.hip.x, start.hip.x);
+    body.foot_m = med(&|b| b.foot_m, start.foot_m);
     for j in 0..RADII {
         body.radius_m[j] = med(&|b| b.radius_m[j], start.radius_m[j]);
     }
-    // Where the chest joint splits the trunk is not seen on its surface: the trunk's length is
-    // the points', its split the typical body's.
-    if let Some(t) = &typical {
-        let trunk = body.spine_m[0] + body.spine_m[1];
-        let share = t.spine_m[0] / (t.spine_m[0] + t.spine_m[1]).max(1e-9);
-        body.spine_m = [share * trunk, (1.0 - share) * trunk, body.spine_m[2]];
+    Some(bounded(body, &start))
+}
+
+/// `body` held within [`LENGTH_BOUND`] and [`RADIUS_BOUND`] of `typical` scaled by the
+/// median of `body`'s lengths' and widths' ratios to `typical`'s; the trunk split as in
+/// `typical` (the chest joint is not seen on the trunk's surface).
+fn bounded(mut body: SubjectBody, typical: &SubjectBody) -> SubjectBody {
+    let t = typical;
+    let mut ratios: Vec<f64> = (0..3)
+        .map(|j| body.spine_m[j] / t.spine_m[j])
+        .chain((0..4).map(|j| body.limb_m[j] / t.limb_m[j]))
+        .collect();
+    ratios.push(body.shoulder.x / t.shoulder.x);
+    ratios.push(body.hip.x / t.hip.x);
+    let s = median(ratios).unwrap_or(1.0);
+    let hold = |v: f64, t: f64, b: f64| v.clamp(s * t / b, s * t * b);
+    for j in 0..3 {
+        body.spine_m[j] = hold(body.spine_m[j], t.spine_m[j], LENGTH_BOUND);
     }
-    Some(body)
+    for j in 0..4 {
+        body.limb_m[j] = hold(body.limb_m[j], t.limb_m[j], LENGTH_BOUND);
+    }
+    body.shoulder.x = hold(body.shoulder.x, t.shoulder.x, LENGTH_BOUND);
+    body.hip.x = hold(body.hip.x, t.hip.x, LENGTH_BOUND);
+    body.foot_m = hold(body.foot_m, t.foot_m, LENGTH_BOUND);
+    for j in 0..RADII {
+        body.radius_m[j] = hold(body.radius_m[j], t.radius_m[j], RADIUS_BOUND);
+    }
+    let trunk = body.spine_m[0] + body.spine_m[1];
+    let share = t.spine_m[0] / (t.spine_m[0] + t.spine_m[1]).max(1e-9);
+    body.spine_m = [share * trunk, (1.0 - share) * trunk, body.spine_m[2]];
+    body
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_refined_body_keeps_its_scale_and_loses_a_forearm_that_swallowed_the_hand() {
+        let t = typical(1.75).expect("a typical body");
+        // Every length 10 % longer (a taller subject), the forearm half as long again.
+        let mut b = t.clone();
+        b.spine_m = b.spine_m.map(|l| l * 1.1);
+        b.limb_m = b.limb_m.map(|l| l * 1.1);
+        b.shoulder.x *= 1.1;
+        b.hip.x *= 1.1;
+        b.limb_m[1] *= 1.5;
+        b.radius_m[4] *= 2.0;
+        let held = bounded(b.clone(), &t);
+        assert!(
+            (held.limb_m[0] - b.limb_m[0]).abs() < 1e-9,
+            "the scale is kept"
+        );
+        let forearm = 1.1 * t.limb_m[1] * LENGTH_BOUND;
+        assert!(
+            (held.limb_m[1] - forearm).abs() < 1e-9,
+            "{}",
+            held.limb_m[1]
+        );
+        assert!((held.radius_m[4] - 1.1 * t.radius_m[4] * RADIUS_BOUND).abs() < 1e-9);
+        let trunk = held.spine_m[0] + held.spine_m[1];
+        assert!((trunk - 1.1 * (t.spine_m[0] + t.spine_m[1])).abs() < 1e-9);
+    }
 }

@@ -1,13 +1,20 @@
 //! The subject's articulated body fitted over the clip (issue 91): what the paper's skeleton
 //! curve starts, this finishes. In order ([`fit_clip`]):
 //!
-//! 1. **The body** (`body`): segment lengths and where the shoulders and hips sit, read from
-//!    the frames whose curve showed all five limbs, then lengths, widths and capsule radii fitted
-//!    to the points of a few of those frames and the median kept (robust over the clip).
+//! 1. **The body** (`body`): the project's typical body at the clip's height, its lengths,
+//!    widths and capsule radii fitted to the points of a few frames whose curve showed all five
+//!    limbs, the median kept (robust over the clip) and held near the typical proportions.
 //! 2. **The fit per frame** (`solve`): Levenberg–Marquardt over the root and the joints'
-//!    rotations (within the joints' limits) pulls every capsule onto the frame's points, started
-//!    from the frame before (the previous frames' motion) and from the curve's own pose on this
-//!    frame (its labels and sides chosen over the whole clip); the better fit is kept.
+//!    rotations (within the joints' limits, a thigh's turn about itself among them) pulls every
+//!    capsule onto the frame's points, started from the frame before (the previous frames'
+//!    motion) and from the curve's own pose on this frame (its labels chosen over the whole
+//!    clip, its sides taken facing the way the frame before faces); the better fit is kept.
+//!    Which way the body faces is decided once for the clip: it is tracked from its first
+//!    frame's best fit and from that fit turned round (a track never turns the body round
+//!    between two frames); the track whose fits cost clearly less over the clip is kept, and
+//!    when neither does, the one facing as the curve does on more frames. What tells front from
+//!    back: the feet (a capsule forward of each ankle) on a real body's volume, the knees' bend
+//!    (the thighs cannot turn half round about themselves) on a bent leg.
 //! 3. **Flags**: a frame whose fit leaves many points off the body or a capsule without points
 //!    is flagged with the reason; a frame without points is interpolated and flagged. No frame is
 //!    dropped.
@@ -104,31 +111,27 @@ pub fn fit_clip(
         .map(|p| (p.points.len() >= 20).then(|| frame_data(p)))
         .collect();
     let first = (0..n).find(|&i| curve_pose[i].is_some() && data[i].is_some())?;
-    let mut done: Vec<Option<Done>> = vec![None; n];
-    let mut from_curve = 0;
-    let order: Vec<(usize, Option<usize>)> = (first..n)
-        .map(|i| (i, i.checked_sub(1).filter(|&p| p >= first)))
-        .chain((0..first).rev().map(|i| (i, Some(i + 1))))
-        .collect();
-    for (i, before) in order {
-        let Some(d) = &data[i] else { continue };
-        let prev = before.and_then(|b| done[b]);
-        let f = best_start(
-            &body,
-            d,
-            curve_pose[i].as_ref(),
-            prev.map(|p| p.pose),
-            prev.is_none(),
-            params,
-        );
-        if f.from_curve && prev.is_some() {
-            from_curve += 1;
+    let clip = Clip {
+        body: &body,
+        data: &data,
+        curve: &curve_pose,
+        first,
+        params,
+    };
+    let facing = track(&clip, None);
+    // The body turned round on the first frame, tracked the same way: the clip's front is the
+    // one whose fits explain the points clearly better, or else the one the curve shows.
+    let (done, from_curve) = match facing.done[first] {
+        Some(f) => {
+            let other = track(&clip, Some(turned_round(&f.pose)));
+            if facing_kept(&facing, &other, &curve_pose) {
+                (facing.done, facing.from_curve)
+            } else {
+                (other.done, other.from_curve)
+            }
         }
-        done[i] = Some(Done {
-            pose: f.fit.pose,
-            quality: f.fit.quality,
-        });
-    }
+        _ => (facing.done, facing.from_curve),
+    };
     let (skeleton, warnings) = skeleton_of(&done, points, &body, names, params, curve)?;
     Some(Fitted {
         skeleton,
@@ -136,6 +139,113 @@ pub fn fit_clip(
         warnings,
         from_curve,
     })
+}
+
+/// How much better (the mean over frames of the log of the ratio of the two fits' costs) one
+/// facing must explain the points to decide the clip's front; below it the two facings fit
+/// about as well (a capsule body standing straight) and the curve's front is kept.
+const FACING_MARGIN: f64 = 0.1;
+
+/// Whether track `a` faces the clip's front rather than `b` (the same clip turned round): the
+/// one whose fits cost clearly less over the frames both fitted; when neither does, the one
+/// facing the way the curve's pose faces on more frames.
+fn facing_kept(a: &Tracked, b: &Tracked, curve: &[Option<PerJoint<Point3<f64>>>]) -> bool {
+    let logs: Vec<f64> = a
+        .done
+        .iter()
+        .zip(&b.done)
+        .filter_map(|(x, y)| Some((x.as_ref()?.quality.cost, y.as_ref()?.quality.cost)))
+        .filter(|(x, y)| *x > 0.0 && *y > 0.0)
+        .map(|(x, y)| (y / x).ln())
+        .collect();
+    let mean = logs.iter().sum::<f64>() / logs.len().max(1) as f64;
+    let with_curve = |t: &Tracked| {
+        t.done
+            .iter()
+            .zip(curve)
+            .filter(|(d, c)| match (d, c) {
+                (Some(d), Some(c)) => {
+                    let front = |r: &Rotation3<f64>| r * Vector3::z();
+                    front(&d.pose.pelvis).dot(&front(&Pose::from_joints(c).pelvis)) > 0.0
+                }
+                _ => false,
+            })
+            .count()
+    };
+    if mean.abs() > FACING_MARGIN {
+        mean > 0.0
+    } else {
+        with_curve(a) >= with_curve(b)
+    }
+}
+
+/// What every frame's fit starts from.
+struct Clip<'a> {
+    body: &'a SubjectBody,
+    data: &'a [Option<FrameData>],
+    curve: &'a [Option<PerJoint<Point3<f64>>>],
+    /// The first frame with points and a curve pose: the tracking starts there.
+    first: usize,
+    params: &'a ArticulatedParams,
+}
+
+/// The clip's fits from one start on its first frame.
+struct Tracked {
+    done: Vec<Option<Done>>,
+    /// Frames whose fit started from the curve's pose.
+    from_curve: usize,
+    /// The fits' summed cost.
+    cost: f64,
+}
+
+/// Every frame fitted from the frame before (the first frame from `start`, or its best start
+/// when `None`), forwards from the first frame, then backwards before it.
+fn track(clip: &Clip, start: Option<Pose>) -> Tracked {
+    let n = clip.data.len();
+    let first = clip.first;
+    let mut out = Tracked {
+        done: vec![None; n],
+        from_curve: 0,
+        cost: 0.0,
+    };
+    let order: Vec<(usize, Option<usize>)> = (first..n)
+        .map(|i| (i, i.checked_sub(1).filter(|&p| p >= first)))
+        .chain((0..first).rev().map(|i| (i, Some(i + 1))))
+        .collect();
+    for (i, before) in order {
+        let Some(d) = &clip.data[i] else { continue };
+        let prev = before.and_then(|b| out.done[b]);
+        let f = match (i == first, start) {
+            (true, Some(s)) => Started {
+                fit: solve::fit(&s, clip.body, d, clip.params.iterations, false),
+                from_curve: false,
+            },
+            _ => best_start(
+                clip.body,
+                d,
+                clip.curve[i].as_ref(),
+                prev.map(|p| p.pose),
+                prev.is_none(),
+                clip.params,
+            ),
+        };
+        if f.from_curve && prev.is_some() {
+            out.from_curve += 1;
+        }
+        out.cost += f.fit.quality.cost;
+        out.done[i] = Some(Done {
+            pose: f.fit.pose,
+            quality: f.fit.quality,
+        });
+    }
+    out
+}
+
+/// `pose` turned half a turn about the vertical (+Y) through its root.
+fn turned_round(pose: &Pose) -> Pose {
+    let mut p = *pose;
+    p.pelvis = Rotation3::from_axis_angle(&Vector3::y_axis(), std::f64::consts::PI) * p.pelvis;
+    p
 }
 
 /// The best of a frame's fits and where it started.
@@ -150,9 +260,10 @@ pub(crate) struct Started {
 const FACINGS: usize = 8;
 
 /// The best fit of `body` to the frame `d` from its starts: the previous frame's pose `prev`,
-/// the curve's `curve` (kept only when clearly better than the previous frame's); and when
-/// neither fits well (or neither exists, or `search`), the body standing upright (+Y, the project's world)
-/// at the points' centre in [`FACINGS`] facings.
+/// the curve's `curve` (facing the way `prev` faces; kept only when clearly better than the
+/// previous frame's); and when neither fits well (or neither exists, or `search`), the body
+/// standing upright (+Y, the project's world) at the points' centre in [`FACINGS`] facings
+/// (with `prev`, only those less than a right angle from its facing).
 pub(crate) fn best_start(
     body: &SubjectBody,
     d: &FrameData,
@@ -167,7 +278,15 @@ pub(crate) fn best_start(
         from_curve: false,
     });
     if let Some(c) = curve {
-        let f = run(&Pose::from_joints(c));
+        // The curve's sides are its weakest reading: its pose is taken facing the way the
+        // previous frame's fit faces.
+        let mut start = Pose::from_joints(c);
+        if let Some(p) = prev
+            && (start.pelvis * Vector3::z()).dot(&(p.pelvis * Vector3::z())) < 0.0
+        {
+            start = Pose::from_joints(&swapped_sides(c));
+        }
+        let f = run(&start);
         // The curve's start replaces the previous frame's only when clearly better.
         if best
             .as_ref()
@@ -190,6 +309,13 @@ pub(crate) fn best_start(
             start.root = Point3::from(centre);
             let turn = k as f64 * std::f64::consts::TAU / FACINGS as f64;
             start.pelvis = Rotation3::from_axis_angle(&Vector3::y_axis(), turn);
+            // Within a track the body does not turn round between two frames (the clip's two
+            // tracks try both ways).
+            if prev.is_some_and(|p| {
+                (start.pelvis * Vector3::z()).dot(&(p.pelvis * Vector3::z())) < 0.0
+            }) {
+                continue;
+            }
             let f = run(&start);
             if best
                 .as_ref()
@@ -209,6 +335,18 @@ pub(crate) fn best_start(
     })
 }
 
+/// The joints `p` with left and right named the other way round (the body seen facing the
+/// other way).
+fn swapped_sides(p: &PerJoint<Point3<f64>>) -> PerJoint<Point3<f64>> {
+    let mut out = *p;
+    let (l, r) = (model::side_joints(0), model::side_joints(1));
+    for k in 0..6 {
+        out[l[k]] = p[r[k]];
+        out[r[k]] = p[l[k]];
+    }
+    out
+}
+
 /// Whether a fit leaves too many points off the body or a capsule without points.
 fn is_poor(q: &Quality, d: &FrameData, params: &ArticulatedParams) -> bool {
     q.unexplained > params.poor_unexplained
@@ -216,7 +354,7 @@ fn is_poor(q: &Quality, d: &FrameData, params: &ArticulatedParams) -> bool {
 }
 
 /// Segment names for warnings, in [`model::SEGMENTS`] order.
-const SEGMENT_NAMES: [&str; 13] = [
+const SEGMENT_NAMES: [&str; 15] = [
     "lower trunk",
     "upper trunk",
     "shoulders",
@@ -230,6 +368,8 @@ const SEGMENT_NAMES: [&str; 13] = [
     "left shin",
     "right thigh",
     "right shin",
+    "left foot",
+    "right foot",
 ];
 
 /// The fitted frames as a skeleton: flags for poor fits, frames without a fit interpolated.
@@ -309,4 +449,44 @@ fn skeleton_of(
         },
         warnings,
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A track of `n` frames facing +z (`back`: −z), each frame's fit costing `cost`.
+    fn tracked(n: usize, back: bool, cost: f64) -> Tracked {
+        let mut pose = Pose::default_standing();
+        if back {
+            pose = turned_round(&pose);
+        }
+        let quality = Quality {
+            cost,
+            unexplained: 0.0,
+            worst_gap: (0, 0.0),
+        };
+        Tracked {
+            done: vec![Some(Done { pose, quality }); n],
+            from_curve: 0,
+            cost: cost * n as f64,
+        }
+    }
+
+    #[test]
+    fn the_facing_that_fits_clearly_better_is_kept_and_the_curve_breaks_a_tie() {
+        let body = body::typical(1.75).expect("a typical body");
+        let front = Pose::default_standing().posed(&body).joints;
+        let curve_back =
+            vec![Some(turned_round(&Pose::default_standing()).posed(&body).joints); 10];
+        let curve_front = vec![Some(front); 10];
+        // Clearly cheaper: kept whatever the curve shows.
+        let (a, b) = (tracked(10, false, 1.0), tracked(10, true, 1.5));
+        assert!(facing_kept(&a, &b, &curve_back));
+        assert!(!facing_kept(&b, &a, &curve_front));
+        // About as cheap: the curve's facing.
+        let (a, b) = (tracked(10, false, 1.0), tracked(10, true, 0.97));
+        assert!(facing_kept(&a, &b, &curve_front));
+        assert!(!facing_kept(&a, &b, &curve_back));
+    }
 }

@@ -1,14 +1,16 @@
 //! The articulated body the fit poses: the product's 16-joint skeleton with the subject's segment
 //! lengths, the shoulders and hips at fixed places in the chest and pelvis, and a capsule (a
-//! round-ended cylinder) on each segment. A [`Pose`] is the root (pelvis position and frame), a
-//! ball joint at the spine's base, the neck, both shoulders and both hips, and a hinge at each
-//! elbow and knee; `Pose::posed` is its forward kinematics, [`Pose::from_joints`] the inverse
+//! round-ended cylinder) on each segment, and on each foot one forward of its ankle, rigid with
+//! its shank (a real body's feet are in its volume: without them the shank reaches for the toes
+//! and the knee's bend, which tells the body's front, reverses). A [`Pose`] is the root (pelvis
+//! position and frame), a ball joint at the spine's base, the neck, both shoulders and both
+//! hips, and a hinge at each elbow and knee; `Pose::posed` is its forward kinematics, [`Pose::from_joints`] the inverse
 //! (a pose from 16 joint positions, as the skeleton curve gives them).
 //!
 //! Frames are orthonormal: x to the subject's left, y up, z to the front. At rest (every local
 //! rotation the identity) the spine and head point up (+y) and the limbs hang down (−y).
 
-use nalgebra::{Matrix3, Point3, Rotation3, Vector3};
+use nalgebra::{Matrix3, Point3, Rotation3, UnitQuaternion, Vector3};
 use videomocap_core::skeleton::{Joint, PerJoint};
 
 /// The rigid parts of the model, each moved by the degrees of freedom of its chain.
@@ -21,18 +23,27 @@ pub(crate) enum Part {
     Forearm(usize),
     Thigh(usize),
     Shank(usize),
+    Foot(usize),
 }
 
 /// Radius classes: one per segment kind, left and right alike.
-pub(crate) const RADII: usize = 9;
+pub(crate) const RADII: usize = 10;
 
-/// One capsule: from joint `a` to joint `b` on `part`; when `cap` says so the far end is pulled
+/// A capsule's far end: a joint of the skeleton, or a foot's toe (left 0, right 1; not one of
+/// the 16 joints).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum End {
+    Joint(Joint),
+    Toe(usize),
+}
+
+/// One capsule: from joint `a` to `b` on `part`; when `cap` says so the far end is pulled
 /// in by the radius (the head top is the body's surface; a wrist or ankle is the centre of the
-/// limb's end, the hand and foot beyond it).
+/// limb's end, the hand beyond it).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct SegmentDef {
     pub a: Joint,
-    pub b: Joint,
+    pub b: End,
     pub part: Part,
     /// Index into [`SubjectBody::radius_m`].
     pub radius: usize,
@@ -41,15 +52,24 @@ pub(crate) struct SegmentDef {
 }
 
 /// The capsules of the model.
-pub(crate) const SEGMENTS: [SegmentDef; 13] = {
+pub(crate) const SEGMENTS: [SegmentDef; 15] = {
     use Joint::*;
     const fn s(a: Joint, b: Joint, part: Part, radius: usize, cap: bool) -> SegmentDef {
         SegmentDef {
             a,
-            b,
+            b: End::Joint(b),
             part,
             radius,
             cap,
+        }
+    }
+    const fn foot(a: Joint, k: usize) -> SegmentDef {
+        SegmentDef {
+            a,
+            b: End::Toe(k),
+            part: Part::Foot(k),
+            radius: 9,
+            cap: false,
         }
     }
     [
@@ -66,6 +86,8 @@ pub(crate) const SEGMENTS: [SegmentDef; 13] = {
         s(LeftKnee, LeftAnkle, Part::Shank(0), 8, false),
         s(RightHip, RightKnee, Part::Thigh(1), 7, false),
         s(RightKnee, RightAnkle, Part::Shank(1), 8, false),
+        foot(LeftAnkle, 0),
+        foot(RightAnkle, 1),
     ]
 };
 
@@ -80,8 +102,11 @@ pub struct SubjectBody {
     pub shoulder: Vector3<f64>,
     /// The left hip in the pelvis's frame, from the pelvis joint (the right one mirrored).
     pub hip: Vector3<f64>,
+    /// Ankle → the foot capsule's far end, metres (towards the front, `FOOT_TILT` down from
+    /// square to the shank).
+    pub foot_m: f64,
     /// Capsule radii: lower trunk, upper trunk, shoulder girdle, hip girdle, head, upper arm,
-    /// forearm, thigh, shank; metres.
+    /// forearm, thigh, shank, foot; metres.
     pub radius_m: [f64; RADII],
 }
 
@@ -95,6 +120,11 @@ pub(crate) const NECK_MAX: f64 = 1.0;
 /// See [`HINGE_MAX`]: how far a thigh may point behind the hips (hyperextension), as the sine
 /// of the angle from straight down.
 pub(crate) const THIGH_BACK_SIN: f64 = 0.6;
+/// See [`HINGE_MAX`]: how far a thigh may turn about its own axis from its rest (the swing–twist
+/// split about the bone), radians; a hip turns about 40° either way. Without it a body turned
+/// round bends its knees forwards by turning each thigh half a turn, and the knee's bend no
+/// longer tells the body's front from its back.
+pub(crate) const THIGH_TWIST_MAX: f64 = 0.7;
 
 /// A pose of the model: global frame of the pelvis, local rotations of the chest (about the
 /// pelvis), head (about the neck), upper arms and thighs, and the elbow and knee angles.
@@ -126,6 +156,18 @@ pub(crate) struct Posed {
     pub chest: Matrix3<f64>,
     pub upper_arm: [Matrix3<f64>; 2],
     pub thigh: [Matrix3<f64>; 2],
+    /// The feet's far ends (left, right).
+    pub toe: [Point3<f64>; 2],
+}
+
+impl Posed {
+    /// Where segment `s`'s capsule axis ends (before any `cap`).
+    pub(crate) fn end(&self, s: &SegmentDef) -> Point3<f64> {
+        match s.b {
+            End::Joint(j) => self.joints[j],
+            End::Toe(k) => self.toe[k],
+        }
+    }
 }
 
 /// Mirrors a left-side offset to the right (x flips).
@@ -145,6 +187,16 @@ pub(crate) fn forearm_dir(angle: f64) -> Vector3<f64> {
 /// A shank's direction in its thigh's frame (bent towards the back).
 pub(crate) fn shank_dir(angle: f64) -> Vector3<f64> {
     Vector3::new(0.0, -angle.cos(), -angle.sin())
+}
+
+/// How far the foot points down from square to its shank (towards the front), radians: the
+/// ankle sits about 8 cm above the floor and the toes' middle about 3 cm, 15–20 cm ahead
+/// (not tuned).
+pub(crate) const FOOT_TILT: f64 = 0.3;
+
+/// A foot's direction in its thigh's frame, the knee bent by `angle` (rigid with the shank).
+pub(crate) fn foot_dir(angle: f64) -> Vector3<f64> {
+    Vector3::new(0.0, -(angle + FOOT_TILT).sin(), (angle + FOOT_TILT).cos())
 }
 
 /// Which side's joints of a limb part: shoulder, elbow, wrist, hip, knee, ankle of the left
@@ -187,6 +239,7 @@ impl Pose {
         j[HeadTop] = j[Neck] + rh * up * body.spine_m[2];
         let ua = [0, 1].map(|k| rc * self.upper_arm[k].matrix());
         let th = [0, 1].map(|k| rp * self.thigh[k].matrix());
+        let mut toe = [Point3::origin(); 2];
         for k in 0..2 {
             let [sh, el, wr, hp, kn, an] = side_joints(k);
             j[sh] = j[Chest] + rc * mirror(&body.shoulder, k);
@@ -195,12 +248,14 @@ impl Pose {
             j[hp] = self.root + rp * mirror(&body.hip, k);
             j[kn] = j[hp] - th[k] * up * body.limb_m[2];
             j[an] = j[kn] + th[k] * shank_dir(self.knee[k]) * body.limb_m[3];
+            toe[k] = j[an] + th[k] * foot_dir(self.knee[k]) * body.foot_m;
         }
         Posed {
             joints: j,
             chest: rc,
             upper_arm: ua,
             thigh: th,
+            toe,
         }
     }
 
@@ -264,6 +319,7 @@ impl Pose {
         self.chest = cap_rotation(&self.chest, SPINE_MAX);
         self.head = cap_rotation(&self.head, NECK_MAX);
         for t in &mut self.thigh {
+            *t = cap_twist(t, THIGH_TWIST_MAX);
             // The thigh's direction in the pelvis frame may not point far behind.
             let d = *t * -Vector3::y();
             if d.z < -THIGH_BACK_SIN {
@@ -288,6 +344,27 @@ fn cap_rotation(r: &Rotation3<f64>, max: f64) -> Rotation3<f64> {
     } else {
         *r
     }
+}
+
+/// `r` with its turn about its own y axis (the twist of its swing–twist split) at most `max`.
+fn cap_twist(r: &Rotation3<f64>, max: f64) -> Rotation3<f64> {
+    let q = UnitQuaternion::from_rotation_matrix(r);
+    let (w, y) = (q.w, q.j);
+    let norm = (w * w + y * y).sqrt();
+    if norm < 1e-9 {
+        // Swung half a turn: the twist is not defined.
+        return *r;
+    }
+    let twist = 2.0 * (y / norm).atan2(w / norm);
+    // The twist's angle in (−π, π].
+    let twist =
+        (twist + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+    if twist.abs() <= max {
+        return *r;
+    }
+    let keep = Rotation3::from_axis_angle(&Vector3::y_axis(), twist.clamp(-max, max));
+    let undo = Rotation3::from_axis_angle(&Vector3::y_axis(), -twist);
+    r * undo * keep
 }
 
 /// An orthonormal frame with y along `up` and x along `left` made square to it.
@@ -326,6 +403,7 @@ mod tests {
             limb_m: [0.3, 0.25, 0.42, 0.4],
             shoulder: Vector3::new(0.18, 0.2, 0.0),
             hip: Vector3::new(0.1, -0.02, 0.0),
+            foot_m: 0.15,
             radius_m: [0.12; RADII],
         }
     }
@@ -367,6 +445,30 @@ mod tests {
         let j = pose.posed(&b).joints;
         assert!(j[Joint::LeftWrist].z > j[Joint::LeftElbow].z);
         assert!(j[Joint::LeftAnkle].z < j[Joint::LeftKnee].z);
+        // The feet point forwards and a little down, bent with the knee.
+        let toe = pose.posed(&b).toe[0];
+        let standing = Pose::default_standing().posed(&b);
+        assert!(standing.toe[0].z > standing.joints[Joint::LeftAnkle].z + 0.1);
+        assert!(standing.toe[0].y < standing.joints[Joint::LeftAnkle].y);
+        assert!(toe.z > j[Joint::LeftAnkle].z);
+    }
+
+    #[test]
+    fn a_thigh_turned_about_its_own_axis_is_turned_back_within_the_limit() {
+        // A swing (about an axis square to the bone) after the turn about the bone.
+        let axis = nalgebra::Unit::new_normalize(Vector3::new(-0.8, 0.0, 0.3));
+        let swing = Rotation3::from_axis_angle(&axis, 0.9);
+        let mut pose = Pose::default_standing();
+        pose.thigh[0] = swing * Rotation3::from_axis_angle(&Vector3::y_axis(), 2.5);
+        pose.thigh[1] = swing * Rotation3::from_axis_angle(&Vector3::y_axis(), -0.3);
+        let before = pose.thigh;
+        pose.limit();
+        // The bone's direction is kept; the turn about it is capped, a small one left alone.
+        let along = |r: &Rotation3<f64>| r * Vector3::y();
+        assert!((along(&pose.thigh[0]) - along(&before[0])).norm() < 1e-9);
+        let twist = (swing.inverse() * pose.thigh[0]).angle();
+        assert!((twist - THIGH_TWIST_MAX).abs() < 1e-9, "twist {twist}");
+        assert!((pose.thigh[1].matrix() - before[1].matrix()).norm() < 1e-9);
     }
 
     #[test]

@@ -15,8 +15,12 @@ use videomocap_core::skeleton::Joint;
 /// Degrees of freedom of the pose.
 pub(crate) const POSE_DOF: usize = 28;
 /// Degrees of freedom of the body: three spine lengths, four limb lengths, shoulder and hip
-/// half-widths, and the radii.
-pub(crate) const BODY_DOF: usize = 9 + RADII;
+/// half-widths, the foot's length, and the radii.
+pub(crate) const BODY_DOF: usize = RADIUS_COL + RADII;
+/// The body's column of the foot's length (after [`POSE_DOF`]).
+const FOOT_COL: usize = 9;
+/// The body's first radius column (after [`POSE_DOF`]).
+const RADIUS_COL: usize = 10;
 /// Where each coverage sample sits along its capsule's axis.
 const COVER_AT: [f64; 3] = [0.15, 0.5, 0.85];
 
@@ -71,7 +75,7 @@ fn capsules(posed: &Posed, body: &SubjectBody) -> Vec<Capsule> {
         .iter()
         .map(|s| {
             let a = posed.joints[s.a];
-            let mut b = posed.joints[s.b];
+            let mut b = posed.end(s);
             let r = body.radius_m[s.radius].max(1e-3);
             if s.cap {
                 let d = b - a;
@@ -146,7 +150,7 @@ fn row(
     r.rot(3, c - root, n);
     let part = SEGMENTS[seg].part;
     match part {
-        Part::Pelvis | Part::Thigh(_) | Part::Shank(_) => {}
+        Part::Pelvis | Part::Thigh(_) | Part::Shank(_) | Part::Foot(_) => {}
         _ => r.rot(6, c - root, n),
     }
     match part {
@@ -159,10 +163,11 @@ fn row(
                 r.push(18 + k, -axis.dot(&(c - j[el]).cross(n)));
             }
         }
-        Part::Thigh(k) | Part::Shank(k) => {
+        Part::Thigh(k) | Part::Shank(k) | Part::Foot(k) => {
             let [.., hp, kn, _] = side_joints(k);
             r.rot(20 + 3 * k, c - j[hp], n);
-            if let Part::Shank(_) = part {
+            // The foot turns with the shank about the knee.
+            if let Part::Shank(_) | Part::Foot(_) = part {
                 let axis = posed.thigh[k] * Vector3::x();
                 r.push(26 + k, -axis.dot(&(c - j[kn]).cross(n)));
             }
@@ -227,22 +232,31 @@ fn body_columns(r: &mut Row, seg: usize, t: f64, n: &Vector3<f64>, posed: &Posed
                 .unwrap_or(Vector3::x());
             length(8, x, 1.0 - 2.0 * t);
         }
-        Part::Thigh(k) | Part::Shank(k) => {
+        Part::Thigh(k) | Part::Shank(k) | Part::Foot(k) => {
             let [.., hp, kn, an] = side_joints(k);
             let x = (j[LeftHip] - j[RightHip])
                 .try_normalize(1e-9)
                 .unwrap_or(Vector3::x());
             length(8, if k == 0 { x } else { -x }, 1.0);
-            if let Part::Thigh(_) = s.part {
-                length(5, dir(hp, kn), t);
-            } else {
-                length(5, dir(hp, kn), 1.0);
-                length(6, dir(kn, an), t);
+            match s.part {
+                Part::Thigh(_) => length(5, dir(hp, kn), t),
+                Part::Shank(_) => {
+                    length(5, dir(hp, kn), 1.0);
+                    length(6, dir(kn, an), t);
+                }
+                _ => {
+                    length(5, dir(hp, kn), 1.0);
+                    length(6, dir(kn, an), 1.0);
+                    let u = (posed.toe[k] - j[an])
+                        .try_normalize(1e-9)
+                        .unwrap_or(Vector3::z());
+                    length(FOOT_COL, u, t);
+                }
             }
         }
         _ => {}
     }
-    r.push(POSE_DOF + 9 + s.radius, -1.0);
+    r.push(POSE_DOF + RADIUS_COL + s.radius, -1.0);
 }
 
 /// The normal equations of one pose.
@@ -358,12 +372,17 @@ fn step(pose: &Pose, body: &SubjectBody, d: &DVector<f64>) -> (Pose, SubjectBody
         }
         b.shoulder.x = (b.shoulder.x + e(7)).max(0.03);
         b.hip.x = (b.hip.x + e(8)).max(0.02);
+        b.foot_m = (b.foot_m + e(FOOT_COL)).clamp(FOOT_MIN_M, 0.35);
         for k in 0..RADII {
-            b.radius_m[k] = (b.radius_m[k] + e(9 + k)).clamp(0.01, 0.3);
+            b.radius_m[k] = (b.radius_m[k] + e(RADIUS_COL + k)).clamp(0.01, 0.3);
         }
     }
     (p, b)
 }
+
+/// The shortest foot (a body without feet, as the capsule volumes have, keeps one this long,
+/// inside its shank's round end).
+const FOOT_MIN_M: f64 = 0.01;
 
 /// A fit's result.
 #[derive(Debug, Clone)]
@@ -434,7 +453,8 @@ mod tests {
             limb_m: [0.3, 0.25, 0.42, 0.4],
             shoulder: Vector3::new(0.18, 0.2, 0.0),
             hip: Vector3::new(0.1, -0.02, 0.0),
-            radius_m: [0.13, 0.12, 0.06, 0.08, 0.1, 0.05, 0.04, 0.07, 0.05],
+            foot_m: 0.14,
+            radius_m: [0.13, 0.12, 0.06, 0.08, 0.1, 0.05, 0.04, 0.07, 0.05, 0.04],
         }
     }
 
@@ -511,8 +531,14 @@ mod tests {
         let data = FrameData::new(surface(&pose, &truth_body), 0.03);
         let mut start = truth_body.clone();
         start.limb_m = start.limb_m.map(|l| l * 1.12);
+        start.foot_m = 0.09;
         start.radius_m = [0.09; RADII];
         let f = fit(&pose, &start, &data, 60, true);
+        assert!(
+            (f.body.foot_m - truth_body.foot_m).abs() < 0.03,
+            "foot {}",
+            f.body.foot_m
+        );
         for k in 0..4 {
             let d = (f.body.limb_m[k] - truth_body.limb_m[k]).abs();
             assert!(
@@ -524,5 +550,43 @@ mod tests {
         }
         let d = (f.body.radius_m[7] - truth_body.radius_m[7]).abs();
         assert!(d < 0.01, "thigh radius {}", f.body.radius_m[7]);
+    }
+
+    #[test]
+    fn a_body_without_feet_is_read_with_its_feet_shrunk() {
+        let mut truth_body = body();
+        truth_body.foot_m = FOOT_MIN_M;
+        let mut pose = Pose::default_standing();
+        pose.knee = [0.4, 0.2];
+        let data = FrameData::new(surface(&pose, &truth_body), 0.03);
+        // Started with long feet: they come back within the shanks' round ends and the radius
+        // beyond (a shorter foot is buried in the shank and costs nothing either way).
+        let mut start = body();
+        start.foot_m = 0.2;
+        let f = fit(&pose, &start, &data, 60, true);
+        assert!(f.body.foot_m < 0.1, "foot {}", f.body.foot_m);
+    }
+
+    #[test]
+    fn the_feet_tell_the_front_from_the_back() {
+        // Nearly straight legs: without feet, a body turned round explains the points almost
+        // as well (only the slight bends differ); the feet make it clearly worse.
+        let b = body();
+        let mut truth = Pose::default_standing();
+        truth.root = Point3::new(0.0, 1.0, 0.0);
+        truth.knee = [0.15, 0.05];
+        let data = FrameData::new(surface(&truth, &b), 0.03);
+        let mut turned = truth;
+        turned.pelvis = Rotation3::from_axis_angle(&Vector3::y_axis(), std::f64::consts::PI);
+        let (right, wrong) = (
+            fit(&truth, &b, &data, 20, false),
+            fit(&turned, &b, &data, 20, false),
+        );
+        assert!(
+            wrong.quality.cost > 2.0 * right.quality.cost,
+            "{} vs {}",
+            wrong.quality.cost,
+            right.quality.cost
+        );
     }
 }
