@@ -13,6 +13,7 @@ Examples:
   videomocap-bench volume --split test         the point-volume pipeline
   videomocap-bench scrub                       the app's frame access on a long 1080p clip
   videomocap-bench speed                       decoding and rendering speed
+  videomocap-bench speed track --runs 3        track with/without the network beside MediaPipe
   videomocap-bench synth --motion walk --view side --frames 150 -o synth_walk/
   videomocap-bench synth --motion tests/data/cmu_02_01_walk.bvh --view oblique -o walk/
   videomocap-bench score tracks2d.json synth_walk/gt.json
@@ -53,9 +54,10 @@ pub enum Command {
     Scrub(BenchArgs),
     /// VBA alone, the pose network alone and the two together, from the same clicked marks.
     Learned(BenchArgs),
-    /// Decoding (beside the ffmpeg command) and rendering speed.
+    /// Decoding (beside the ffmpeg command) and rendering speed; `track`: whole `videomocap
+    /// track` processes with and without the pose network beside MediaPipe's (issue 95).
     Speed {
-        /// all, decode or synth.
+        /// all, decode, synth, track or network (the network's profile per operator).
         #[arg(default_value = "all")]
         what: String,
         #[command(flatten)]
@@ -257,4 +259,7 @@ pub struct BenchArgs {
     /// (`scripts/fit_doubt.py`).
     #[arg(long)]
     pub doubt_dump: Option<PathBuf>,
+    /// `speed track` and `speed network`: runs of each process or network run (medians).
+    #[arg(long, default_value_t = 3)]
+    pub runs: usize,
 }
