@@ -14,6 +14,7 @@ Examples:
   videomocap-bench scrub                       the app's frame access on a long 1080p clip
   videomocap-bench speed                       decoding and rendering speed
   videomocap-bench speed track --runs 3        track with/without the network beside MediaPipe
+  videomocap-bench speed retrack --runs 3      a re-track after one correction, 300 frames of 1080p
   videomocap-bench synth --motion walk --view side --frames 150 -o synth_walk/
   videomocap-bench synth --motion tests/data/cmu_02_01_walk.bvh --view oblique -o walk/
   videomocap-bench score tracks2d.json synth_walk/gt.json
@@ -57,7 +58,8 @@ pub enum Command {
     /// Decoding (beside the ffmpeg command) and rendering speed; `track`: whole `videomocap
     /// track` processes with and without the pose network beside MediaPipe's (issue 95).
     Speed {
-        /// all, decode, synth, track or network (the network's profile per operator).
+        /// all, decode, synth, track, network (the network's profile per operator) or retrack
+        /// (a re-track after one correction on a 300-frame 1080p clip).
         #[arg(default_value = "all")]
         what: String,
         #[command(flatten)]
@@ -259,7 +261,8 @@ pub struct BenchArgs {
     /// (`scripts/fit_doubt.py`).
     #[arg(long)]
     pub doubt_dump: Option<PathBuf>,
-    /// `speed track` and `speed network`: runs of each process or network run (medians).
+    /// `speed track`, `speed network` and `speed retrack`: runs of each process, network run
+    /// or re-track (medians).
     #[arg(long, default_value_t = 3)]
     pub runs: usize,
 }

@@ -10,6 +10,7 @@ mod bench_learned;
 mod bench_lift;
 mod bench_lift_network;
 mod bench_motion;
+mod bench_retrack;
 mod bench_scrub;
 mod bench_speed;
 mod bench_suite;
@@ -38,6 +39,7 @@ fn main() -> ExitCode {
         Command::Scrub(a) => bench_scrub::run(a, global),
         Command::Learned(a) => bench_learned::run(a, global),
         Command::Speed { what, args } if what == "track" => bench_speed::run(args, global),
+        Command::Speed { what, args } if what == "retrack" => bench_retrack::run(args, global),
         Command::Speed { what, args } if what == "network" => {
             bench_speed::run_network(args, global)
         }
