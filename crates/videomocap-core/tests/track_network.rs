@@ -154,3 +154,77 @@ fn an_edit_history_replayed_gives_the_tracks_of_a_fresh_run() {
     assert_eq!(replayed.spans, fresh.spans);
     assert_eq!(replayed.tracks.frames[3].points[Joint::Neck].pos, neck);
 }
+
+/// A reader of a video that cannot make a second reader of itself: tracking on it runs the
+/// network after VBA's passes, on the calling thread only.
+struct NoSecondReader(Box<dyn videomocap_core::video::VideoSource>);
+
+impl videomocap_core::video::VideoSource for NoSecondReader {
+    fn info(&self) -> &videomocap_core::video::VideoInfo {
+        self.0.info()
+    }
+    fn time_of(&self, index: usize) -> f64 {
+        self.0.time_of(index)
+    }
+    fn decode(
+        &mut self,
+        index: usize,
+    ) -> Result<image::RgbImage, videomocap_core::video::VideoError> {
+        self.0.decode(index)
+    }
+    fn output_size(&mut self, size: Option<(u32, u32)>) -> bool {
+        self.0.output_size(size)
+    }
+}
+
+/// The network run ahead of VBA's passes on its own thread (issue 95) is only a cache: with it
+/// and without it (a video that cannot be read twice at once), the tracks and what the network
+/// saw are the same, byte for byte, on the marks alone and with corrections, one of them a
+/// pelvis placed a torso away from the network's (a key that refuses the network's body, where
+/// the network's chain needs VBA's).
+#[test]
+fn the_network_run_ahead_of_vba_changes_nothing() {
+    use videomocap_core::video::{DEFAULT_SEQUENCE_FPS, ImageSequence};
+    let dir = tempfile::tempdir().unwrap();
+    let clip = render_small_clip(dir.path(), ProceduralMotion::Walk, 12, View::Oblique).unwrap();
+    let marks = Marks::load(&clip.marks).unwrap();
+    let network = Arc::new(PoseNetwork::bundled().unwrap());
+    let marked = KeyFrames::from_marks(&marks);
+    let mut corrected = marked.clone();
+    let torso = marks.points[Joint::Neck] - marks.points[Joint::Pelvis];
+    corrected.set(
+        FrameIndex(5),
+        Joint::Pelvis,
+        marks.points[Joint::Pelvis] + torso,
+    );
+    corrected.set(
+        FrameIndex(9),
+        Joint::LeftWrist,
+        marks.points[Joint::LeftWrist] + nalgebra::Vector2::new(3.0, 0.0),
+    );
+    let text = |t: &videomocap_core::formats::Tracks2d| t.to_json_value().to_string();
+    for keys in [&marked, &corrected] {
+        let job = TrackJob {
+            keys: keys.clone(),
+            params: TrackerParams::default(),
+            threads: 2,
+            background: None,
+            network: Some(network.clone()),
+            previous_network: None,
+        };
+        let mut ahead = Video::open(&clip.video, &OpenOptions::default()).unwrap();
+        assert!(ahead.reopen(0).is_some(), "a video file can be read twice");
+        let source = Box::new(ImageSequence::open(&clip.video, DEFAULT_SEQUENCE_FPS).unwrap());
+        let mut after = Video::from_source(Box::new(NoSecondReader(source)), 1 << 26);
+        assert!(after.reopen(0).is_none());
+        let cancel = AtomicBool::new(false);
+        let with = track_video(&mut ahead, &job, &mut |_| {}, &cancel).unwrap();
+        let without = track_video(&mut after, &job, &mut |_| {}, &cancel).unwrap();
+        assert!(with.network.is_some());
+        assert_eq!(with.network, without.network);
+        assert_eq!(text(&with.tracks), text(&without.tracks));
+        assert_eq!(with.spans, without.spans);
+        assert_eq!(ahead.info().width, after.info().width);
+        assert!(without.network.unwrap().iter().all(|f| f.crop.is_some()));
+    }
+}

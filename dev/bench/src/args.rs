@@ -13,6 +13,8 @@ Examples:
   videomocap-bench volume --split test         the point-volume pipeline
   videomocap-bench scrub                       the app's frame access on a long 1080p clip
   videomocap-bench speed                       decoding and rendering speed
+  videomocap-bench speed track --runs 3        track with/without the network beside MediaPipe
+  videomocap-bench speed retrack --runs 3      a re-track after one correction, 300 frames of 1080p
   videomocap-bench synth --motion walk --view side --frames 150 -o synth_walk/
   videomocap-bench synth --motion tests/data/cmu_02_01_walk.bvh --view oblique -o walk/
   videomocap-bench score tracks2d.json synth_walk/gt.json
@@ -53,9 +55,11 @@ pub(crate) enum Command {
     Scrub(BenchArgs),
     /// VBA alone, the pose network alone and the two together, from the same clicked marks.
     Learned(BenchArgs),
-    /// Decoding (beside the ffmpeg command) and rendering speed.
+    /// Decoding (beside the ffmpeg command) and rendering speed; `track`: whole `videomocap
+    /// track` processes with and without the pose network beside MediaPipe's (issue 95).
     Speed {
-        /// all, decode or synth.
+        /// all, decode, synth, track, network (the network's profile per operator) or retrack
+        /// (a re-track after one correction on a 300-frame 1080p clip).
         #[arg(default_value = "all")]
         what: String,
         #[command(flatten)]
@@ -270,4 +274,8 @@ pub(crate) struct BenchArgs {
     /// (`scripts/fit_doubt.py`).
     #[arg(long)]
     pub doubt_dump: Option<PathBuf>,
+    /// `speed track`, `speed network` and `speed retrack`: runs of each process, network run
+    /// or re-track (medians).
+    #[arg(long, default_value_t = 3)]
+    pub runs: usize,
 }

@@ -10,7 +10,9 @@ mod bench_learned;
 mod bench_lift;
 mod bench_lift_network;
 mod bench_motion;
+mod bench_retrack;
 mod bench_scrub;
+mod bench_speed;
 mod bench_suite;
 mod bench_track;
 mod bench_views;
@@ -58,6 +60,11 @@ fn main() -> ExitCode {
         Command::Motion(a) => bench_motion::run(a, global),
         Command::Scrub(a) => bench_scrub::run(a, global),
         Command::Learned(a) => bench_learned::run(a, global),
+        Command::Speed { what, args } if what == "track" => bench_speed::run(args, global),
+        Command::Speed { what, args } if what == "retrack" => bench_retrack::run(args, global),
+        Command::Speed { what, args } if what == "network" => {
+            bench_speed::run_network(args, global)
+        }
         Command::Speed { what, args } => bench::run(what, args, global),
         Command::Synth(a) => synth::run(a, global),
         Command::Score { tracks, reference } => score::run(tracks, reference, global),

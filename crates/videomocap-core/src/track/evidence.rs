@@ -116,36 +116,9 @@ pub fn run_network(
             Some(c) if !full => Some(c),
             _ => marked(),
         };
-        let mut seen = |crop: Option<Crop>| -> NetFrame {
-            let Some(c) = crop else {
-                return NetFrame {
-                    crop: None,
-                    joints: None,
-                    next: None,
-                    world: None,
-                };
-            };
-            if let Some(b) = previous
-                .and_then(|p| p.get(t))
-                .filter(|b| b.crop == Some(c))
-            {
-                return b.clone();
-            }
-            let pose = video
-                .frame(f.index.get())
-                .ok()
-                .and_then(|image| network.run(&image.image, &c).ok())
-                .filter(|p| p.presence >= MIN_PRESENCE);
-            NetFrame {
-                crop: Some(c),
-                next: pose.as_ref().and_then(|p| p.next_crop),
-                world: pose.as_ref().map(|p| p.world),
-                joints: pose.map(|p| p.joints),
-            }
-        };
-        let mut frame = seen(crop);
+        let mut frame = look(video, network, t, crop, previous);
         if key.is_some_and(|k| !full && refuses(k, &frame)) && crop != marked() {
-            frame = seen(marked());
+            frame = look(video, network, t, marked(), previous);
         }
         next = frame.next;
         out.push(frame);
@@ -153,9 +126,42 @@ pub fn run_network(
     Ok(out)
 }
 
+/// What the network sees on frame `t` in `crop`: taken from `reuse` when it holds frame `t`
+/// with exactly that crop (the network's output depends on nothing else), else run.
+pub(crate) fn look(
+    video: &mut Video,
+    network: &PoseNetwork,
+    t: usize,
+    crop: Option<Crop>,
+    reuse: Option<&NetworkFrames>,
+) -> NetFrame {
+    let Some(c) = crop else {
+        return NetFrame {
+            crop: None,
+            joints: None,
+            next: None,
+            world: None,
+        };
+    };
+    if let Some(b) = reuse.and_then(|p| p.get(t)).filter(|b| b.crop == Some(c)) {
+        return b.clone();
+    }
+    let pose = video
+        .frame(t)
+        .ok()
+        .and_then(|image| network.run(&image.image, &c).ok())
+        .filter(|p| p.presence >= MIN_PRESENCE);
+    NetFrame {
+        crop: Some(c),
+        next: pose.as_ref().and_then(|p| p.next_crop),
+        world: pose.as_ref().map(|p| p.world),
+        joints: pose.map(|p| p.joints),
+    }
+}
+
 /// Whether a key's pelvis or head top lies far from where the network sees them (or the network
 /// saw nobody): the network's body is not the one the user marked.
-fn refuses(key: &PerJoint<Option<Point2<f64>>>, seen: &NetFrame) -> bool {
+pub(crate) fn refuses(key: &PerJoint<Option<Point2<f64>>>, seen: &NetFrame) -> bool {
     let placed = [Joint::Pelvis, Joint::HeadTop]
         .into_iter()
         .filter_map(|j| key[j].map(|p| (j, p)))

@@ -14,6 +14,7 @@
 //! - `limb`: one limb chain per frame, upper then lower segment, refined as one figure
 //! - `body`: the top-down tracker (head → trunk → limbs)
 //! - `evidence`: the pose network's evidence weighed in
+//! - `ahead`: the network run on its own thread while VBA's passes run
 //! - `doubt`: the evidence of each joint-frame's doubt, for calibrating it (`bench learned
 //!   --doubt-dump`)
 //! - `occlusion`: interpolation over weak runs, the weak-span report
@@ -23,6 +24,7 @@
 //! - `fuse`: the forward and backward passes made one, per joint between its key frames
 //! - `shared`: the errors and progress every step uses (below them all)
 
+mod ahead;
 mod background;
 mod block;
 mod body;

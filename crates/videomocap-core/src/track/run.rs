@@ -15,6 +15,7 @@
 //! a cache of values that depend on nothing else (the background; the network's output for a
 //! frame and a crop exactly as it was).
 
+use super::ahead::{merged, run_ahead};
 use super::background::KnownBackground;
 use super::body::{JointResult, stature_px};
 use super::evidence::{EvidenceParams, NetworkFrames, flag_jumps, run_network, weigh};
@@ -33,7 +34,11 @@ use crate::video::{Video, VideoInfo};
 use nalgebra::Point2;
 use std::collections::BTreeMap;
 use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// The frame cache of the network's own reader of the video (it reads each frame once, in
+/// order).
+const AHEAD_CACHE_BYTES: usize = 0;
 
 /// What to track.
 #[derive(Debug, Clone)]
@@ -114,8 +119,24 @@ pub fn track_video(
     job.params.validate()?;
     let info = video.info().clone();
     let network = job.network.as_deref().filter(|_| job.params.network);
-    // 1. VBA's passes, forwards and backwards, made one per joint.
-    let passes = track_at_working_scale(video, &info, job, network.is_some(), progress, cancel);
+    // 1. VBA's passes, forwards and backwards, made one per joint; meanwhile the network runs
+    // ahead on its own reader of the video where it needs nothing of VBA (`ahead`: a cache for
+    // step 2, the result the same without it).
+    let reader = network.and_then(|_| video.reopen(AHEAD_CACHE_BYTES));
+    let stop = AtomicBool::new(false);
+    let (passes, ahead) = std::thread::scope(|s| {
+        let stop = &stop;
+        let worker = network.zip(reader).map(|(net, mut reader)| {
+            let previous = job.previous_network.as_ref();
+            s.spawn(move || run_ahead(&mut reader, net, &job.keys, previous, stop, cancel))
+        });
+        let passes = track_at_working_scale(video, &info, job, network.is_some(), progress, cancel);
+        if passes.is_err() {
+            stop.store(true, Ordering::Relaxed);
+        }
+        // A worker that panicked leaves no cache: the network's frames are run in step 2.
+        (passes, worker.and_then(|w| w.join().ok()))
+    });
     if (video.info().width, video.info().height) != (info.width, info.height) {
         // Back to the size the caller had (full size unless it shrank the video itself).
         video.output_size(Some((info.width, info.height)));
@@ -131,7 +152,8 @@ pub fn track_video(
     // 2. The network's evidence weighed in, the user's marks deciding whose body it is.
     let net = match network {
         Some(network) => {
-            let reuse = job.previous_network.as_ref();
+            let cached = ahead.map(|a| merged(a, job.previous_network.as_ref()));
+            let reuse = cached.as_ref().or(job.previous_network.as_ref());
             let mut tick = || {
                 done += 1;
                 progress(&TrackProgress {

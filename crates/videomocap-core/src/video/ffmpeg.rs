@@ -420,6 +420,17 @@ impl VideoSource for FfmpegSource {
         true
     }
 
+    fn reopen(&self) -> Option<Box<dyn VideoSource>> {
+        let mut other = FfmpegSource::open_with_threads(&self.info.path, None).ok()?;
+        if other.pts != self.pts {
+            return None;
+        }
+        if self.shrunk.is_some() {
+            other.shrink_to(self.info.width, self.info.height);
+        }
+        Some(Box::new(other))
+    }
+
     fn info(&self) -> &VideoInfo {
         &self.info
     }

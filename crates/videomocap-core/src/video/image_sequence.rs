@@ -106,6 +106,13 @@ impl VideoSource for ImageSequence {
         &self.info
     }
 
+    fn reopen(&self) -> Option<Box<dyn VideoSource>> {
+        Some(Box::new(ImageSequence {
+            files: self.files.clone(),
+            info: self.info.clone(),
+        }))
+    }
+
     fn time_of(&self, index: usize) -> f64 {
         index as f64 / self.info.fps
     }

@@ -80,6 +80,12 @@ pub trait VideoSource: Send {
     fn output_size(&mut self, _size: Option<(u32, u32)>) -> bool {
         false
     }
+    /// A second, independent reader of the same frames at the same output size (for a worker
+    /// thread that reads while this one is read elsewhere), or `None` if the backend cannot
+    /// make one. Its frames are the same bits as this one's.
+    fn reopen(&self) -> Option<Box<dyn VideoSource>> {
+        None
+    }
 }
 
 /// Options for [`Video::open`].
@@ -188,6 +194,15 @@ impl Video {
         let cache_bytes = self.cache.capacity_frames() * self.cache.frame_bytes();
         let span = SpanSource::new(self.source, start, len)?;
         Ok(Video::from_source(Box::new(span), cache_bytes))
+    }
+
+    /// A second, independent reader of this video's frames at its current output size, with a
+    /// cache of `cache_bytes` ([`VideoSource::reopen`]); `None` if the backend cannot make one.
+    pub fn reopen(&self, cache_bytes: usize) -> Option<Video> {
+        let source = self.source.reopen()?;
+        let same =
+            (source.info().width, source.info().height) == (self.info().width, self.info().height);
+        same.then(|| Video::from_source(source, cache_bytes))
     }
 
     /// How many frames of the current size the cache holds at most.

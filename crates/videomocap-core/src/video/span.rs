@@ -46,6 +46,14 @@ impl VideoSource for SpanSource {
         &self.info
     }
 
+    fn reopen(&self) -> Option<Box<dyn VideoSource>> {
+        Some(Box::new(SpanSource {
+            inner: self.inner.reopen()?,
+            start: self.start,
+            info: self.info.clone(),
+        }))
+    }
+
     fn output_size(&mut self, size: Option<(u32, u32)>) -> bool {
         if !self.inner.output_size(size) {
             return false;
