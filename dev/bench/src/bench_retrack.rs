@@ -70,7 +70,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 /// Runs the measurement (see the module's text).
-pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let runs = a.runs.max(1);
     let dir = tempfile::tempdir().map_err(ExitError::failed)?;
     let real = repo_root().join("sample_videos/pose2sim_balancing_cam01");

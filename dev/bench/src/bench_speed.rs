@@ -31,6 +31,7 @@ struct Timing {
 }
 
 /// CPU seconds (user + system) used so far by this process's waited-for children.
+#[allow(unsafe_code)] // getrusage: std has no safe way to read children's CPU time
 fn children_cpu_s() -> f64 {
     // SAFETY: getrusage writes one plain struct that we own.
     let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
@@ -144,7 +145,7 @@ fn commands(clip: &Clip, dir: &Path, mediapipe: bool) -> anyhow::Result<Vec<Comm
 }
 
 /// Runs the table (see the module's text).
-pub fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let runs = a.runs.max(1);
     let dir = tempfile::tempdir().map_err(ExitError::failed)?;
     let clips = clips(dir.path(), global).map_err(ExitError::failed)?;
@@ -230,7 +231,7 @@ fn print_table(rows: &[(String, Vec<Timing>)], runs: usize, global: &GlobalArgs)
 
 /// `speed network`: the network's operator counts (the ONNX file, the plan the product runs)
 /// and the time of each kind of operator, on one thread and on two.
-pub fn run_network(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
+pub(crate) fn run_network(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     use videomocap_core::network::PoseNetwork;
     let runs = a.runs.max(1);
     for threads in [1, 2] {
