@@ -122,7 +122,11 @@ pub fn track_video(
     // 1. VBA's passes, forwards and backwards, made one per joint; meanwhile the network runs
     // ahead on its own reader of the video where it needs nothing of VBA (`ahead`: a cache for
     // step 2, the result the same without it).
-    let reader = network.and_then(|_| video.reopen(AHEAD_CACHE_BYTES));
+    // Only with a second thread to run on: a job given one CPU (a batch task on one core) stays
+    // on one thread (`tests/batch_threads.rs`).
+    let reader = network
+        .filter(|_| job.threads >= 2)
+        .and_then(|_| video.reopen(AHEAD_CACHE_BYTES));
     let stop = AtomicBool::new(false);
     let (passes, ahead) = std::thread::scope(|s| {
         let stop = &stop;
