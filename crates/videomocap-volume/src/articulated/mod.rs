@@ -214,7 +214,15 @@ fn track(clip: &Clip, start: Option<Pose>) -> Tracked {
         .collect();
     for (i, before) in order {
         let Some(d) = &clip.data[i] else { continue };
-        let prev = before.and_then(|b| out.done[b]);
+        // The nearest fitted frame on the side the track comes from (a frame without points
+        // does not make the next one start afresh, which would lose the track's facing).
+        let prev = before.and_then(|b| {
+            if b < i {
+                (first..=b).rev().find_map(|k| out.done[k])
+            } else {
+                (b..n).find_map(|k| out.done[k])
+            }
+        });
         let f = match (i == first, start) {
             (true, Some(s)) => Started {
                 fit: solve::fit(&s, clip.body, d, clip.params.iterations, false),
