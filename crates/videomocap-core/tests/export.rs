@@ -1,6 +1,8 @@
 //! Exports: BVH round trips through our reader (random plausible motions, the real sample),
 //! the golden file, the world frame against motion capture, and the tables.
 
+#![allow(clippy::unwrap_used)] // a test's unwrap is its failure, named by the panic
+
 use nalgebra::{Matrix3, Point3, Rotation3, Vector3};
 use proptest::prelude::*;
 use std::path::Path;

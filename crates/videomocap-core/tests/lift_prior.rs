@@ -2,6 +2,8 @@
 //! lifts as well as upright (the prior lives in the body's own frames) and is flagged as an
 //! unusual pose, and a pose the prior has never seen still lifts, flagged too.
 
+#![allow(clippy::unwrap_used)] // a test's unwrap is its failure, named by the panic
+
 mod lift_support;
 
 use lift_support::{camera, run, truth};

@@ -2,6 +2,8 @@
 //! marks, it finds the limb joints; a model file that is missing, truncated or not a model is
 //! refused by name.
 
+#![allow(clippy::unwrap_used)] // a test's unwrap is its failure, named by the panic
+
 use nalgebra::{Point2, Vector3};
 use videomocap_core::network::{Crop, NetworkError, PoseNetwork};
 use videomocap_core::skeleton::{Joint, PerJoint};

@@ -1,6 +1,8 @@
 //! Tracking on rendered clips with known joints: accuracy floors, the CLI's output file, and
 //! bad input (too short a video, marks off the image).
 
+#![allow(clippy::unwrap_used)] // a test's unwrap is its failure, named by the panic
+
 mod common;
 
 use std::path::Path;

@@ -1,6 +1,7 @@
 //! Frame-accurate random access: on a 300-frame H.264 clip with a 250-frame GOP and B-frames,
 //! `frame(i)` in any order equals the i-th frame of a sequential decode.
 
+#![allow(clippy::unwrap_used)] // a test's unwrap is its failure, named by the panic
 #![cfg(feature = "ffmpeg")]
 
 use image::{Rgb, RgbImage};

@@ -1,6 +1,8 @@
 //! The volume pipeline (Chu, Jenkins, Mataric) on synthetic volumes with known joints, bad
 //! frames, and the command line end to end.
 
+#![allow(clippy::unwrap_used)] // a test's unwrap is its failure, named by the panic
+
 use nalgebra::{Point3, Vector3};
 use rand::SeedableRng;
 use std::sync::atomic::AtomicBool;

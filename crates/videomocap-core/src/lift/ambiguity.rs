@@ -25,7 +25,7 @@ mod priors;
 mod viterbi;
 mod weights;
 
-pub use priors::image_facing_cost;
+pub(super) use priors::image_facing_cost;
 pub use weights::AmbiguityWeights;
 
 pub(crate) use memo::PriorMemo;
@@ -52,7 +52,7 @@ struct Group {
 use Joint::*;
 
 /// How many groups of bones have their roots chosen together.
-pub const GROUP_COUNT: usize = 7;
+pub(super) const GROUP_COUNT: usize = 7;
 
 /// Centre outwards: every group's first parent is known when it is solved. The legs come
 /// before the arms, whose prior reads the thighs ([`AmbiguityWeights::arm_swing`]).

@@ -24,7 +24,7 @@ pub const KEY_JOINTS: [Joint; 3] = [Joint::LeftShoulder, Joint::RightShoulder, J
 
 /// The key lines as pairs of indices into [`KEY_JOINTS`]: the shoulder line and the two
 /// chest–shoulder lines.
-pub const KEY_LINES: [(usize, usize); 3] = [(0, 1), (2, 0), (2, 1)];
+pub(super) const KEY_LINES: [(usize, usize); 3] = [(0, 1), (2, 0), (2, 1)];
 
 /// Six residuals by six parameters.
 type Jacobian6 = SMatrix<f64, 6, 6>;
@@ -69,7 +69,7 @@ impl KeyTriangle {
 
 /// Where the object space sits in the camera: `X_c = R·X_w + D`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Pose {
+pub(super) struct Pose {
     /// `R` of eq. 6.
     pub rotation: Rotation3<f64>,
     /// `(D_x, D_y, D_z)`, metres.
@@ -78,12 +78,12 @@ pub struct Pose {
 
 impl Pose {
     /// A model point in camera space.
-    pub fn apply(&self, p: &Point3<f64>) -> Point3<f64> {
+    pub(super) fn apply(&self, p: &Point3<f64>) -> Point3<f64> {
         self.rotation * p + self.translation
     }
 
     /// The pose after a step `(ΔD_x, ΔD_y, ΔD_z, ΔW_x, ΔW_y, ΔW_z)`: `D + ΔD`, `exp(ΔW)·R`.
-    pub fn stepped(&self, delta: &SVector<f64, 6>) -> Pose {
+    pub(super) fn stepped(&self, delta: &SVector<f64, 6>) -> Pose {
         Pose {
             rotation: Rotation3::new(Vector3::new(delta[3], delta[4], delta[5])) * self.rotation,
             translation: self.translation + Vector3::new(delta[0], delta[1], delta[2]),
@@ -93,7 +93,7 @@ impl Pose {
 
 /// Which residuals the calibration fits.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Residuals {
+pub(super) enum Residuals {
     /// Eq. 8: distance of each marked end point from its projected key line (the paper).
     Lines,
     /// Image distance of each projected key joint from its marked point, x and y. Used when the
@@ -104,7 +104,7 @@ pub enum Residuals {
 
 /// A calibrated pose.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Calibration {
+pub(super) struct Calibration {
     /// The pose found.
     pub pose: Pose,
     /// Root mean square of the six residuals, pixels.
@@ -140,7 +140,7 @@ fn project_with_derivative(
 }
 
 /// The six residuals and their analytic Jacobian (eq. 9's coefficients) at a pose.
-pub fn residuals(
+pub(super) fn residuals(
     cam: &PinholeCamera,
     triangle: &KeyTriangle,
     image: &[Point2<f64>; 3],
@@ -189,7 +189,7 @@ pub fn residuals(
 
 /// Thinness of an image triangle: twice its area over its longest side squared (0 when the
 /// three points are collinear, about 0.4–0.8 for a shoulder triangle seen from the front).
-pub fn shape(image: &[Point2<f64>; 3]) -> f64 {
+pub(super) fn shape(image: &[Point2<f64>; 3]) -> f64 {
     let a = image[1] - image[0];
     let b = image[2] - image[0];
     let area2 = (a.x * b.y - a.y * b.x).abs();
@@ -202,7 +202,7 @@ pub fn shape(image: &[Point2<f64>; 3]) -> f64 {
 }
 
 /// The longest side of an image triangle, pixels.
-pub fn longest_side(image: &[Point2<f64>; 3]) -> f64 {
+pub(super) fn longest_side(image: &[Point2<f64>; 3]) -> f64 {
     [
         (image[1] - image[0]).norm(),
         (image[2] - image[0]).norm(),
@@ -213,10 +213,10 @@ pub fn longest_side(image: &[Point2<f64>; 3]) -> f64 {
 }
 
 /// Below this [`shape`], lines are not used (see [`Residuals::Points`]).
-pub const THIN_TRIANGLE: f64 = 0.08;
+pub(super) const THIN_TRIANGLE: f64 = 0.08;
 
 /// Damped Newton from one start.
-pub fn calibrate_from(
+pub(super) fn calibrate_from(
     cam: &PinholeCamera,
     triangle: &KeyTriangle,
     image: &[Point2<f64>; 3],
@@ -240,7 +240,7 @@ pub fn calibrate_from(
 /// foreshortened side of the image triangle, its centroid on the centroid's ray. The yaws turn
 /// about the body's own up as the image shows it ([`image_roll`]), not the camera's: a body
 /// upside down or lying in the image starts from the same poses, turned with it, as upright.
-pub fn starting_poses(
+pub(super) fn starting_poses(
     cam: &PinholeCamera,
     triangle: &KeyTriangle,
     image: &[Point2<f64>; 3],
@@ -298,7 +298,7 @@ fn image_roll(image: &[Point2<f64>; 3]) -> f64 {
 /// Every distinct pose that fits the image within `tolerance_px`, best fit first. A three-point
 /// pose has up to four exact solutions; choosing among them needs the rest of the body and is
 /// done by the caller.
-pub fn calibrate_all(
+pub(super) fn calibrate_all(
     cam: &PinholeCamera,
     triangle: &KeyTriangle,
     image: &[Point2<f64>; 3],

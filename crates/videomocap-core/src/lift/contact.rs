@@ -36,7 +36,7 @@ const BLEND_FRAMES: f64 = 1.0;
 /// solved on, `points` the skeleton in camera space, `seen` per frame whether each ankle's
 /// track was seen (not lost, not off the frame): a foot is never planted where it was not seen,
 /// and a contact broken by such a span is two contacts.
-pub fn foot_contacts(
+pub(super) fn foot_contacts(
     cam: &PinholeCamera,
     images: &[PerJoint<Point2<f64>>],
     points: &[PerJoint<Point3<f64>>],
@@ -92,7 +92,7 @@ pub fn foot_contacts(
 /// along its own viewing ray (it stays on its 2D track; the body follows); between contacts the
 /// moves are interpolated, and all are blended over a few frames. Bone lengths and directions
 /// are unchanged.
-pub fn plant_feet(points: &mut [PerJoint<Point3<f64>>], contacts: &[[bool; 2]]) {
+pub(super) fn plant_feet(points: &mut [PerJoint<Point3<f64>>], contacts: &[[bool; 2]]) {
     let n = points.len().min(contacts.len());
     // The move each frame's planted ankles ask for (the mean when both are planted): along the
     // ankle's ray (scaled to unit depth), by the depth it is off its contact's median.

@@ -16,7 +16,7 @@ pub use crate::camera::{DEFAULT_FOV_LONG_SIDE_DEG, default_focal};
 
 /// The estimate and the scan behind it.
 #[derive(Debug, Clone, PartialEq)]
-pub struct FocalEstimate {
+pub(super) struct FocalEstimate {
     /// The focal length chosen, pixels.
     pub focal_px: f64,
     /// Mean miss (metres per joint and frame) at that focal length.
@@ -50,7 +50,7 @@ fn score(job: &LiftJob<'_>, focal_px: f64) -> f64 {
 /// (`super::subject_fit`): those are read as ratios in the image and fit any focal length
 /// about equally (on the synthetic suite the estimate was off by a median factor of 2.12 with
 /// fitted lengths, 1.53 with the table's).
-pub fn estimate_focal(job: &LiftJob<'_>) -> Result<FocalEstimate, LiftError> {
+pub(super) fn estimate_focal(job: &LiftJob<'_>) -> Result<FocalEstimate, LiftError> {
     let cam = job.camera;
     let width = cam.width.max(1);
     let focal_of = |fov: f64| PinholeCamera::focal_from_horizontal_fov(fov, width);

@@ -30,7 +30,7 @@ pub(super) fn deepest_trunk(
 }
 
 /// The nearest a key joint may be to the camera, metres: no one films a trunk from closer.
-pub const NEAREST_KEY_M: f64 = 0.2;
+pub(super) const NEAREST_KEY_M: f64 = 0.2;
 
 /// Whether a key pose may be kept: its centroid no deeper than `max_depth`, every joint at
 /// least [`NEAREST_KEY_M`] in front of the camera. A pinhole images a triangle with every point

@@ -28,12 +28,12 @@ use nalgebra::{DVector, Matrix3, Point2, Point3, Rotation3, UnitQuaternion, Vect
 /// over all joints): 5 gave 61.6, 20.5,
 /// 113.2, 69.3 and 70.7 mm; 10 gave 61.6, 20.3, 113.1, 69.2, 70.7; 20 gave 62.6, 20.4, 112.9,
 /// 69.2, 71.9.
-pub const KEY_ACCELERATION_TIMES_NOISE: f64 = 10.0;
+pub(super) const KEY_ACCELERATION_TIMES_NOISE: f64 = 10.0;
 
 /// The firmest key acceleration deviation, m/s² (reached at 2 px of noise): tracks of 5 px
 /// noise would otherwise be smoothed to a standstill (the tracker's output on a dance clip). At
 /// 3 the same sweep gave 61.7, 20.3, 113.6, 69.2, 70.7 mm; at 8 62.4, 20.3, 112.5, 69.2, 71.3.
-pub const MIN_KEY_ACCELERATION_MPS2: f64 = 5.0;
+pub(super) const MIN_KEY_ACCELERATION_MPS2: f64 = 5.0;
 
 /// Deviation (metres) of a frame's trunk pitch towards the camera (the chest's depth behind the
 /// shoulders' midpoint) from the clip's median is this over the key joints' noise (pixels): 15 mm
@@ -43,11 +43,11 @@ pub const MIN_KEY_ACCELERATION_MPS2: f64 = 5.0;
 /// the synthetic suite with true lengths (four draws of 2 px noise; the real sample with noise;
 /// the tracker's output): off 61.9, 70.3, 111.8 mm; 0.04 gave 58.0, 70.4, 112.0; 0.03 gave 56.8,
 /// 70.5, 112.0; 0.02 gave 55.6, 71.2; 0.01 gave 54.8, 72.1 (the real sample's subject sways).
-pub const KEY_TILT_TIMES_NOISE: f64 = 0.03;
+pub(super) const KEY_TILT_TIMES_NOISE: f64 = 0.03;
 
 /// Below this noise (pixels) the path is left as it is (exact tracks stay exact); above it, the
 /// least noise assumed.
-pub const MIN_NOISE_PX: f64 = 0.1;
+pub(super) const MIN_NOISE_PX: f64 = 0.1;
 
 /// Deviation of a side from its length, metres.
 const SIDE_SIGMA_M: f64 = 0.001;
@@ -171,7 +171,7 @@ fn key_acceleration_mps2(noise_px: f64) -> f64 {
 /// to the key joints' image points `observed` (with weights `weights`) over the whole clip, for
 /// tracks of `noise_px` white noise at `fps` (below [`MIN_NOISE_PX`], `key` is returned as it
 /// is); every frame's result is the rigid `model` triangle.
-pub fn smooth_key_path(
+pub(super) fn smooth_key_path(
     cam: &PinholeCamera,
     key: &[[Point3<f64>; 3]],
     observed: &[[Point2<f64>; 3]],

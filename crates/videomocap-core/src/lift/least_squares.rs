@@ -30,7 +30,7 @@ pub(crate) struct Row {
 
 impl Row {
     /// A row with no derivatives yet.
-    pub fn new(value: f64) -> Row {
+    pub(super) fn new(value: f64) -> Row {
         Row {
             value,
             entries: [(0, 0.0); MAX_ENTRIES],
@@ -39,7 +39,7 @@ impl Row {
     }
 
     /// Adds the partial derivative `d` with respect to unknown `col`.
-    pub fn with(mut self, col: usize, d: f64) -> Row {
+    pub(super) fn with(mut self, col: usize, d: f64) -> Row {
         self.entries[self.len] = (col, d);
         self.len += 1;
         self

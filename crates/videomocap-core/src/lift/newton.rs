@@ -10,7 +10,7 @@ use nalgebra::{SMatrix, SVector};
 
 /// Result of a solve.
 #[derive(Debug, Clone, Copy)]
-pub struct Solved<S> {
+pub(super) struct Solved<S> {
     /// The best state found.
     pub state: S,
     /// Residual vector norm at that state.
@@ -19,7 +19,7 @@ pub struct Solved<S> {
 
 /// Minimises `|r(s)|²` from `start`. `eval` gives residuals and their Jacobian with respect to
 /// the step parameters; `step` applies a step.
-pub fn levenberg_marquardt<S: Clone, const R: usize, const P: usize>(
+pub(super) fn levenberg_marquardt<S: Clone, const R: usize, const P: usize>(
     start: S,
     eval: impl Fn(&S) -> (SVector<f64, R>, SMatrix<f64, R, P>),
     step: impl Fn(&S, &SVector<f64, P>) -> S,

@@ -23,7 +23,8 @@
 
 mod gmm;
 
-pub use gmm::{Component, Gmm, fit};
+pub use gmm::Component;
+pub(super) use gmm::{Gmm, fit};
 
 use crate::skeleton::Joint::{self, *};
 use crate::skeleton::PerJoint;

@@ -14,7 +14,7 @@ pub(super) const PROPAGATION_TOLERANCE_M: f64 = 0.005;
 
 /// The key joints' depths found for one frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct KeyDepths {
+pub(super) struct KeyDepths {
     /// Camera-space key joints (left shoulder, right shoulder, chest).
     pub points: [Point3<f64>; 3],
     /// Root mean square of the three distance residuals of eq. 11, metres.
@@ -22,7 +22,7 @@ pub struct KeyDepths {
 }
 
 /// The ray of eq. 10 scaled so that its Z is 1: `P = Z·ray`.
-pub fn depth_ray(cam: &PinholeCamera, p: &Point2<f64>) -> Vector3<f64> {
+pub(super) fn depth_ray(cam: &PinholeCamera, p: &Point2<f64>) -> Vector3<f64> {
     Vector3::new(
         (p.x - cam.cx) / cam.focal_px,
         (p.y - cam.cy) / cam.focal_px,
@@ -32,7 +32,7 @@ pub fn depth_ray(cam: &PinholeCamera, p: &Point2<f64>) -> Vector3<f64> {
 
 /// Solves eqs. 10–11 for the key joints seen at `image`, with side lengths `sides` (in
 /// [`KEY_LINES`] order), starting from the depths `start`.
-pub fn key_depths(
+pub(super) fn key_depths(
     cam: &PinholeCamera,
     image: &[Point2<f64>; 3],
     sides: &[f64; 3],

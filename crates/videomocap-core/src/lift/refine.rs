@@ -84,15 +84,15 @@ impl Default for RefineParams {
 /// MPJPE with 2 px noise and 20.4 → 21.6 mm with exact tracks
 /// (without the floor below, 30 gave 66.3 and 23.5 and 100 gave 63.1 and 20.9; the fixed
 /// 100 m/s² gives 64.2 and 24.4).
-pub const ACCELERATION_TIMES_NOISE: f64 = 60.0;
+pub(super) const ACCELERATION_TIMES_NOISE: f64 = 60.0;
 
 /// The firmest acceleration deviation the adaptive refinement uses, m/s² (reached at 2 px of
 /// noise): at 20 m/s² it bent fast motions such as jumping jacks out of shape on the suite.
-pub const MIN_ACCELERATION_MPS2: f64 = 30.0;
+pub(super) const MIN_ACCELERATION_MPS2: f64 = 30.0;
 
 /// The least noise the adaptive refinement assumes, pixels (exact tracks read 0.1–1 px: fast
 /// motion is not quite smooth at the frame rate).
-pub const MIN_NOISE_PX: f64 = 0.1;
+pub(super) const MIN_NOISE_PX: f64 = 0.1;
 
 /// What the refinement did.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -112,7 +112,7 @@ pub struct RefineSummary {
 
 /// The refined sequence.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Refined {
+pub(super) struct Refined {
     /// Joints per frame.
     pub points: Vec<PerJoint<Point3<f64>>>,
     /// Bone lengths (indexed like [`Bone::ALL`]), metres.
@@ -125,7 +125,7 @@ pub struct Refined {
 
 /// The weight of a track point in the reprojection term: its confidence (at least 0.05), halved
 /// when it was interpolated (not seen there).
-pub fn track_weight(p: &TrackedPoint) -> f64 {
+pub(super) fn track_weight(p: &TrackedPoint) -> f64 {
     let c = f64::from(p.confidence).clamp(0.05, 1.0);
     if p.source == PointSource::Interpolated {
         0.5 * c
@@ -380,7 +380,7 @@ impl Problem<'_> {
 /// give the skeleton back exactly (0.75 mm off on the bundled synthetic clip). A bone the
 /// refinement shrank to nothing takes its direction from `fallback` (the per-frame solve), or
 /// straight down (+Y) when that one is nothing too.
-pub fn snap_to_lengths(
+pub(super) fn snap_to_lengths(
     free: &PerJoint<Point3<f64>>,
     fallback: &PerJoint<Point3<f64>>,
     lengths: &[f64; BONE_COUNT],
@@ -476,7 +476,7 @@ fn network_directions(
 /// (empty: none), `fps` sets Δt, and `track_noise_px` is the tracks' white noise
 /// ([`super::smoothing::median_noise_px`]) for the adaptive acceleration term.
 #[allow(clippy::too_many_arguments)]
-pub fn refine(
+pub(super) fn refine(
     cam: &PinholeCamera,
     images: &[PerJoint<Point2<f64>>],
     weights: &[PerJoint<f64>],

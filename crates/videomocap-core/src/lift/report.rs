@@ -84,13 +84,13 @@ impl BoneDepth {
 
 /// How many times the tracks' own white noise a bone's child must miss its image point before
 /// the bone is flagged too long ([`too_long_beyond_noise`]).
-pub const TOO_LONG_NOISE_TIMES: f64 = 3.0;
+pub(super) const TOO_LONG_NOISE_TIMES: f64 = 3.0;
 
 /// The share of a bone's own image length its child may miss its image point by before the bone
 /// is flagged too long: the lengths read from the clip are uncertain by a few per cent (the
 /// median bone within 2–5 % on the benchmark), so a bone a little short of its image says
 /// nothing about the tracks.
-pub const TOO_LONG_LENGTH_SHARE: f64 = 0.05;
+pub(super) const TOO_LONG_LENGTH_SHARE: f64 = 0.05;
 
 /// Whether a bone whose image is longer than its length allows misses by more than the 2D
 /// noise and the length's own uncertainty explain: its child's image point lies farther from

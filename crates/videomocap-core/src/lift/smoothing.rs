@@ -17,18 +17,18 @@ use crate::track::smooth::gaussian_mean;
 use nalgebra::{Point2, Vector2};
 
 /// Widest Gaussian the adaptive choice takes, frames (beyond it motion is cut, not noise).
-pub const MAX_ADAPTIVE_SIGMA: f64 = 3.0;
+pub(super) const MAX_ADAPTIVE_SIGMA: f64 = 3.0;
 
 /// The width used is this many times the 2D optimum: the per-frame solve amplifies what noise
 /// is left (a bone's depth is `√(L² − l²)`, steep where the bone is nearly parallel to the
 /// image), so the 3D optimum lies wider. Measured on the synthetic suite with 2 px noise and
 /// true lengths: ×1 gave 124 mm MPJPE, ×1.6 77.5 mm, ×2.2 75.4 mm; with exact tracks ×1.6 left
 /// the 31 mm of no smoothing unchanged and ×2.2 raised it to 33.5 mm.
-pub const WIDTH_FACTOR: f64 = 1.6;
+pub(super) const WIDTH_FACTOR: f64 = 1.6;
 
 /// The estimated white-noise deviation and motion RMS of one track, per axis, both in pixels
 /// (per frame² for the motion), from its second differences; `None` below five frames.
-pub fn noise_and_motion(track: &[Point2<f64>]) -> Option<(f64, f64)> {
+pub(super) fn noise_and_motion(track: &[Point2<f64>]) -> Option<(f64, f64)> {
     if track.len() < 5 {
         return None;
     }
@@ -46,7 +46,7 @@ pub fn noise_and_motion(track: &[Point2<f64>]) -> Option<(f64, f64)> {
 
 /// [`WIDTH_FACTOR`] times the Gaussian width (frames) that minimises a 2D track's expected
 /// squared error, at most [`MAX_ADAPTIVE_SIGMA`]; 0 for a track without noise.
-pub fn adaptive_sigma(noise_px: f64, motion_px: f64) -> f64 {
+pub(super) fn adaptive_sigma(noise_px: f64, motion_px: f64) -> f64 {
     if noise_px <= 0.0 {
         return 0.0;
     }
@@ -61,7 +61,10 @@ const UNTOUCHED_BELOW: f64 = 0.3;
 
 /// The tracks smoothed over time, joint `j` by a Gaussian of `sigma[j]` frames (0 = untouched),
 /// each point weighted by its trust ([`super::refine::track_weight`]).
-pub fn smoothed_images(tracks: &Tracks2d, sigma: &PerJoint<f64>) -> Vec<PerJoint<Point2<f64>>> {
+pub(super) fn smoothed_images(
+    tracks: &Tracks2d,
+    sigma: &PerJoint<f64>,
+) -> Vec<PerJoint<Point2<f64>>> {
     let raw: Vec<PerJoint<Point2<f64>>> = tracks
         .frames
         .iter()
@@ -85,7 +88,7 @@ pub fn smoothed_images(tracks: &Tracks2d, sigma: &PerJoint<f64>) -> Vec<PerJoint
 }
 
 /// Each joint's adaptive Gaussian width (frames) for these tracks.
-pub fn adaptive_sigmas(tracks: &Tracks2d) -> PerJoint<f64> {
+pub(super) fn adaptive_sigmas(tracks: &Tracks2d) -> PerJoint<f64> {
     let mut out = PerJoint([0.0; JOINT_COUNT]);
     for j in Joint::ALL {
         let track: Vec<Point2<f64>> = tracks.frames.iter().map(|f| f.points[j].pos).collect();
@@ -98,7 +101,7 @@ pub fn adaptive_sigmas(tracks: &Tracks2d) -> PerJoint<f64> {
 
 /// The median over `joints` of their tracks' white-noise deviation, pixels (0 below five
 /// frames): how noisy the 2D input is (as a whole with [`Joint::ALL`]).
-pub fn median_noise_px(tracks: &Tracks2d, joints: &[Joint]) -> f64 {
+pub(super) fn median_noise_px(tracks: &Tracks2d, joints: &[Joint]) -> f64 {
     let mut noise: Vec<f64> = joints
         .iter()
         .filter_map(|&j| {

@@ -26,7 +26,8 @@
 mod at_depth;
 mod reading;
 
-pub use reading::{ChestDrop, LengthOrigin, PartLength, SubjectFit};
+pub use reading::SubjectFit;
+pub(super) use reading::{ChestDrop, LengthOrigin, PartLength};
 
 use at_depth::fit_at_depth;
 
@@ -58,7 +59,7 @@ const LIMB_QUANTILE: f64 = 0.8;
 /// benchmark's dev split from exact 2D and the stated height (with [`LENGTH_MARGIN`] 0): 0.8 /
 /// 0.9 / 0.95 / 1.0 gave 119.7 / 118.5 / 122.2 / 136.7 mm; with the margin 0.9 and 0.95 were
 /// within 3 mm, 0.95 ahead with 2 px noise (118.0 against 120.5).
-pub const ENVELOPE_QUANTILE: f64 = 0.95;
+pub(super) const ENVELOPE_QUANTILE: f64 = 0.95;
 
 /// The doubt ([`SubjectModel::length_doubt`]) of a length read from the clip: the lift solves
 /// the limbs and the head (every bone hung from a joint by one of its two depth roots) this
@@ -70,10 +71,10 @@ pub const ENVELOPE_QUANTILE: f64 = 0.95;
 /// split from exact 2D and the stated height (quantile 0.95): margin 0 / 3 / 5 / 8 / 11 %:
 /// 122.2 / 114.9 / 110.9 / 111.4 / 116.1 mm MPJPE; with 2 px noise 125.1 / 118.9 / 118.0 /
 /// 119.7 / 123.6 mm (the cut-out: 138.5 and 142.6).
-pub const LENGTH_MARGIN: f64 = 0.05;
+pub(super) const LENGTH_MARGIN: f64 = 0.05;
 
 /// A limb's measured length is held within these factors of the table's.
-pub const LIMB_RANGE: (f64, f64) = (0.8, 1.2);
+pub(super) const LIMB_RANGE: (f64, f64) = (0.8, 1.2);
 
 /// Fewest measured frames for a limb's length: a quantile of a handful of poses says little.
 const MIN_LIMB_FRAMES: usize = 10;
@@ -236,7 +237,10 @@ fn measure_limb(views: &[FrameView<'_>], bones: &[(Joint, Joint)]) -> Option<f64
 /// the module's text), and what was read; unchanged where nothing could be measured. The lift
 /// reads it through [`fit_in_perspective`]; the tests read this first step alone.
 #[cfg(test)]
-pub fn fit_to_tracks(subject: &SubjectModel, tracks: &Tracks2d) -> (SubjectModel, SubjectFit) {
+pub(super) fn fit_to_tracks(
+    subject: &SubjectModel,
+    tracks: &Tracks2d,
+) -> (SubjectModel, SubjectFit) {
     let images = smoothed_images(tracks, &adaptive_sigmas(tracks));
     fit(subject, &views(tracks, &images, None))
 }
@@ -245,7 +249,7 @@ pub fn fit_to_tracks(subject: &SubjectModel, tracks: &Tracks2d) -> (SubjectModel
 /// bone's parent over the trunk's in a first lift (per frame, with `params`) with that fit through
 /// `camera`: in a side view the near limbs are nearer the camera than the trunk and look several
 /// per cent longer. Falls back to the first fit when that lift fails.
-pub fn fit_in_perspective(
+pub(super) fn fit_in_perspective(
     subject: &SubjectModel,
     tracks: &Tracks2d,
     camera: PinholeCamera,

@@ -15,15 +15,15 @@ use image::RgbImage;
 use std::sync::Arc;
 
 /// Frames sampled for the median.
-pub const SAMPLES: usize = 25;
+pub(super) const SAMPLES: usize = 25;
 
 /// A pixel is steady when at least this share of the samples lie within `tau` of its median.
-pub const STABLE_SHARE: f32 = 0.7;
+pub(super) const STABLE_SHARE: f32 = 0.7;
 
 /// The camera counts as static when at least this share of the pixels are steady. The suite's
 /// clips (static cameras, people of 200–450 px in 640×480) have 0.92 to 1.00, the real sample
 /// 0.92; a camera panning over a textured scene has far less.
-pub const MIN_STATIC_SHARE: f32 = 0.6;
+pub(super) const MIN_STATIC_SHARE: f32 = 0.6;
 
 /// The per-pixel median of frames from a static camera, at the tracker's working size.
 #[derive(Debug, Clone)]
@@ -131,7 +131,7 @@ impl Background {
 /// How much a pixel `c` stands out from its background `b`: 255 times its largest channel
 /// difference over `tau`, at most 255 (one pixel; the tracker reads whole frames).
 #[cfg(test)]
-pub fn foreground_level(c: &[u8; 3], b: &[u8; 3], tau: f32) -> f32 {
+pub(super) fn foreground_level(c: &[u8; 3], b: &[u8; 3], tau: f32) -> f32 {
     level(max_abs_diff(c, b), tau)
 }
 
@@ -155,7 +155,7 @@ fn level_table(tau: f32) -> [f32; 256] {
 
 /// Indices of `count` frames spread evenly over `0..n`, first and last included (all of them
 /// when `n ≤ count`).
-pub fn sample_indices(n: usize, count: usize) -> Vec<usize> {
+pub(super) fn sample_indices(n: usize, count: usize) -> Vec<usize> {
     if n <= count || count < 2 {
         return (0..n).collect();
     }

@@ -7,7 +7,7 @@ use nalgebra::{Point2, Vector2};
 
 /// A morph-block in image pixels.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MorphBlock {
+pub(super) struct MorphBlock {
     /// Where the middle line meets the anchored side (a joint), pixels.
     pub origin: Point2<f64>,
     /// Height along the middle line, pixels (the bone's image length).
@@ -21,7 +21,7 @@ pub struct MorphBlock {
 
 impl MorphBlock {
     /// The block whose middle line runs from `from` to `to`, `width` pixels wide.
-    pub fn along(from: Point2<f64>, to: Point2<f64>, width: f64) -> MorphBlock {
+    pub(super) fn along(from: Point2<f64>, to: Point2<f64>, width: f64) -> MorphBlock {
         let d = to - from;
         MorphBlock {
             origin: from,
@@ -32,28 +32,28 @@ impl MorphBlock {
     }
 
     /// Unit vector along the middle line.
-    pub fn direction(&self) -> Vector2<f64> {
+    pub(super) fn direction(&self) -> Vector2<f64> {
         Vector2::new(self.theta.cos(), self.theta.sin())
     }
 
     /// Unit vector across the middle line (θ + 90°).
-    pub fn across(&self) -> Vector2<f64> {
+    pub(super) fn across(&self) -> Vector2<f64> {
         Vector2::new(-self.theta.sin(), self.theta.cos())
     }
 
     /// The far end of the middle line (the other joint).
-    pub fn end(&self) -> Point2<f64> {
+    pub(super) fn end(&self) -> Point2<f64> {
         self.origin + self.direction() * self.m
     }
 
     /// Image position of block coordinates `u` (0 at the anchor, 1 at the far end) and `v`
     /// (−0.5 … 0.5 across, positive towards θ + 90°).
-    pub fn to_image(self, u: f64, v: f64) -> Point2<f64> {
+    pub(super) fn to_image(self, u: f64, v: f64) -> Point2<f64> {
         self.origin + self.direction() * (u * self.m) + self.across() * (v * self.n)
     }
 
     /// Block coordinates `(u, v)` of an image point (inverse of [`MorphBlock::to_image`]).
-    pub fn to_block(self, p: Point2<f64>) -> (f64, f64) {
+    pub(super) fn to_block(self, p: Point2<f64>) -> (f64, f64) {
         let d = p - self.origin;
         let u = if self.m > 1e-9 {
             d.dot(&self.direction()) / self.m
@@ -70,7 +70,7 @@ impl MorphBlock {
 }
 
 /// Wraps an angle to (−π, π].
-pub fn wrap_angle(a: f64) -> f64 {
+pub(super) fn wrap_angle(a: f64) -> f64 {
     let mut a = a % std::f64::consts::TAU;
     if a <= -std::f64::consts::PI {
         a += std::f64::consts::TAU;

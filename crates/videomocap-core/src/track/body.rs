@@ -23,7 +23,7 @@ use rayon::prelude::*;
 use std::sync::Arc;
 
 /// The four limb chains: root joint, middle joint, end joint.
-pub const CHAINS: [[Joint; 3]; 4] = [
+pub(super) const CHAINS: [[Joint; 3]; 4] = [
     [Joint::LeftShoulder, Joint::LeftElbow, Joint::LeftWrist],
     [Joint::RightShoulder, Joint::RightElbow, Joint::RightWrist],
     [Joint::LeftHip, Joint::LeftKnee, Joint::LeftAnkle],
@@ -44,7 +44,7 @@ const CHAIN_ROOTS: [usize; 4] = [1, 2, 3, 4];
 
 /// One joint's result in one frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct JointResult {
+pub(super) struct JointResult {
     /// Position, pixels (tracker scale).
     pub pos: Point2<f64>,
     /// Reliability in [0, 1]: the block's similarity mapped by `c0 / (c0 + cost)`.
@@ -99,7 +99,7 @@ pub fn stature_px(pose: &PerJoint<Point2<f64>>, proportions: &Proportions) -> f6
 
 /// Tracks the body frame by frame.
 #[derive(Debug, Clone)]
-pub struct BodyTracker {
+pub(super) struct BodyTracker {
     params: Tuning,
     head: Part,
     trunk: Part,
@@ -131,7 +131,7 @@ pub struct BodyTracker {
 impl BodyTracker {
     /// Starts from a pose on `image` (a key frame): blocks from the pose, widths from the
     /// proportions scaled to it, colour models sampled from the image.
-    pub fn new(
+    pub(super) fn new(
         image: &RgbImage,
         pose: &PerJoint<Point2<f64>>,
         proportions: &Proportions,
@@ -280,7 +280,7 @@ impl BodyTracker {
     }
 
     /// The current pose (after the last step, or the starting pose).
-    pub fn pose(&self) -> PerJoint<JointResult> {
+    pub(super) fn pose(&self) -> PerJoint<JointResult> {
         let mut out = PerJoint::from_fn(|_| JointResult {
             pos: Point2::origin(),
             reliability: 0.0,
@@ -337,7 +337,7 @@ impl BodyTracker {
     }
 
     /// Tracks the body into the next frame and returns its pose.
-    pub fn step(&mut self, image: &RgbImage) -> PerJoint<JointResult> {
+    pub(super) fn step(&mut self, image: &RgbImage) -> PerJoint<JointResult> {
         let p = self.params;
         // Both frames are taken out of `self` while the parts are updated, and put back at the
         // end with their roles swapped.

@@ -15,7 +15,7 @@ use nalgebra::{Point2, Vector2};
 
 /// The head predictor with its adaptive threshold `p`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct HeadPredictor {
+pub(super) struct HeadPredictor {
     /// The profile cut, as a fraction of the profile's mean (the paper's `p`, default 0.5).
     pub p: f64,
 }
@@ -28,7 +28,7 @@ const STILL_LEVEL: f64 = 12.0;
 
 /// What the predictor found.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct HeadMotion {
+pub(super) struct HeadMotion {
     /// Predicted displacement of the head, pixels.
     pub displacement: Vector2<f64>,
     /// The motion direction α of eq. 5, degrees.
@@ -44,7 +44,7 @@ impl Default for HeadPredictor {
 impl HeadPredictor {
     /// Predicts the head's displacement from frame k (`prev`) to k + 1 (`next`), given the
     /// head_top and neck of frame k.
-    pub fn predict(
+    pub(super) fn predict(
         &self,
         prev: FrameView,
         next: FrameView,
@@ -140,7 +140,7 @@ impl HeadPredictor {
 
     /// Adapts `p` from how good the prediction was: an overshoot raises the cut (shorter runs,
     /// smaller displacements next time), a shortfall lowers it.
-    pub fn adapt(&mut self, predicted: Vector2<f64>, actual: Vector2<f64>) {
+    pub(super) fn adapt(&mut self, predicted: Vector2<f64>, actual: Vector2<f64>) {
         let (p, a) = (predicted.norm(), actual.norm());
         if (p - a).abs() < 0.5 {
             return;

@@ -141,7 +141,7 @@ fn moves_with_its_anchors(
 /// them), marks the rest lost, and lists every weak run.
 /// `frames` must hold consecutive frame indices; `is_key(frame, joint)` marks
 /// hand-placed joints.
-pub fn fill_weak_runs(
+pub(super) fn fill_weak_runs(
     frames: &mut [FrameTracks],
     weak: f32,
     max_gap: usize,

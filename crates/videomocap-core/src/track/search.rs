@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 /// The best block found and its cost.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Found {
+pub(super) struct Found {
     /// The block.
     pub block: MorphBlock,
     /// Its cost: the appearance cost (mean weighted difference, 8-bit levels) plus the prior's
@@ -23,7 +23,7 @@ pub struct Found {
 /// length from the body's proportions. Without it a uniformly coloured limb slides or shrinks
 /// along flat stretches of the cost surface.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Prior {
+pub(super) struct Prior {
     /// Predicted angle, radians.
     pub theta: f64,
     /// Predicted length, pixels.
@@ -44,7 +44,7 @@ pub struct Prior {
 
 impl Prior {
     /// No prior.
-    pub const NONE: Prior = Prior {
+    pub(super) const NONE: Prior = Prior {
         theta: 0.0,
         m: 1.0,
         per_degree: 0.0,
@@ -56,7 +56,7 @@ impl Prior {
     };
 
     /// The penalty of a candidate (infinite outside the length bounds).
-    pub fn penalty(&self, b: &MorphBlock) -> f32 {
+    pub(super) fn penalty(&self, b: &MorphBlock) -> f32 {
         if b.m < self.m_min || b.m > self.m_max {
             return f32::INFINITY;
         }
@@ -92,7 +92,7 @@ fn total_cost(
 
 /// Ranges of the spiral search (the paper's Δθ and Δm).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SpiralParams {
+pub(super) struct SpiralParams {
     /// Distance between neighbouring points of the path, pixels.
     pub step_px: f64,
     /// Δθ: each point is tried at θ − Δθ, θ and θ + Δθ, radians.
@@ -133,7 +133,7 @@ fn variants(b: &MorphBlock, p: &SpiralParams) -> impl Iterator<Item = MorphBlock
 /// The spiral search of Fig. 6 around `predicted` (origin, m, n, θ): ring by ring outwards,
 /// stopping after the first ring that finds nothing better than the best so far; then a local
 /// refinement of position, angle and size down to a quarter of a pixel.
-pub fn spiral(
+pub(super) fn spiral(
     template: &Template,
     frame: FrameView,
     predicted: &MorphBlock,
@@ -246,7 +246,7 @@ fn spiral_refine(template: &Template, frame: FrameView, best: Found, p: &SpiralP
 
 /// Step sizes of a local refinement.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Steps {
+pub(super) struct Steps {
     /// First position step, pixels.
     pub position: f64,
     /// First angle step, radians.
@@ -264,7 +264,7 @@ pub struct Steps {
 
 /// Coordinate descent from `start`: tries ± each step on each free parameter until nothing
 /// improves, then halves the steps.
-pub fn refine(
+pub(super) fn refine(
     template: &Template,
     frame: FrameView,
     start: Found,
@@ -328,7 +328,7 @@ pub fn refine(
 
 /// Ranges of the search of an anchored block.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AngularParams {
+pub(super) struct AngularParams {
     /// Half-width of the angle range around the predicted angle, radians.
     pub range_theta: f64,
     /// Angle step of the coarse scan, radians.
@@ -343,7 +343,7 @@ pub struct AngularParams {
 
 /// Searches a block anchored at a fixed joint: a coarse scan of angle × length on the coarse
 /// grid, then a refinement of the three best on the full grid.
-pub fn angular(
+pub(super) fn angular(
     template: &Template,
     frame: FrameView,
     predicted: &MorphBlock,
@@ -361,13 +361,13 @@ pub fn angular(
 /// synthetic bar needs about 5. The arm rescue's cost on the real sample (instructions to
 /// decode and track it, counted by cachegrind; 10.4 G without the rescue): uncapped 16.9 G, 2
 /// 14.0 G, 1.5 11.3 G.
-pub const COARSE_SLACK: f32 = 1.5;
+pub(super) const COARSE_SLACK: f32 = 1.5;
 
 /// [`angular`] for a caller that only wants a block costing under `cap`: coarse candidates
 /// costing more than [`COARSE_SLACK`] times `cap` are dropped as soon as their partial sum
 /// shows it (early exit), and never refined. The result may cost `cap` or more; the caller
 /// checks.
-pub fn angular_below(
+pub(super) fn angular_below(
     template: &Template,
     frame: FrameView,
     predicted: &MorphBlock,
@@ -445,7 +445,7 @@ pub fn angular_below(
 /// One segment of a two-segment chain (upper arm and forearm, thigh and shank): its colour
 /// model, its width and its motion prior.
 #[derive(Debug, Clone, Copy)]
-pub struct ChainSegment<'a> {
+pub(super) struct ChainSegment<'a> {
     /// The segment's colour model.
     pub template: &'a Template,
     /// Its width, pixels.
@@ -456,7 +456,7 @@ pub struct ChainSegment<'a> {
 
 /// Where a two-segment chain hangs from.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ChainRoot {
+pub(super) struct ChainRoot {
     /// The root joint (shoulder, hip).
     pub at: Point2<f64>,
     /// When the root may move: its rest point and the cost per square pixel of leaving it.
@@ -471,7 +471,7 @@ pub struct ChainRoot {
 /// costs (plus the spring's) falls; steps start at `step_px` and are halved `levels − 1` times.
 /// `allowed` refuses a pair of blocks (a lower segment folded back). Returns the two blocks and
 /// their summed cost.
-pub fn refine_chain(
+pub(super) fn refine_chain(
     frame: FrameView,
     root: ChainRoot,
     segments: [ChainSegment; 2],

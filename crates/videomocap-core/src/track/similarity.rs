@@ -29,17 +29,18 @@
 //! the 1080×1920 tracking-to-decoding ratio from 2.04 to 1.57.
 
 use super::block::MorphBlock;
+pub use super::frame::FloatFrame;
+pub(super) use super::frame::FrameView;
 use super::frame::{FRAC_BITS, FRAC_ONE};
-pub use super::frame::{FloatFrame, FrameView};
 
 /// Most rows in a block's sampling grid.
-pub const MAX_ROWS: usize = 24;
+pub(super) const MAX_ROWS: usize = 24;
 /// Most columns in a block's sampling grid.
-pub const MAX_COLS: usize = 10;
+pub(super) const MAX_COLS: usize = 10;
 
 /// The weights of eqs. 3–5 and of the colour-model mix.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SimilarityWeights {
+pub(crate) struct SimilarityWeights {
     /// `W_R, W_G, W_B` of eq. 3. Default equal thirds: clothes and skin differ as much in hue as
     /// in brightness, so no channel is favoured.
     pub rgb: [f32; 3],
@@ -158,7 +159,7 @@ impl FixedGrid {
 /// block that stops exactly at a joint of a uniformly coloured limb can shrink along it at no
 /// cost.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Extent {
+pub(super) struct Extent {
     /// Start, units of m.
     pub start: f64,
     /// End, units of m.
@@ -167,7 +168,7 @@ pub struct Extent {
 
 impl Extent {
     /// Exactly the block (the paper's).
-    pub const BLOCK: Extent = Extent {
+    pub(super) const BLOCK: Extent = Extent {
         start: 0.0,
         end: 1.0,
     };
@@ -176,7 +177,7 @@ impl Extent {
 /// The colour model of one block: `rows × cols` cells, each with its key-frame colour, its
 /// adaptive colour and its region weight (eq. 5).
 #[derive(Debug, Clone)]
-pub struct Template {
+pub(super) struct Template {
     rows: usize,
     cols: usize,
     /// Per cell: the key model's R, G, B, foreground and the adaptive model's (four lanes,
@@ -197,7 +198,7 @@ pub struct Template {
 }
 
 /// Grid size for a block of `m × n` pixels: one cell per pixel, capped.
-pub fn grid_size(m: f64, n: f64) -> (usize, usize) {
+pub(super) fn grid_size(m: f64, n: f64) -> (usize, usize) {
     let rows = (m.round() as usize).clamp(4, MAX_ROWS);
     let cols = (n.round() as usize).clamp(3, MAX_COLS);
     (rows, cols)
@@ -205,7 +206,7 @@ pub fn grid_size(m: f64, n: f64) -> (usize, usize) {
 
 impl Template {
     /// Samples a block of `frame` as both the key and the adaptive model.
-    pub fn sample(
+    pub(super) fn sample(
         frame: FrameView,
         block: &MorphBlock,
         extent: Extent,
@@ -332,45 +333,45 @@ impl Template {
 
     /// Rows of the grid.
     #[cfg(test)]
-    pub fn rows(&self) -> usize {
+    pub(super) fn rows(&self) -> usize {
         self.rows
     }
 
     /// Columns of the grid.
     #[cfg(test)]
-    pub fn cols(&self) -> usize {
+    pub(super) fn cols(&self) -> usize {
         self.cols
     }
 
     /// The key-frame colour of cell `(i, j)`.
     #[cfg(test)]
-    pub fn key_colour(&self, i: usize, j: usize) -> [f32; 3] {
+    pub(super) fn key_colour(&self, i: usize, j: usize) -> [f32; 3] {
         let [c, _] = self.cells[i * self.cols + j];
         [c[0], c[1], c[2]]
     }
 
     /// The adaptive colour of cell `(i, j)`.
     #[cfg(test)]
-    pub fn adaptive_colour(&self, i: usize, j: usize) -> [f32; 3] {
+    pub(super) fn adaptive_colour(&self, i: usize, j: usize) -> [f32; 3] {
         let [_, c] = self.cells[i * self.cols + j];
         [c[0], c[1], c[2]]
     }
 
     /// The sampled extent along the middle line.
     #[cfg(test)]
-    pub fn extent(&self) -> Extent {
+    pub(super) fn extent(&self) -> Extent {
         self.extent
     }
 
     /// The weights in use.
     #[cfg(test)]
-    pub fn weights(&self) -> SimilarityWeights {
+    pub(super) fn weights(&self) -> SimilarityWeights {
         self.weights
     }
 
     /// Updates the adaptive model with the block found in a new frame by a linear weight:
     /// `model ← (1 − rate)·model + rate·observed` (the paper's self-adapting colour model).
-    pub fn update(&mut self, frame: FrameView, block: &MorphBlock, rate: f32) {
+    pub(super) fn update(&mut self, frame: FrameView, block: &MorphBlock, rate: f32) {
         let g = GridGeometry::new(block, self.extent, self.rows, self.cols);
         for ([_, adaptive], c) in self
             .cells
@@ -387,20 +388,26 @@ impl Template {
     /// candidate block in `frame`. `coarse` compares only every other row and column (4× fewer
     /// samples, for the wide first search). Returns `f32::INFINITY` as soon as the partial sum
     /// proves the cost exceeds `bound` (early exit: the candidate already loses).
-    pub fn cost(&self, frame: FrameView, block: &MorphBlock, coarse: bool, bound: f32) -> f32 {
+    pub(super) fn cost(
+        &self,
+        frame: FrameView,
+        block: &MorphBlock,
+        coarse: bool,
+        bound: f32,
+    ) -> f32 {
         self.cost_lanes(frame, block, coarse, bound, self.foreground)
     }
 
     /// [`Template::cost`] on the colour alone, the foreground lane left out: what the
     /// reliability is read from, so that it means the same with and without a background.
-    pub fn appearance_cost(&self, frame: FrameView, block: &MorphBlock) -> f32 {
+    pub(super) fn appearance_cost(&self, frame: FrameView, block: &MorphBlock) -> f32 {
         self.cost_lanes(frame, block, false, f32::INFINITY, 0.0)
     }
 
     /// Makes [`Template::cost`] weigh the foreground lane by `weight` (levels of foreground
     /// difference against levels of colour difference): the part must stand out from the
     /// background where it stood out on the key frame. 0 (the default) leaves it out.
-    pub fn set_foreground(&mut self, weight: f32) {
+    pub(super) fn set_foreground(&mut self, weight: f32) {
         self.foreground = weight;
     }
 

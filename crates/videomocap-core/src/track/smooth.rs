@@ -25,17 +25,17 @@ use nalgebra::Vector2;
 /// The least weight a neighbour's reliability gives it: a lost joint (reliability near 0)
 /// still counts a little, so that a run of weak frames is smoothed among itself rather than
 /// left as tracked.
-pub const MIN_WEIGHT: f64 = 0.05;
+pub(crate) const MIN_WEIGHT: f64 = 0.05;
 
 /// How far the window reaches, in standard deviations.
-pub const REACH_SIGMAS: f64 = 3.0;
+pub(crate) const REACH_SIGMAS: f64 = 3.0;
 
 /// The Gaussian-weighted mean at position `t` of a series of `len` points: every position `u`
 /// within [`REACH_SIGMAS`] standard deviations (`sigma`, in positions) gives `sample(u)`, its
 /// point and weight (`None` leaves it out), weighed by `exp(−(u − t)² / 2σ²)` on top. The
 /// weights that count must not all be 0. One window for the tracker's smoothing here and the
 /// lift's (`lift::smoothing`), which differ only in what they weigh and leave out.
-pub fn gaussian_mean(
+pub(crate) fn gaussian_mean(
     t: usize,
     len: usize,
     sigma: f64,
@@ -60,7 +60,7 @@ pub fn gaussian_mean(
 /// `is_key(frame, joint)` holds and joints off the frame are left where they are;
 /// off-frame joints are not used as neighbours. Does nothing when `sigma_frames` is not above
 /// 0.
-pub fn smooth_tracks(
+pub(crate) fn smooth_tracks(
     frames: &mut [FrameTracks],
     sigma_frames: f64,
     first: usize,

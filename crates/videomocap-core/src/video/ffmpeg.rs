@@ -405,6 +405,7 @@ impl Converter {
 // SAFETY: every FFmpeg object in `FfmpegSource` (demuxer, decoder, scaler) is owned by it alone
 // and only touched through `&mut self`; FFmpeg contexts may move between threads as long as they
 // are not used from two at once, which `&mut` rules out.
+#[allow(unsafe_code)]
 unsafe impl Send for FfmpegSource {}
 
 impl VideoSource for FfmpegSource {

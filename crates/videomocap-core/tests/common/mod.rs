@@ -1,5 +1,7 @@
 //! Helpers shared by the integration tests.
 
+#![allow(clippy::unwrap_used)] // a test's unwrap is its failure, named by the panic
+
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use videomocap_core::formats::Marks;
@@ -10,7 +12,7 @@ use videomocap_testkit::synth::GroundTruth;
 
 /// Tracks `video` (a file or a folder of frames) from the marks in `dir` with `params` on two
 /// threads, and scores it against the truth in `dir` (`marks.json`, `gt.json`).
-pub fn track_and_score(dir: &Path, video: &Path, params: TrackerParams) -> ClipScore {
+pub(crate) fn track_and_score(dir: &Path, video: &Path, params: TrackerParams) -> ClipScore {
     let gt = GroundTruth::load(&dir.join("gt.json")).unwrap();
     let marks = Marks::load(&dir.join("marks.json")).unwrap();
     let mut video = Video::open(video, &OpenOptions::default()).unwrap();

@@ -1,6 +1,7 @@
 //! The walking-like test sequence the lift's integration tests share, built from the skeleton
 //! model itself (rigid key triangle, constant bone lengths), where the answer is known exactly.
 
+#![allow(clippy::unwrap_used)] // a test's unwrap is its failure, named by the panic
 #![allow(dead_code)] // each test crate uses its own share of these
 
 use nalgebra::{Point3, Rotation3, Vector3};
@@ -12,14 +13,14 @@ use videomocap_core::skeleton::{Bone, Joint, PerJoint, SubjectModel};
 use videomocap_testkit::eval::pose3d::tracks_from_truth;
 use videomocap_testkit::synth::{GroundTruth, GroundTruthFrame};
 
-pub const FRAMES: usize = 60;
+pub(crate) const FRAMES: usize = 60;
 
-pub fn camera() -> PinholeCamera {
+pub(crate) fn camera() -> PinholeCamera {
     PinholeCamera::centred(700.0, 640, 480)
 }
 
 /// A lift of `tracks` through [`camera`], with no forced roots.
-pub fn job_for<'a>(
+pub(crate) fn job_for<'a>(
     tracks: &'a Tracks2d,
     subject: &SubjectModel,
     params: LiftParams,
@@ -34,12 +35,12 @@ pub fn job_for<'a>(
 }
 
 /// A walking-like sequence of the default subject, turning slowly in front of the camera.
-pub fn truth() -> (GroundTruth, SubjectModel) {
+pub(crate) fn truth() -> (GroundTruth, SubjectModel) {
     truth_of(SubjectModel::default())
 }
 
 /// The walking-like sequence of subject `s`.
-pub fn truth_of(s: SubjectModel) -> (GroundTruth, SubjectModel) {
+pub(crate) fn truth_of(s: SubjectModel) -> (GroundTruth, SubjectModel) {
     use Joint::*;
     let tri = KeyTriangle::from_subject(&s).unwrap();
     // The bone joining two joints, whichever way the model's tree runs.
@@ -142,7 +143,12 @@ pub fn truth_of(s: SubjectModel) -> (GroundTruth, SubjectModel) {
     (gt, s)
 }
 
-pub fn run(gt: &GroundTruth, subject: &SubjectModel, noise: f64, refine: bool) -> LiftOutput {
+pub(crate) fn run(
+    gt: &GroundTruth,
+    subject: &SubjectModel,
+    noise: f64,
+    refine: bool,
+) -> LiftOutput {
     let tracks = tracks_from_truth(gt, noise, 3);
     let params = LiftParams {
         refine,

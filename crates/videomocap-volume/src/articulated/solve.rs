@@ -35,7 +35,7 @@ pub(crate) struct FrameData {
 
 impl FrameData {
     /// The fit's view of `points` with the robust loss's scale `sigma_m`.
-    pub fn new(points: Vec<Point3<f64>>, sigma_m: f64) -> FrameData {
+    pub(crate) fn new(points: Vec<Point3<f64>>, sigma_m: f64) -> FrameData {
         let coords: Vec<[f64; 3]> = points.iter().map(|p| [p.x, p.y, p.z]).collect();
         FrameData {
             tree: ImmutableKdTree::new_from_slice(&coords),

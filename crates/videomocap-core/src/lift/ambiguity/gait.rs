@@ -9,34 +9,34 @@ use crate::skeleton::PerJoint;
 use nalgebra::{Point3, Vector3};
 
 /// The shortest lag (frames) taken for half a stride (a sprint at 30 frames/s takes about 8).
-pub const MIN_LAG: usize = 5;
+pub(super) const MIN_LAG: usize = 5;
 
 /// How closely (Pearson correlation) the right thigh's forward swing must repeat the left's
 /// at the lag for the motion to count as a gait. The suite's walks and runs reach 0.97 to 1.00
 /// at their calibrated pose; its dances 0.39 to 0.84 (below, or gated by the arms themselves:
 /// [`SYMMETRY_MAX_DISCREPANCY`]).
-pub const MIN_CORRELATION: f64 = 0.8;
+pub(super) const MIN_CORRELATION: f64 = 0.8;
 
 /// The least standard deviation of a thigh's forward component (the sine of its swing) for the
 /// legs to be moving at all.
-pub const MIN_SWING: f64 = 0.05;
+pub(super) const MIN_SWING: f64 = 0.05;
 
 /// The largest median (over the frames) of an arm's first-pass squared distance from its
 /// partner's mirrored pose (unit directions, upper arm plus forearm) for the arm to be steered:
 /// the suite's walking and running arms measure 0.05 to 0.13 at their calibrated pose,
 /// dribble_oblique's 1.3 to 1.5 (one hand bounces the ball), dance_turns_frontal's 1.2 to 1.4.
 /// At 0.15 / 0.3 / 0.6 the suite's wrong roots from exact 2D are the same (722).
-pub const SYMMETRY_MAX_DISCREPANCY: f64 = 0.3;
+pub(super) const SYMMETRY_MAX_DISCREPANCY: f64 = 0.3;
 
 /// How many passes over the arms follow the first (each reads the other arm's previous one).
 /// The suite from exact 2D with true lengths: 1 / 2 passes, 732 / 722 wrong roots.
-pub const SYMMETRY_ROUNDS: usize = 2;
+pub(super) const SYMMETRY_ROUNDS: usize = 2;
 
 /// The lag (frames, half a stride) at which the right thigh's forward swing best repeats the
 /// left's, when it does so closely enough ([`MIN_CORRELATION`]) and both thighs swing
 /// ([`MIN_SWING`]); `None` otherwise. Lags up to half the clip are tried, so a clip must hold a
 /// whole stride.
-pub fn gait_lag(points: &[PerJoint<Point3<f64>>], trunks: &[TrunkFrame]) -> Option<usize> {
+pub(super) fn gait_lag(points: &[PerJoint<Point3<f64>>], trunks: &[TrunkFrame]) -> Option<usize> {
     let swing = |hip: Joint, knee: Joint| -> Vec<f64> {
         points
             .iter()
@@ -68,7 +68,7 @@ pub fn gait_lag(points: &[PerJoint<Point3<f64>>], trunks: &[TrunkFrame]) -> Opti
 }
 
 /// The other arm's poses of a previous pass and the lag they are compared at.
-pub struct Symmetry<'a> {
+pub(super) struct Symmetry<'a> {
     /// Half a stride, frames ([`gait_lag`]).
     pub lag: usize,
     /// Every joint of every frame as the previous pass left them.
@@ -119,7 +119,7 @@ impl Symmetry<'_> {
     /// [`super::AmbiguityWeights::gait_symmetry`]'s cost (unweighted, squared metres) of an arm
     /// posed as in `p` on frame `t`: each bone's [`Symmetry::discrepancy`] times its length
     /// squared.
-    pub fn cost(&self, group: &Group, p: &PerJoint<Point3<f64>>, t: usize) -> f64 {
+    pub(super) fn cost(&self, group: &Group, p: &PerJoint<Point3<f64>>, t: usize) -> f64 {
         self.discrepancy(group, p, t).map_or(0.0, |d| {
             group
                 .bones
@@ -133,7 +133,7 @@ impl Symmetry<'_> {
     /// Whether an arm follows the other closely enough in the previous pass to be steered
     /// by it: the median of its [`Symmetry::discrepancy`] (both bones) at most
     /// [`SYMMETRY_MAX_DISCREPANCY`].
-    pub fn holds(&self, group: &Group) -> bool {
+    pub(super) fn holds(&self, group: &Group) -> bool {
         let mut d: Vec<f64> = (0..self.previous.len())
             .filter_map(|t| self.discrepancy(group, &self.previous[t], t))
             .map(|d| d[0] + d[1])

@@ -27,7 +27,10 @@ pub(super) const THIGH_DEPTH: f64 = 0.45;
 /// The facing's cost of a key path, weighed by [`AmbiguityWeights::image_depth`] (unweighted, squared metres): each
 /// frame's shoulders' depth step (left minus right) against the network's, squared, times
 /// the network's confidence in both shoulders; `None` without any network body.
-pub fn image_facing_cost(key: &[[Point3<f64>; 3]], bodies: &[Option<NetworkBody>]) -> Option<f64> {
+pub(crate) fn image_facing_cost(
+    key: &[[Point3<f64>; 3]],
+    bodies: &[Option<NetworkBody>],
+) -> Option<f64> {
     let mut seen = false;
     let cost = key
         .iter()

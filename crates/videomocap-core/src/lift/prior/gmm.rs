@@ -19,7 +19,7 @@ pub struct Component {
 /// component and packed in one slice (no allocation when it is evaluated): the normalising
 /// constant's log, the mean, and the inverse of the covariance's Cholesky factor.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Gmm {
+pub(crate) struct Gmm {
     pub(crate) dims: usize,
     pub(crate) components: Vec<Component>,
     /// Per component [`Gmm::stride`] numbers: ln weight − ½ d ln 2π − Σ ln Lᵢᵢ (the log of the
@@ -35,12 +35,12 @@ pub struct Gmm {
 const NEGLIGIBLE: f64 = 37.0;
 
 /// The most dimensions a mixture may have (the pose prior's largest group has 9).
-pub const MAX_DIMS: usize = 16;
+pub(super) const MAX_DIMS: usize = 16;
 
 impl Gmm {
     /// A mixture from its components; `Err` names what is wrong (dimensions, weights, a factor
     /// that is not positive definite, a number that is not finite).
-    pub fn new(dims: usize, components: Vec<Component>) -> Result<Gmm, String> {
+    pub(crate) fn new(dims: usize, components: Vec<Component>) -> Result<Gmm, String> {
         if components.is_empty() {
             return Err("a mixture without components".to_owned());
         }
@@ -99,7 +99,7 @@ impl Gmm {
     /// more than [`NEGLIGIBLE`] below the best so far: added, it would not have changed the
     /// running sum's bits (so the result is the same as the full sum's, to the bit; checked in
     /// a test against [`Gmm::log_density_full`]).
-    pub fn log_density(&self, x: &[f64]) -> f64 {
+    pub(crate) fn log_density(&self, x: &[f64]) -> f64 {
         let dims = self.dims;
         let mut total = LogSumExp::default();
         let mut d = [0.0f64; MAX_DIMS];
@@ -165,7 +165,7 @@ impl Gmm {
     }
 
     /// The highest log density over the components' means (about the mixture's mode).
-    pub fn peak(&self) -> f64 {
+    pub(crate) fn peak(&self) -> f64 {
         self.components
             .iter()
             .map(|c| self.log_density(&c.mean))
@@ -222,7 +222,7 @@ fn cholesky(a: &[f64], dims: usize) -> Option<Vec<f64>> {
 /// the same data give the same file). `floor` is added to every covariance's diagonal (the
 /// directions of unit vectors and of mirrored pairs lie on lower-dimensional sets). `Err` where
 /// `dims` is beyond [`MAX_DIMS`].
-pub fn fit(
+pub(crate) fn fit(
     data: &[Vec<f64>],
     dims: usize,
     k: usize,

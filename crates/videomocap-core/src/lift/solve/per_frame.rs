@@ -332,7 +332,7 @@ fn frame_reports(job: &LiftJob<'_>, prep: &Prepared, key: &[[Point3<f64>; 3]]) -
 /// miss, squared metres for a group's cost, both summed over the clip): a part that fits
 /// exactly (cost 0) would otherwise outvote every other. 0.01 and 0.1 chose the same poses on
 /// every clip of `bench lift`.
-pub const FIT_FLOOR: f64 = 0.01;
+pub(super) const FIT_FLOOR: f64 = 0.01;
 
 /// How badly a calibration pose, carried through the clip, fits: the sum of the logarithms of
 /// the 2D miss (metres, [`miss_m`] summed over the frames) and of each group of bones' prior
@@ -344,7 +344,7 @@ pub const FIT_FLOOR: f64 = 0.01;
 /// trunk tipped the other way (treadmill_raised 353.9 mm); with this sum of logs 174.2 mm,
 /// and the suite 117.7 → 103.5 mm (from the height 119.5 → 117.7); exact and noisy 2D and the
 /// real sample within 0.1 mm.
-pub fn fit_score(miss_m: f64, group_costs: &[f64]) -> f64 {
+pub(super) fn fit_score(miss_m: f64, group_costs: &[f64]) -> f64 {
     std::iter::once(miss_m)
         .chain(group_costs.iter().copied())
         .map(|c| c.max(FIT_FLOOR).ln())

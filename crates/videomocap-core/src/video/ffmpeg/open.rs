@@ -8,6 +8,7 @@ use ffmpeg_next as ff;
 use std::path::Path;
 
 /// Reads the display rotation (clockwise degrees, multiple of 90) from a stream's display matrix.
+#[allow(unsafe_code)] // FFmpeg's C data, read beside a SAFETY comment
 pub(super) fn display_rotation(stream: &ff::format::stream::Stream) -> u32 {
     for side in stream.side_data() {
         if side.kind() == ff::codec::packet::side_data::Type::DisplayMatrix
@@ -97,6 +98,7 @@ pub(super) fn open_decoder(
 
 /// The index: every packet of the stream, in file order (its timestamp, whether a keyframe),
 /// discarded and corrupt packets left out.
+#[allow(unsafe_code)] // FFmpeg's C data, read beside a SAFETY comment
 pub(super) fn index_packets(
     input: &mut ff::format::context::Input,
     stream_index: usize,
