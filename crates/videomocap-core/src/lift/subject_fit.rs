@@ -208,7 +208,7 @@ fn measure_drop(views: &[FrameView<'_>]) -> Option<(f64, usize)> {
 /// A limb group's [`LIMB_QUANTILE`] of image length over trunk length, when enough frames show
 /// it.
 fn measure_limb(views: &[FrameView<'_>], bones: &[(Joint, Joint)]) -> Option<f64> {
-    let mut ratios: Vec<f64> = views
+    let ratios: Vec<f64> = views
         .iter()
         .flat_map(|v| {
             bones.iter().filter_map(move |&(a, b)| {
@@ -228,9 +228,14 @@ fn measure_limb(views: &[FrameView<'_>], bones: &[(Joint, Joint)]) -> Option<f64
     if ratios.len() < MIN_LIMB_FRAMES * bones.len() {
         return None;
     }
-    ratios.sort_by(f64::total_cmp);
-    let k = ((ratios.len() - 1) as f64 * LIMB_QUANTILE).round() as usize;
-    ratios.get(k).copied()
+    quantile(ratios, LIMB_QUANTILE)
+}
+
+/// The `q` quantile of `values` (the nearest rank); `None` when there are none.
+fn quantile(mut values: Vec<f64>, q: f64) -> Option<f64> {
+    values.sort_by(f64::total_cmp);
+    let k = ((values.len().checked_sub(1)?) as f64 * q).round() as usize;
+    values.get(k).copied()
 }
 
 /// The subject with its key triangle's height and its limbs' lengths read from the tracks (see

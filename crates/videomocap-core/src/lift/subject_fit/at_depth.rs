@@ -5,7 +5,7 @@
 
 use super::{
     ChestDrop, ENVELOPE_QUANTILE, FrameView, LENGTH_MARGIN, LIMB_RANGE, LengthOrigin,
-    MIN_LIMB_FRAMES, PartLength, SubjectFit, place_chest, stature_stack,
+    MIN_LIMB_FRAMES, PartLength, SubjectFit, place_chest, quantile, stature_stack,
 };
 use crate::formats::KnownLengths;
 use crate::lift::LiftError;
@@ -56,7 +56,7 @@ fn measure_at_depth(
     pairs: &[(Joint, Joint)],
     depth_of: Option<Joint>,
 ) -> Option<f64> {
-    let mut lengths: Vec<f64> = views
+    let lengths: Vec<f64> = views
         .iter()
         .flat_map(|v| {
             pairs.iter().filter_map(move |&(a, b)| {
@@ -72,9 +72,7 @@ fn measure_at_depth(
     if lengths.len() < MIN_LIMB_FRAMES * pairs.len() {
         return None;
     }
-    lengths.sort_by(f64::total_cmp);
-    let k = ((lengths.len() - 1) as f64 * ENVELOPE_QUANTILE).round() as usize;
-    lengths.get(k).copied()
+    quantile(lengths, ENVELOPE_QUANTILE)
 }
 
 /// The bones each group of [`GROUPS`] sets (both sides; none for the shoulder width, which is
