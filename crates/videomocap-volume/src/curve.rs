@@ -286,55 +286,86 @@ pub fn head_tip_guess(tree: &ShellTree, input: &[Point3<f64>]) -> Option<Point3<
 /// but a leg is not), else the shortest; the arms are the limbs leaving the head's node first,
 /// then those nearest the head.
 fn name_limbs(limbs: &[(Vec<usize>, usize)], length: &[f64], points: &[Point3<f64>]) -> Named {
-    let tip = |k: usize| points[*limbs[k].0.last().unwrap_or(&limbs[k].1)];
     let mut nodes: Vec<usize> = limbs.iter().map(|l| l.1).collect();
     nodes.sort_unstable();
     nodes.dedup();
-    let at =
-        |node: usize| -> Vec<usize> { (0..limbs.len()).filter(|&k| limbs[k].1 == node).collect() };
     if let [n0, n1] = nodes[..]
-        && at(n0).len() >= 2
-        && at(n1).len() >= 2
-        && let Some(axis) = (points[n0] - points[n1]).try_normalize(1e-9)
+        && let Some(named) = name_at_two_nodes(limbs, length, points, (n0, n1))
     {
-        // cos(k, away): limb k's leaf direction against `away`.
-        let cos = |k: usize, away: &Vector3<f64>| {
-            (tip(k) - points[limbs[k].1])
-                .try_normalize(1e-9)
-                .map_or(0.0, |d| d.dot(away))
-        };
-        // The limbs at `node` by reach away from the other node, farthest first.
-        let by_reach = |node: usize, away: Vector3<f64>| {
-            let mut g = at(node);
-            g.sort_by(|&a, &b| (length[b] * cos(b, &away)).total_cmp(&(length[a] * cos(a, &away))));
-            let reach: f64 = g.iter().take(2).map(|&k| length[k] * cos(k, &away)).sum();
-            (g, reach)
-        };
-        let (g0, r0) = by_reach(n0, axis);
-        let (g1, r1) = by_reach(n1, -axis);
-        let (pelvis, chest, up) = if r0 >= r1 {
-            (g0, at(n1), -axis)
-        } else {
-            (g1, at(n0), axis)
-        };
-        let longest = length.iter().copied().fold(f64::MIN_POSITIVE, f64::max);
-        let continues = |k: usize| cos(k, &up) - length[k] / longest;
-        let head = chest
-            .iter()
-            .copied()
-            .max_by(|&a, &b| continues(a).total_cmp(&continues(b)))
-            .unwrap_or(chest[0]);
-        let mut arms = chest
-            .iter()
-            .chain(&pelvis[2..])
-            .copied()
-            .filter(|&k| k != head);
-        return Named {
-            head,
-            arms: [arms.next(), arms.next()],
-            legs: [pelvis[0], pelvis[1]],
-        };
+        return named;
     }
+    name_by_shortest(limbs, length, points, &nodes)
+}
+
+/// The limbs of `limbs` attached at `node`.
+fn limbs_at(limbs: &[(Vec<usize>, usize)], node: usize) -> Vec<usize> {
+    (0..limbs.len()).filter(|&k| limbs[k].1 == node).collect()
+}
+
+/// Two branch nodes, each with two limbs or more: the pelvis is the node whose two
+/// farthest-reaching limbs reach farther, the head the chest limb that best continues the
+/// pelvis→chest axis for its length (see [`name_limbs`]); `None` when a node has fewer limbs
+/// or the nodes coincide.
+fn name_at_two_nodes(
+    limbs: &[(Vec<usize>, usize)],
+    length: &[f64],
+    points: &[Point3<f64>],
+    (n0, n1): (usize, usize),
+) -> Option<Named> {
+    let at = |node: usize| limbs_at(limbs, node);
+    if at(n0).len() < 2 || at(n1).len() < 2 {
+        return None;
+    }
+    let axis = (points[n0] - points[n1]).try_normalize(1e-9)?;
+    let tip = |k: usize| points[*limbs[k].0.last().unwrap_or(&limbs[k].1)];
+    // cos(k, away): limb k's leaf direction against `away`.
+    let cos = |k: usize, away: &Vector3<f64>| {
+        (tip(k) - points[limbs[k].1])
+            .try_normalize(1e-9)
+            .map_or(0.0, |d| d.dot(away))
+    };
+    // The limbs at `node` by reach away from the other node, farthest first.
+    let by_reach = |node: usize, away: Vector3<f64>| {
+        let mut g = at(node);
+        g.sort_by(|&a, &b| (length[b] * cos(b, &away)).total_cmp(&(length[a] * cos(a, &away))));
+        let reach: f64 = g.iter().take(2).map(|&k| length[k] * cos(k, &away)).sum();
+        (g, reach)
+    };
+    let (g0, r0) = by_reach(n0, axis);
+    let (g1, r1) = by_reach(n1, -axis);
+    let (pelvis, chest, up) = if r0 >= r1 {
+        (g0, at(n1), -axis)
+    } else {
+        (g1, at(n0), axis)
+    };
+    let longest = length.iter().copied().fold(f64::MIN_POSITIVE, f64::max);
+    let continues = |k: usize| cos(k, &up) - length[k] / longest;
+    let head = chest
+        .iter()
+        .copied()
+        .max_by(|&a, &b| continues(a).total_cmp(&continues(b)))
+        .unwrap_or(chest[0]);
+    let mut arms = chest
+        .iter()
+        .chain(&pelvis[2..])
+        .copied()
+        .filter(|&k| k != head);
+    Some(Named {
+        head,
+        arms: [arms.next(), arms.next()],
+        legs: [pelvis[0], pelvis[1]],
+    })
+}
+
+/// One branch node, or a lone limb at a node: the head is the shortest of three limbs leaving
+/// one of the `nodes` when there is such a node, else the shortest; the arms are the limbs
+/// leaving the head's node first, then those nearest the head; the last two the legs.
+fn name_by_shortest(
+    limbs: &[(Vec<usize>, usize)],
+    length: &[f64],
+    points: &[Point3<f64>],
+    nodes: &[usize],
+) -> Named {
     let shortest = |among: &[usize]| {
         among
             .iter()
@@ -342,7 +373,10 @@ fn name_limbs(limbs: &[(Vec<usize>, usize)], length: &[f64], points: &[Point3<f6
             .min_by(|&a, &b| length[a].total_cmp(&length[b]))
             .unwrap_or(0)
     };
-    let three = nodes.iter().map(|&n| at(n)).find(|g| g.len() == 3);
+    let three = nodes
+        .iter()
+        .map(|&n| limbs_at(limbs, n))
+        .find(|g| g.len() == 3);
     let all: Vec<usize> = (0..limbs.len()).collect();
     let head = shortest(three.as_deref().unwrap_or(&all));
     let head_start = points[limbs[head].0[0]];
@@ -411,28 +445,7 @@ pub fn skeleton_curve(
         .iter()
         .map(|&k| tree.nodes[k].members.clone())
         .collect();
-    // Limbs: from each leaf up to (not including) the first node with two or more leaves below
-    // it (or the root).
-    let mut limbs: Vec<(Vec<usize>, usize)> = Vec::new(); // (chain outwards, attachment)
-    for &k in &order {
-        if !tree.nodes[k].children.is_empty() {
-            continue;
-        }
-        let mut chain = vec![index[k]];
-        let mut cur = k;
-        let attach = loop {
-            match tree.nodes[cur].parent {
-                Some(p) if p != tree.root && leaves_below(tree, p) < 2 => {
-                    chain.push(index[p]);
-                    cur = p;
-                }
-                Some(p) => break index[p],
-                None => break index[cur],
-            }
-        };
-        chain.reverse();
-        limbs.push((chain, attach));
-    }
+    let mut limbs = leaf_limbs(tree, &order, &index);
     let length = |(chain, attach): &(Vec<usize>, usize)| {
         let mut prev = points[*attach];
         chain.iter().fold(0.0, |acc, &i| {
@@ -462,6 +475,33 @@ pub fn skeleton_curve(
         parents,
         members,
     })
+}
+
+/// The limbs of `tree`: from each leaf up to (not including) the first node with two or more
+/// leaves below it (or the root), each as its chain outwards and its attachment (indices of
+/// curve points: `index` maps tree nodes to them, `order` lists the live nodes).
+fn leaf_limbs(tree: &ShellTree, order: &[usize], index: &[usize]) -> Vec<(Vec<usize>, usize)> {
+    let mut limbs: Vec<(Vec<usize>, usize)> = Vec::new();
+    for &k in order {
+        if !tree.nodes[k].children.is_empty() {
+            continue;
+        }
+        let mut chain = vec![index[k]];
+        let mut cur = k;
+        let attach = loop {
+            match tree.nodes[cur].parent {
+                Some(p) if p != tree.root && leaves_below(tree, p) < 2 => {
+                    chain.push(index[p]);
+                    cur = p;
+                }
+                Some(p) => break index[p],
+                None => break index[cur],
+            }
+        };
+        chain.reverse();
+        limbs.push((chain, attach));
+    }
+    limbs
 }
 
 #[cfg(test)]

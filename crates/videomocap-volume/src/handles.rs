@@ -75,128 +75,20 @@ fn parted_at(branches: &[Branch], a: usize, b: usize) -> u32 {
 /// Opens the loops of `g` seen from `source`: the graph without the edges that close them, and
 /// how many edges (counted once) were removed; `None` when there is no loop.
 pub(super) fn cut_handles(g: &Graph, source: usize) -> Option<(Graph, usize)> {
-    let n = g.len();
-    let mut dist = vec![0f32; n];
-    let mut parent = vec![u32::MAX; n];
-    dijkstra(
-        g,
-        source,
-        &mut dist,
-        &mut BinaryHeap::new(),
-        Some(&mut parent),
-    );
-    let band = g.longest_edge().max(f32::MIN_POSITIVE);
-    let level: Vec<u32> = dist
-        .iter()
-        .map(|d| {
-            if d.is_finite() {
-                (d / band) as u32
-            } else {
-                u32::MAX
-            }
-        })
-        .collect();
-    let mut order: Vec<usize> = (0..n).filter(|&i| level[i] != u32::MAX).collect();
-    order.sort_by(|&a, &b| dist[a].total_cmp(&dist[b]));
-    let top = order.last().map_or(0, |&i| level[i]) as usize;
-    let far = order.last().map_or(0.0, |&i| dist[i]);
-    let min_loop = MIN_LOOP_BANDS.max((MIN_LOOP_SHARE * far / band).ceil() as u32);
-    let mut by_level: Vec<Vec<usize>> = vec![Vec::new(); top + 1];
-    for &i in &order {
-        by_level[level[i] as usize].push(i);
-    }
-
-    let mut branches = vec![Branch {
-        parent: None,
-        born: 0,
-    }];
-    let mut branch = vec![usize::MAX; n];
-    // The branch each point's shortest path arrived through (its lowest-band ancestor's).
-    let mut incoming = vec![usize::MAX; n];
-    let mut component = vec![usize::MAX; n];
-    let mut merges: Vec<(usize, usize)> = Vec::new();
-    let mut stack = Vec::new();
-    for (k, nodes) in by_level.iter().enumerate() {
+    let bands = Bands::new(g, source);
+    let mut sweep = Sweep::new(g.len());
+    for (k, nodes) in bands.by_level.iter().enumerate() {
         let k = k as u32;
-        // Components of this band (edges between its points), each in order of distance.
-        let mut comps: Vec<Vec<usize>> = Vec::new();
-        for &s in nodes {
-            if component[s] != usize::MAX {
-                continue;
-            }
-            let id = comps.len();
-            component[s] = id;
-            let mut members = vec![s];
-            stack.push(s);
-            while let Some(i) = stack.pop() {
-                for (j, _) in g.neighbours(i) {
-                    if level[j] == k && component[j] == usize::MAX {
-                        component[j] = id;
-                        members.push(j);
-                        stack.push(j);
-                    }
-                }
-            }
-            members.sort_by(|&a, &b| dist[a].total_cmp(&dist[b]));
-            comps.push(members);
-        }
-        // Pieces: a component, or the parts of a closing loop, each fed by one branch.
-        let mut pieces: Vec<(usize, Vec<usize>)> = Vec::new();
-        for members in comps {
-            for &v in &members {
-                let p = parent[v];
-                incoming[v] = if p == u32::MAX {
-                    0
-                } else if level[p as usize] < k {
-                    branch[p as usize]
-                } else {
-                    incoming[p as usize]
-                };
-            }
-            let mut feeds: Vec<usize> = members.iter().map(|&v| incoming[v]).collect();
-            feeds.sort_unstable();
-            feeds.dedup();
-            let closing = feeds.len() >= 2
-                && feeds
-                    .iter()
-                    .skip(1)
-                    .any(|&b| k.saturating_sub(parted_at(&branches, feeds[0], b)) >= min_loop);
-            if closing {
-                for (a, &fa) in feeds.iter().enumerate() {
-                    for &fb in &feeds[a + 1..] {
-                        merges.push((fa, fb));
-                    }
-                    pieces.push((
-                        fa,
-                        members
-                            .iter()
-                            .copied()
-                            .filter(|&v| incoming[v] == fa)
-                            .collect(),
-                    ));
-                }
-            } else {
-                // A short loop (the grid's staircase): the piece goes on as its first feeder.
-                pieces.push((feeds[0], members));
-            }
-        }
-        // A branch feeding one piece goes on; feeding several, it splits.
-        for (b, members) in &pieces {
-            let fed = pieces.iter().filter(|(c, _)| c == b).count();
-            let id = if fed == 1 {
-                *b
-            } else {
-                branches.push(Branch {
-                    parent: Some(*b),
-                    born: k,
-                });
-                branches.len() - 1
-            };
-            for &v in members {
-                branch[v] = id;
-            }
-        }
+        let comps = sweep.components(g, &bands, nodes, k);
+        let pieces = sweep.pieces(&bands, comps, k);
+        sweep.grow_branches(&pieces, k);
     }
+    let Sweep {
+        branches,
+        branch,
+        mut merges,
+        ..
+    } = sweep;
     if merges.is_empty() {
         return None;
     }
@@ -215,6 +107,187 @@ pub(super) fn cut_handles(g: &Graph, source: usize) -> Option<(Graph, usize)> {
     let opened = g.without(cut);
     let removed = (g.targets_len() - opened.targets_len()) / 2;
     (removed > 0).then_some((opened, removed))
+}
+
+/// The geodesic distances from the source cut into bands as wide as the graph's longest edge.
+struct Bands {
+    /// Each point's distance from the source.
+    dist: Vec<f32>,
+    /// Each point's predecessor on its shortest path (`u32::MAX` for none).
+    parent: Vec<u32>,
+    /// Each point's band (`u32::MAX` where unreached).
+    level: Vec<u32>,
+    /// The reached points of each band, in order of distance.
+    by_level: Vec<Vec<usize>>,
+    /// Bands a loop must span to be opened ([`MIN_LOOP_BANDS`], [`MIN_LOOP_SHARE`]).
+    min_loop: u32,
+}
+
+impl Bands {
+    /// Runs Dijkstra from `source` and bands its distances.
+    fn new(g: &Graph, source: usize) -> Bands {
+        let n = g.len();
+        let mut dist = vec![0f32; n];
+        let mut parent = vec![u32::MAX; n];
+        dijkstra(
+            g,
+            source,
+            &mut dist,
+            &mut BinaryHeap::new(),
+            Some(&mut parent),
+        );
+        let band = g.longest_edge().max(f32::MIN_POSITIVE);
+        let level: Vec<u32> = dist
+            .iter()
+            .map(|d| {
+                if d.is_finite() {
+                    (d / band) as u32
+                } else {
+                    u32::MAX
+                }
+            })
+            .collect();
+        let mut order: Vec<usize> = (0..n).filter(|&i| level[i] != u32::MAX).collect();
+        order.sort_by(|&a, &b| dist[a].total_cmp(&dist[b]));
+        let top = order.last().map_or(0, |&i| level[i]) as usize;
+        let far = order.last().map_or(0.0, |&i| dist[i]);
+        let min_loop = MIN_LOOP_BANDS.max((MIN_LOOP_SHARE * far / band).ceil() as u32);
+        let mut by_level: Vec<Vec<usize>> = vec![Vec::new(); top + 1];
+        for &i in &order {
+            by_level[level[i] as usize].push(i);
+        }
+        Bands {
+            dist,
+            parent,
+            level,
+            by_level,
+            min_loop,
+        }
+    }
+}
+
+/// The sweep outwards band by band: its branches, each point's branch and the branch its
+/// shortest path arrived through, and the pairs of branches whose loops closed.
+struct Sweep {
+    branches: Vec<Branch>,
+    branch: Vec<usize>,
+    /// The branch each point's shortest path arrived through (its lowest-band ancestor's).
+    incoming: Vec<usize>,
+    component: Vec<usize>,
+    merges: Vec<(usize, usize)>,
+    stack: Vec<usize>,
+}
+
+impl Sweep {
+    /// A sweep over `n` points, one branch at the source.
+    fn new(n: usize) -> Sweep {
+        Sweep {
+            branches: vec![Branch {
+                parent: None,
+                born: 0,
+            }],
+            branch: vec![usize::MAX; n],
+            incoming: vec![usize::MAX; n],
+            component: vec![usize::MAX; n],
+            merges: Vec::new(),
+            stack: Vec::new(),
+        }
+    }
+
+    /// The components of band `k` (its `nodes`, joined by edges between them), each in order
+    /// of distance.
+    fn components(&mut self, g: &Graph, bands: &Bands, nodes: &[usize], k: u32) -> Vec<Vec<usize>> {
+        let mut comps: Vec<Vec<usize>> = Vec::new();
+        for &s in nodes {
+            if self.component[s] != usize::MAX {
+                continue;
+            }
+            let id = comps.len();
+            self.component[s] = id;
+            let mut members = vec![s];
+            self.stack.push(s);
+            while let Some(i) = self.stack.pop() {
+                for (j, _) in g.neighbours(i) {
+                    if bands.level[j] == k && self.component[j] == usize::MAX {
+                        self.component[j] = id;
+                        members.push(j);
+                        self.stack.push(j);
+                    }
+                }
+            }
+            members.sort_by(|&a, &b| bands.dist[a].total_cmp(&bands.dist[b]));
+            comps.push(members);
+        }
+        comps
+    }
+
+    /// Band `k`'s pieces: a component, or the parts of a closing loop, each with the branch
+    /// that feeds it; a closing loop's feeding branches are recorded as merged.
+    fn pieces(
+        &mut self,
+        bands: &Bands,
+        comps: Vec<Vec<usize>>,
+        k: u32,
+    ) -> Vec<(usize, Vec<usize>)> {
+        let mut pieces: Vec<(usize, Vec<usize>)> = Vec::new();
+        for members in comps {
+            for &v in &members {
+                let p = bands.parent[v];
+                self.incoming[v] = if p == u32::MAX {
+                    0
+                } else if bands.level[p as usize] < k {
+                    self.branch[p as usize]
+                } else {
+                    self.incoming[p as usize]
+                };
+            }
+            let mut feeds: Vec<usize> = members.iter().map(|&v| self.incoming[v]).collect();
+            feeds.sort_unstable();
+            feeds.dedup();
+            let closing = feeds.len() >= 2
+                && feeds.iter().skip(1).any(|&b| {
+                    k.saturating_sub(parted_at(&self.branches, feeds[0], b)) >= bands.min_loop
+                });
+            if closing {
+                for (a, &fa) in feeds.iter().enumerate() {
+                    for &fb in &feeds[a + 1..] {
+                        self.merges.push((fa, fb));
+                    }
+                    pieces.push((
+                        fa,
+                        members
+                            .iter()
+                            .copied()
+                            .filter(|&v| self.incoming[v] == fa)
+                            .collect(),
+                    ));
+                }
+            } else {
+                // A short loop (the grid's staircase): the piece goes on as its first feeder.
+                pieces.push((feeds[0], members));
+            }
+        }
+        pieces
+    }
+
+    /// A branch feeding one piece of band `k` goes on; feeding several, it splits.
+    fn grow_branches(&mut self, pieces: &[(usize, Vec<usize>)], k: u32) {
+        for (b, members) in pieces {
+            let fed = pieces.iter().filter(|(c, _)| c == b).count();
+            let id = if fed == 1 {
+                *b
+            } else {
+                self.branches.push(Branch {
+                    parent: Some(*b),
+                    born: k,
+                });
+                self.branches.len() - 1
+            };
+            for &v in members {
+                self.branch[v] = id;
+            }
+        }
+    }
 }
 
 impl Neighbours {

@@ -285,16 +285,31 @@ pub fn embed(points: &[Point3<f64>], params: &IsomapParams) -> Result<Embedding,
     embed_graph(&Neighbours::new(points, params)?, params)
 }
 
-/// Embeds a built neighbourhood graph in three dimensions.
+/// Embeds a built neighbourhood graph in three dimensions: landmarks, classical MDS on them,
+/// then every point placed from its distances to the landmarks (landmark Isomap).
 pub fn embed_graph(nb: &Neighbours, params: &IsomapParams) -> Result<Embedding, IsomapProblem> {
-    let landmarks = params.landmarks.max(4);
     let g = &nb.graph;
     let n = nb.points.len();
-    let kept = nb.kept.clone();
-    let cut_edges = nb.cut_edges;
+    let (chosen, rows) = landmarks(g, n, params.landmarks.max(4));
+    let mds = LandmarkMds::new(&chosen, &rows)?;
+    let mut coords: Vec<Vector3<f64>> = (0..n).map(|a| mds.place(&rows, a)).collect();
+    let mean = coords.iter().sum::<Vector3<f64>>() / n as f64;
+    for c in &mut coords {
+        *c -= mean;
+    }
+    let degree = (0..n).map(|i| g.degree(i)).collect();
+    Ok(Embedding {
+        kept: nb.kept.clone(),
+        coords,
+        degree,
+        cut_edges: nb.cut_edges,
+    })
+}
 
-    // Landmarks by max-min: each new landmark is the point farthest (geodesically) from those
-    // chosen so far, started from the point farthest from point 0.
+/// Up to `count` landmarks by max-min: each new landmark is the point farthest (geodesically)
+/// from those chosen so far, started from the point farthest from point 0. Returns the
+/// landmarks and each one's geodesic distances to every one of the `n` points.
+fn landmarks(g: &Graph, n: usize, count: usize) -> (Vec<usize>, Vec<Vec<f32>>) {
     let mut heap = BinaryHeap::new();
     let mut scratch = vec![0f32; n];
     dijkstra(g, 0, &mut scratch, &mut heap, None);
@@ -305,9 +320,9 @@ pub fn embed_graph(nb: &Neighbours, params: &IsomapParams) -> Result<Embedding, 
             .map_or(0, |(i, _)| i)
     };
     let mut chosen = vec![farthest(&scratch)];
-    let mut rows: Vec<Vec<f32>> = Vec::with_capacity(landmarks);
+    let mut rows: Vec<Vec<f32>> = Vec::with_capacity(count);
     let mut nearest = vec![f32::INFINITY; n];
-    while rows.len() < landmarks {
+    while rows.len() < count {
         let Some(&l) = chosen.last() else { break };
         let mut row = vec![0f32; n];
         dijkstra(g, l, &mut row, &mut heap, None);
@@ -315,63 +330,65 @@ pub fn embed_graph(nb: &Neighbours, params: &IsomapParams) -> Result<Embedding, 
             *m = m.min(*d);
         }
         rows.push(row);
-        if rows.len() < landmarks {
+        if rows.len() < count {
             chosen.push(farthest(&nearest));
         }
     }
+    (chosen, rows)
+}
 
-    // Classical MDS on the landmarks' squared geodesic distances: B = −½ J Δ J.
-    let m = rows.len();
-    let delta = DMatrix::from_fn(m, m, |a, b| {
-        let d = 0.5 * (f64::from(rows[a][chosen[b]]) + f64::from(rows[b][chosen[a]]));
-        d * d
-    });
-    let col_mean: Vec<f64> = (0..m).map(|j| delta.column(j).mean()).collect();
-    let all_mean = col_mean.iter().sum::<f64>() / m as f64;
-    let b = DMatrix::from_fn(m, m, |i, j| {
-        -0.5 * (delta[(i, j)] - col_mean[i] - col_mean[j] + all_mean)
-    });
-    let eig = SymmetricEigen::new(b);
-    let mut order: Vec<usize> = (0..m).collect();
-    order.sort_by(|a, b| eig.eigenvalues[*b].total_cmp(&eig.eigenvalues[*a]));
-    let top = &order[..3];
-    if eig.eigenvalues[top[0]] <= 1e-12 {
-        return Err(IsomapProblem::Degenerate);
+/// Classical MDS on the landmarks: the mean of each landmark's squared distances, and the
+/// pseudo-inverse rows of the top three eigenvectors.
+struct LandmarkMds {
+    col_mean: Vec<f64>,
+    pinv: Vec<Vec<f64>>,
+}
+
+impl LandmarkMds {
+    /// MDS on the landmarks' squared geodesic distances: B = −½ J Δ J. Pseudo-inverse rows
+    /// L#_k = v_kᵀ / √λ_k; a direction without spread (λ ≈ 0: a flat or thin volume) gets
+    /// coordinate 0.
+    fn new(chosen: &[usize], rows: &[Vec<f32>]) -> Result<LandmarkMds, IsomapProblem> {
+        let m = rows.len();
+        let delta = DMatrix::from_fn(m, m, |a, b| {
+            let d = 0.5 * (f64::from(rows[a][chosen[b]]) + f64::from(rows[b][chosen[a]]));
+            d * d
+        });
+        let col_mean: Vec<f64> = (0..m).map(|j| delta.column(j).mean()).collect();
+        let all_mean = col_mean.iter().sum::<f64>() / m as f64;
+        let b = DMatrix::from_fn(m, m, |i, j| {
+            -0.5 * (delta[(i, j)] - col_mean[i] - col_mean[j] + all_mean)
+        });
+        let eig = SymmetricEigen::new(b);
+        let mut order: Vec<usize> = (0..m).collect();
+        order.sort_by(|a, b| eig.eigenvalues[*b].total_cmp(&eig.eigenvalues[*a]));
+        let top = &order[..3];
+        if eig.eigenvalues[top[0]] <= 1e-12 {
+            return Err(IsomapProblem::Degenerate);
+        }
+        let pinv = top
+            .iter()
+            .map(|&k| {
+                let l = eig.eigenvalues[k];
+                let s = if l > 1e-12 { 1.0 / l.sqrt() } else { 0.0 };
+                eig.eigenvectors.column(k).iter().map(|v| v * s).collect()
+            })
+            .collect();
+        Ok(LandmarkMds { col_mean, pinv })
     }
-    // Pseudo-inverse rows L#_k = v_kᵀ / √λ_k; each point: y = −½ L# (δ − δ_μ). A direction
-    // without spread (λ ≈ 0: a flat or thin volume) gets coordinate 0.
-    let pinv: Vec<Vec<f64>> = top
-        .iter()
-        .map(|&k| {
-            let l = eig.eigenvalues[k];
-            let s = if l > 1e-12 { 1.0 / l.sqrt() } else { 0.0 };
-            eig.eigenvectors.column(k).iter().map(|v| v * s).collect()
-        })
-        .collect();
-    let mut coords: Vec<Vector3<f64>> = (0..n)
-        .map(|a| {
-            let mut y = Vector3::zeros();
-            for (j, row) in rows.iter().enumerate() {
-                let d = f64::from(row[a]);
-                let centred = d * d - col_mean[j];
-                for k in 0..3 {
-                    y[k] += pinv[k][j] * centred;
-                }
+
+    /// Point `a` from its distances to the landmarks (`rows`): y = −½ L# (δ − δ_μ).
+    fn place(&self, rows: &[Vec<f32>], a: usize) -> Vector3<f64> {
+        let mut y = Vector3::zeros();
+        for (j, row) in rows.iter().enumerate() {
+            let d = f64::from(row[a]);
+            let centred = d * d - self.col_mean[j];
+            for k in 0..3 {
+                y[k] += self.pinv[k][j] * centred;
             }
-            -0.5 * y
-        })
-        .collect();
-    let mean = coords.iter().sum::<Vector3<f64>>() / n as f64;
-    for c in &mut coords {
-        *c -= mean;
+        }
+        -0.5 * y
     }
-    let degree = (0..n).map(|i| g.degree(i)).collect();
-    Ok(Embedding {
-        kept,
-        coords,
-        degree,
-        cut_edges,
-    })
 }
 
 #[cfg(test)]

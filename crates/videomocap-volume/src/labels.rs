@@ -98,100 +98,181 @@ fn median_at_least(mut v: Vec<f64>, floor: f64) -> f64 {
 /// legs in a stride, keep their labels); the path's first step, with no velocity yet, by how
 /// far they moved.
 pub fn label(frames: &[Option<&FrameResult>], cue: &dyn Fn(usize, &[usize; 4]) -> f64) -> Labels {
-    let posed: Vec<usize> = (0..frames.len()).filter(|&i| frames[i].is_some()).collect();
-    let n = posed.len();
-    // Points per posed frame per labelling.
-    let points: Vec<[Vec<Option<Point3<f64>>>; 4]> = posed
-        .iter()
-        .filter_map(|&i| frames[i])
-        .map(|f| LABELLINGS.map(|l| labelled_points(f, &l)))
+    let prices = StepPrices::new(frames, cue);
+    let n = prices.posed.len();
+    let (cost, from) = prices.cheapest_paths();
+    let path = trace_back(&cost, &from, n);
+    let mut order = vec![None; frames.len()];
+    let mut on_path = vec![false; n];
+    for (m, l) in path {
+        on_path[m] = true;
+        if let Some(f) = frames[prices.posed[m]] {
+            order[prices.posed[m]] =
+                Some(LABELLINGS[l].map(|k| f.fit.limbs[k].is_some().then_some(k)));
+        }
+    }
+    let left_out = (0..n)
+        .filter(|&m| !on_path[m])
+        .map(|m| prices.posed[m])
         .collect();
-    let gap = |a: usize, b: usize| (posed[b] - posed[a]) as f64;
-    let cues: Vec<[f64; 4]> = posed
-        .iter()
-        .map(|&i| LABELLINGS.map(|l| cue(i, &l)))
-        .collect();
-    // Squared distances per frame of gap, in units of `scale2`.
-    let moved = |a: usize, la: usize, m: usize, lb: usize, scale2: f64| {
-        let g2 = gap(a, m) * gap(a, m);
-        mean_squared(&points[a][la], &points[m][lb], scale2 * g2)
-    };
-    let residual = |p: usize, lp: usize, a: usize, la: usize, m: usize, lb: usize, scale2: f64| {
-        let pred = predicted(&points[p][lp], &points[a][la], gap(p, a), gap(a, m));
-        mean_squared(&pred, &points[m][lb], scale2 * gap(a, m).max(1.0).powi(2))
-    };
-    // The clip's typical motion per frame and typical departure from constant velocity: medians
-    // over neighbouring posed frames of the least under any relabelling (squared metres).
-    let floor = MIN_MOTION_M * MIN_MOTION_M;
-    let sigma_moved = median_at_least(
-        (1..n)
-            .map(|m| {
-                (0..4)
-                    .map(|lb| moved(m - 1, 0, m, lb, 1.0))
-                    .fold(f64::INFINITY, f64::min)
-            })
-            .collect(),
-        floor,
-    );
-    let sigma_residual = median_at_least(
-        (2..n)
-            .map(|m| {
-                let mut best = f64::INFINITY;
-                for la in 0..4 {
-                    for lb in 0..4 {
-                        best = best.min(residual(m - 2, 0, m - 1, la, m, lb, 1.0));
-                    }
-                }
-                best
-            })
-            .collect(),
-        floor,
-    );
-    // cost[m][lb][back - 1][la]: the cheapest path whose last step goes from posed frame
-    // a = m − back with labelling la to m with labelling lb; from[…]: the step before it.
-    type Step = [[f64; 4]; REACH];
-    type Back = [[Option<(usize, usize)>; 4]; REACH];
-    let mut cost: Vec<[Step; 4]> = vec![[[[f64::INFINITY; 4]; REACH]; 4]; n];
-    let mut from: Vec<[Back; 4]> = vec![[[[None; 4]; REACH]; 4]; n];
-    for m in 0..n {
-        for lb in 0..4 {
-            for back in 1..=REACH.min(m) {
-                let a = m - back;
-                let over = SKIP_COST * (back - 1) as f64;
-                for la in 0..4 {
-                    // The path starts at a (stepping over every frame before it) …
-                    let mut best = (
-                        SKIP_COST * a as f64
-                            + cues[a][la]
-                            + moved(a, la, m, lb, sigma_moved)
-                            + over
-                            + cues[m][lb],
-                        None,
-                    );
-                    // … or comes to a from p.
-                    for back2 in 1..=REACH.min(a) {
-                        let p = a - back2;
-                        for (lp, &before) in cost[a][la][back2 - 1].iter().enumerate() {
-                            if !before.is_finite() {
-                                continue;
-                            }
-                            let c = before
-                                + residual(p, lp, a, la, m, lb, sigma_residual)
-                                + over
-                                + cues[m][lb];
-                            if c < best.0 {
-                                best = (c, Some((back2, lp)));
-                            }
+    Labels { order, left_out }
+}
+
+/// Per posed frame and labelling, the cheapest path whose last step comes from `back` posed
+/// frames before with a given labelling: `cost[m][lb][back - 1][la]`.
+type Costs = Vec<[[[f64; 4]; REACH]; 4]>;
+/// Per entry of [`Costs`], the step before the last (how far back, which labelling); `None`
+/// where the path starts at the last step's first frame.
+type Froms = Vec<[[[Option<(usize, usize)>; 4]; REACH]; 4]>;
+
+/// What a path's steps are priced from: the posed frames, their points and cues per
+/// labelling, and the clip's typical motion and departure from constant velocity.
+struct StepPrices {
+    /// The frames with a pose.
+    posed: Vec<usize>,
+    /// Points per posed frame per labelling.
+    points: Vec<[Vec<Option<Point3<f64>>>; 4]>,
+    /// The caller's left/right cue per posed frame per labelling.
+    cues: Vec<[f64; 4]>,
+    sigma_moved: f64,
+    sigma_residual: f64,
+}
+
+impl StepPrices {
+    /// Reads the posed frames; the clip's typical motion per frame and typical departure from
+    /// constant velocity are medians over neighbouring posed frames of the least under any
+    /// relabelling (squared metres).
+    fn new(frames: &[Option<&FrameResult>], cue: &dyn Fn(usize, &[usize; 4]) -> f64) -> Self {
+        let posed: Vec<usize> = (0..frames.len()).filter(|&i| frames[i].is_some()).collect();
+        let points = posed
+            .iter()
+            .filter_map(|&i| frames[i])
+            .map(|f| LABELLINGS.map(|l| labelled_points(f, &l)))
+            .collect();
+        let cues = posed
+            .iter()
+            .map(|&i| LABELLINGS.map(|l| cue(i, &l)))
+            .collect();
+        let mut prices = StepPrices {
+            posed,
+            points,
+            cues,
+            sigma_moved: 1.0,
+            sigma_residual: 1.0,
+        };
+        let n = prices.posed.len();
+        let floor = MIN_MOTION_M * MIN_MOTION_M;
+        prices.sigma_moved = median_at_least(
+            (1..n)
+                .map(|m| {
+                    (0..4)
+                        .map(|lb| prices.moved(m - 1, 0, m, lb, 1.0))
+                        .fold(f64::INFINITY, f64::min)
+                })
+                .collect(),
+            floor,
+        );
+        prices.sigma_residual = median_at_least(
+            (2..n)
+                .map(|m| {
+                    let mut best = f64::INFINITY;
+                    for la in 0..4 {
+                        for lb in 0..4 {
+                            best = best.min(prices.residual((m - 2, 0), (m - 1, la), (m, lb), 1.0));
                         }
                     }
-                    cost[m][lb][back - 1][la] = best.0;
-                    from[m][lb][back - 1][la] = best.1;
+                    best
+                })
+                .collect(),
+            floor,
+        );
+        prices
+    }
+
+    /// Frames between posed frames `a` and `b`.
+    fn gap(&self, a: usize, b: usize) -> f64 {
+        (self.posed[b] - self.posed[a]) as f64
+    }
+
+    /// How far posed frame `m`'s points (labelling `lb`) lie from `a`'s (labelling `la`):
+    /// squared distances per frame of gap, in units of `scale2`.
+    fn moved(&self, a: usize, la: usize, m: usize, lb: usize, scale2: f64) -> f64 {
+        let g2 = self.gap(a, m) * self.gap(a, m);
+        mean_squared(&self.points[a][la], &self.points[m][lb], scale2 * g2)
+    }
+
+    /// How far `m`'s points lie from where `a`'s go at their velocity from `p` (each a posed
+    /// frame with its labelling), in units of `scale2`.
+    fn residual(
+        &self,
+        (p, lp): (usize, usize),
+        (a, la): (usize, usize),
+        (m, lb): (usize, usize),
+        scale2: f64,
+    ) -> f64 {
+        let pred = predicted(
+            &self.points[p][lp],
+            &self.points[a][la],
+            self.gap(p, a),
+            self.gap(a, m),
+        );
+        mean_squared(
+            &pred,
+            &self.points[m][lb],
+            scale2 * self.gap(a, m).max(1.0).powi(2),
+        )
+    }
+
+    /// The dynamic programme: per posed frame m, labelling lb and step back, the cheapest path
+    /// ending there ([`Costs`]) and its step before ([`Froms`]).
+    fn cheapest_paths(&self) -> (Costs, Froms) {
+        let n = self.posed.len();
+        let mut cost: Costs = vec![[[[f64::INFINITY; 4]; REACH]; 4]; n];
+        let mut from: Froms = vec![[[[None; 4]; REACH]; 4]; n];
+        for m in 0..n {
+            for lb in 0..4 {
+                for back in 1..=REACH.min(m) {
+                    let a = m - back;
+                    let over = SKIP_COST * (back - 1) as f64;
+                    for la in 0..4 {
+                        // The path starts at a (stepping over every frame before it) …
+                        let mut best = (
+                            SKIP_COST * a as f64
+                                + self.cues[a][la]
+                                + self.moved(a, la, m, lb, self.sigma_moved)
+                                + over
+                                + self.cues[m][lb],
+                            None,
+                        );
+                        // … or comes to a from p.
+                        for back2 in 1..=REACH.min(a) {
+                            let p = a - back2;
+                            for (lp, &before) in cost[a][la][back2 - 1].iter().enumerate() {
+                                if !before.is_finite() {
+                                    continue;
+                                }
+                                let c = before
+                                    + self.residual((p, lp), (a, la), (m, lb), self.sigma_residual)
+                                    + over
+                                    + self.cues[m][lb];
+                                if c < best.0 {
+                                    best = (c, Some((back2, lp)));
+                                }
+                            }
+                        }
+                        cost[m][lb][back - 1][la] = best.0;
+                        from[m][lb][back - 1][la] = best.1;
+                    }
                 }
             }
         }
+        (cost, from)
     }
-    // The cheapest end (stepping over every frame after it); a path of one frame steps over
-    // all the others.
+}
+
+/// The cheapest path's (posed frame, labelling) pairs, last first: its cheapest end (stepping
+/// over every frame after it; a path of one frame steps over all the others), followed back.
+fn trace_back(cost: &Costs, from: &Froms, n: usize) -> Vec<(usize, usize)> {
     let mut best = (SKIP_COST * n.saturating_sub(1) as f64, None);
     for (m, by_label) in cost.iter().enumerate() {
         for (lb, by_back) in by_label.iter().enumerate() {
@@ -226,14 +307,5 @@ pub fn label(frames: &[Option<&FrameResult>], cue: &dyn Fn(usize, &[usize; 4]) -
         }
         None => {}
     }
-    let mut order = vec![None; frames.len()];
-    let mut on_path = vec![false; n];
-    for (m, l) in path {
-        on_path[m] = true;
-        if let Some(f) = frames[posed[m]] {
-            order[posed[m]] = Some(LABELLINGS[l].map(|k| f.fit.limbs[k].is_some().then_some(k)));
-        }
-    }
-    let left_out = (0..n).filter(|&m| !on_path[m]).map(|m| posed[m]).collect();
-    Labels { order, left_out }
+    path
 }

@@ -73,9 +73,10 @@ impl Sets {
     }
 }
 
-/// Builds the shell tree of embedded points (centred at the origin).
+/// Builds the shell tree of embedded points (centred at the origin): each point's shell,
+/// the shells' clusters, the clusters as nodes linked across neighbouring shells, and the tree
+/// grown from the root.
 pub fn build(coords: &[Vector3<f64>], params: &ShellParams) -> ShellTree {
-    let n = coords.len();
     let shells = params.shells.max(2);
     let radius: Vec<f64> = coords.iter().map(|c| c.norm()).collect();
     let r_max = radius.iter().copied().fold(0.0, f64::max).max(1e-12);
@@ -92,106 +93,144 @@ pub fn build(coords: &[Vector3<f64>], params: &ShellParams) -> ShellTree {
         hi = hi.sup(c);
     }
     let threshold = ((hi - lo).norm() * params.cluster_fraction).max(1e-12);
+    let grouping = Grouping::new(coords, &shell_of, threshold);
+    let (mut sets, cross) = grouping.join(threshold);
+    let (mut nodes, links) = grouping.nodes(&mut sets, cross);
+    let (root, unreached) = grow_tree(&mut nodes, &links, coords.len());
+    ShellTree {
+        nodes,
+        root,
+        shell_width: r_max / shells as f64,
+        threshold,
+        unreached,
+    }
+}
 
-    // Bounding-box clustering (Cohen et al.'s boxes): the points of one shell inside one grid
-    // cell of side `threshold` are all within the threshold of each other and form a group with
-    // its bounding box; groups of the same shell in neighbouring cells join one cluster when
-    // their boxes are no farther apart than the threshold (Chebyshev gap). Groups of
-    // neighbouring shells that close link their clusters. Working on boxes instead of point
-    // pairs keeps this linear in the number of points.
-    let cell = |c: &Vector3<f64>| {
-        [
-            (c.x / threshold).floor() as i64,
-            (c.y / threshold).floor() as i64,
-            (c.z / threshold).floor() as i64,
-        ]
-    };
-    struct Group {
-        key: [i64; 3],
-        shell: usize,
-        lo: Vector3<f64>,
-        hi: Vector3<f64>,
-        members: Vec<usize>,
-    }
-    let mut group_of: HashMap<([i64; 3], usize), usize> = HashMap::new();
-    let mut groups: Vec<Group> = Vec::new();
-    for (i, c) in coords.iter().enumerate() {
-        let key = cell(c);
-        let g = *group_of.entry((key, shell_of[i])).or_insert_with(|| {
-            groups.push(Group {
-                key,
-                shell: shell_of[i],
-                lo: *c,
-                hi: *c,
-                members: Vec::new(),
+/// The points of one shell inside one grid cell of side `threshold`: all within the threshold
+/// of each other, with their bounding box.
+struct Group {
+    key: [i64; 3],
+    shell: usize,
+    lo: Vector3<f64>,
+    hi: Vector3<f64>,
+    members: Vec<usize>,
+}
+
+/// Bounding-box clustering (Cohen et al.'s boxes): the points grouped by shell and grid cell;
+/// groups of the same shell in neighbouring cells join one cluster when their boxes are no
+/// farther apart than the threshold (Chebyshev gap), and groups of neighbouring shells that
+/// close link their clusters. Working on boxes instead of point pairs keeps this linear in the
+/// number of points.
+struct Grouping {
+    groups: Vec<Group>,
+    /// Each (cell, shell)'s group.
+    group_of: HashMap<([i64; 3], usize), usize>,
+}
+
+impl Grouping {
+    /// Groups the points by their shell (`shell_of`) and their cell of side `threshold`.
+    fn new(coords: &[Vector3<f64>], shell_of: &[usize], threshold: f64) -> Grouping {
+        let cell = |c: &Vector3<f64>| {
+            [
+                (c.x / threshold).floor() as i64,
+                (c.y / threshold).floor() as i64,
+                (c.z / threshold).floor() as i64,
+            ]
+        };
+        let mut group_of: HashMap<([i64; 3], usize), usize> = HashMap::new();
+        let mut groups: Vec<Group> = Vec::new();
+        for (i, c) in coords.iter().enumerate() {
+            let key = cell(c);
+            let g = *group_of.entry((key, shell_of[i])).or_insert_with(|| {
+                groups.push(Group {
+                    key,
+                    shell: shell_of[i],
+                    lo: *c,
+                    hi: *c,
+                    members: Vec::new(),
+                });
+                groups.len() - 1
             });
-            groups.len() - 1
-        });
-        let gr = &mut groups[g];
-        gr.lo = gr.lo.inf(c);
-        gr.hi = gr.hi.sup(c);
-        gr.members.push(i);
+            let gr = &mut groups[g];
+            gr.lo = gr.lo.inf(c);
+            gr.hi = gr.hi.sup(c);
+            gr.members.push(i);
+        }
+        Grouping { groups, group_of }
     }
-    let gap = |a: &Group, b: &Group| {
-        (0..3)
-            .map(|k| (b.lo[k] - a.hi[k]).max(a.lo[k] - b.hi[k]).max(0.0))
-            .fold(0.0, f64::max)
-    };
-    let mut sets = Sets((0..groups.len() as u32).collect());
-    let mut cross: Vec<(usize, usize)> = Vec::new();
-    for (a, ga) in groups.iter().enumerate() {
-        for dz in -1..=1 {
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    let key = [ga.key[0] + dx, ga.key[1] + dy, ga.key[2] + dz];
-                    for shell in ga.shell.saturating_sub(1)..=ga.shell + 1 {
-                        let Some(&b) = group_of.get(&(key, shell)) else {
-                            continue;
-                        };
-                        if b <= a || gap(ga, &groups[b]) > threshold {
-                            continue;
-                        }
-                        if shell == ga.shell {
-                            sets.union(a, b);
-                        } else {
-                            cross.push((a, b));
+
+    /// Joins the groups of one shell within `threshold` of each other into clusters, and
+    /// lists the pairs of groups of neighbouring shells that close.
+    fn join(&self, threshold: f64) -> (Sets, Vec<(usize, usize)>) {
+        let gap = |a: &Group, b: &Group| {
+            (0..3)
+                .map(|k| (b.lo[k] - a.hi[k]).max(a.lo[k] - b.hi[k]).max(0.0))
+                .fold(0.0, f64::max)
+        };
+        let mut sets = Sets((0..self.groups.len() as u32).collect());
+        let mut cross: Vec<(usize, usize)> = Vec::new();
+        for (a, ga) in self.groups.iter().enumerate() {
+            for dz in -1..=1 {
+                for dy in -1..=1 {
+                    for dx in -1..=1 {
+                        let key = [ga.key[0] + dx, ga.key[1] + dy, ga.key[2] + dz];
+                        for shell in ga.shell.saturating_sub(1)..=ga.shell + 1 {
+                            let Some(&b) = self.group_of.get(&(key, shell)) else {
+                                continue;
+                            };
+                            if b <= a || gap(ga, &self.groups[b]) > threshold {
+                                continue;
+                            }
+                            if shell == ga.shell {
+                                sets.union(a, b);
+                            } else {
+                                cross.push((a, b));
+                            }
                         }
                     }
                 }
             }
         }
+        (sets, cross)
     }
 
-    // Clusters → nodes.
-    let mut node_of_root: HashMap<usize, usize> = HashMap::new();
-    let mut nodes: Vec<Node> = Vec::new();
-    let mut node_of_group = vec![0usize; groups.len()];
-    for (g, group) in groups.iter().enumerate() {
-        let r = sets.find(g);
-        let id = *node_of_root.entry(r).or_insert_with(|| {
-            nodes.push(Node {
-                members: Vec::new(),
-                shell: group.shell,
-                parent: None,
-                children: Vec::new(),
-                alive: false,
+    /// The clusters as nodes (none alive yet), and each node's links to overlapping clusters
+    /// of neighbouring shells (Fig. 4), from the groups' pairs `cross`.
+    fn nodes(&self, sets: &mut Sets, cross: Vec<(usize, usize)>) -> (Vec<Node>, Vec<Vec<usize>>) {
+        let mut node_of_root: HashMap<usize, usize> = HashMap::new();
+        let mut nodes: Vec<Node> = Vec::new();
+        let mut node_of_group = vec![0usize; self.groups.len()];
+        for (g, group) in self.groups.iter().enumerate() {
+            let r = sets.find(g);
+            let id = *node_of_root.entry(r).or_insert_with(|| {
+                nodes.push(Node {
+                    members: Vec::new(),
+                    shell: group.shell,
+                    parent: None,
+                    children: Vec::new(),
+                    alive: false,
+                });
+                nodes.len() - 1
             });
-            nodes.len() - 1
-        });
-        nodes[id].members.extend_from_slice(&group.members);
-        node_of_group[g] = id;
-    }
-    // Links between overlapping clusters of neighbouring shells (Fig. 4).
-    let mut links: Vec<Vec<usize>> = vec![Vec::new(); nodes.len()];
-    for (a, b) in cross {
-        let (na, nb) = (node_of_group[a], node_of_group[b]);
-        if na != nb && !links[na].contains(&nb) {
-            links[na].push(nb);
-            links[nb].push(na);
+            nodes[id].members.extend_from_slice(&group.members);
+            node_of_group[g] = id;
         }
+        let mut links: Vec<Vec<usize>> = vec![Vec::new(); nodes.len()];
+        for (a, b) in cross {
+            let (na, nb) = (node_of_group[a], node_of_group[b]);
+            if na != nb && !links[na].contains(&nb) {
+                links[na].push(nb);
+                links[nb].push(na);
+            }
+        }
+        (nodes, links)
     }
-    // Root: the largest cluster of the innermost non-empty shell; the tree by breadth-first
-    // search from it (a cluster reached twice keeps its first parent).
+}
+
+/// The tree by breadth-first search over `links` from the root, the largest cluster of the
+/// innermost non-empty shell (a cluster reached twice keeps its first parent): (the root, how
+/// many of the `n` points no reached cluster holds).
+fn grow_tree(nodes: &mut [Node], links: &[Vec<usize>], n: usize) -> (usize, usize) {
     let inner = nodes.iter().map(|c| c.shell).min().unwrap_or(0);
     let root = (0..nodes.len())
         .filter(|&k| nodes[k].shell == inner)
@@ -215,13 +254,7 @@ pub fn build(coords: &[Vector3<f64>], params: &ShellParams) -> ShellTree {
             }
         }
     }
-    ShellTree {
-        nodes,
-        root,
-        shell_width: r_max / shells as f64,
-        threshold,
-        unreached,
-    }
+    (root, unreached)
 }
 
 #[cfg(test)]
