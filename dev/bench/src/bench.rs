@@ -48,46 +48,10 @@ pub(crate) fn run(what: &str, a: &BenchArgs, global: &GlobalArgs) -> Result<(), 
     let dir = tempfile::tempdir().map_err(ExitError::failed)?;
     let mut rows: Vec<[String; 4]> = Vec::new();
     if matches!(what, "all" | "decode") {
-        for (w, h) in [(640, 480), (1920, 1080)] {
-            let file = dir.path().join(format!("bench_{w}x{h}.mp4"));
-            say(
-                global,
-                &format!("making a {w}×{h} H.264 clip of {} frames …", a.frames),
-            );
-            make_clip(&file, w, h, a.frames, ClipKind::Noisy, 250).map_err(ExitError::failed)?;
-            let ours = our_decode_fps(&file).map_err(ExitError::failed)?;
-            let theirs = ffmpeg_decode_fps(&file, a.frames).map_err(ExitError::failed)?;
-            rows.push([
-                format!("decode {w}×{h} to RGB"),
-                format!("{ours:.0} frames/s"),
-                format!("{theirs:.0} frames/s"),
-                format!("{:.2}", ours / theirs),
-            ]);
-        }
+        rows.extend(decode_rows(dir.path(), a.frames, global)?);
     }
     if matches!(what, "all" | "synth") {
-        let params = SynthParams {
-            frames: 100,
-            output: VideoOutput::Mp4,
-            ..SynthParams::default()
-        };
-        let out = dir.path().join("synth");
-        let t0 = Instant::now();
-        let r = render_clip(&params, &out, &mut |_, _| {}, &AtomicBool::new(false))
-            .map_err(ExitError::failed)?;
-        let total = t0.elapsed().as_secs_f64();
-        rows.push([
-            "synth render 640×480 (per frame)".into(),
-            format!("{:.1} ms", r.render_s_per_frame * 1e3),
-            "-".into(),
-            "-".into(),
-        ]);
-        rows.push([
-            "synth 100 frames 640×480 incl. MP4".into(),
-            format!("{total:.2} s"),
-            "-".into(),
-            "-".into(),
-        ]);
+        rows.extend(synth_rows(dir.path())?);
     }
     if rows.is_empty() {
         return Err(ExitError::bad_input(anyhow!(
@@ -111,6 +75,61 @@ pub(crate) fn run(what: &str, a: &BenchArgs, global: &GlobalArgs) -> Result<(), 
         }
     }
     Ok(())
+}
+
+/// Decoding speed at 640×480 and 1920×1080 (clips of `frames` made in `dir`), ours against
+/// `ffmpeg -benchmark`: a row each (measure, ours, FFmpeg's, ratio).
+fn decode_rows(
+    dir: &Path,
+    frames: usize,
+    global: &GlobalArgs,
+) -> Result<Vec<[String; 4]>, ExitError> {
+    let mut rows = Vec::new();
+    for (w, h) in [(640, 480), (1920, 1080)] {
+        let file = dir.join(format!("bench_{w}x{h}.mp4"));
+        say(
+            global,
+            &format!("making a {w}×{h} H.264 clip of {frames} frames …"),
+        );
+        make_clip(&file, w, h, frames, ClipKind::Noisy, 250).map_err(ExitError::failed)?;
+        let ours = our_decode_fps(&file).map_err(ExitError::failed)?;
+        let theirs = ffmpeg_decode_fps(&file, frames).map_err(ExitError::failed)?;
+        rows.push([
+            format!("decode {w}×{h} to RGB"),
+            format!("{ours:.0} frames/s"),
+            format!("{theirs:.0} frames/s"),
+            format!("{:.2}", ours / theirs),
+        ]);
+    }
+    Ok(rows)
+}
+
+/// The test kit's render time: per frame, and 100 frames at 640×480 with the MP4 (in `dir`).
+fn synth_rows(dir: &Path) -> Result<Vec<[String; 4]>, ExitError> {
+    let params = SynthParams {
+        frames: 100,
+        output: VideoOutput::Mp4,
+        ..SynthParams::default()
+    };
+    let out = dir.join("synth");
+    let t0 = Instant::now();
+    let r = render_clip(&params, &out, &mut |_, _| {}, &AtomicBool::new(false))
+        .map_err(ExitError::failed)?;
+    let total = t0.elapsed().as_secs_f64();
+    Ok(vec![
+        [
+            "synth render 640×480 (per frame)".into(),
+            format!("{:.1} ms", r.render_s_per_frame * 1e3),
+            "-".into(),
+            "-".into(),
+        ],
+        [
+            "synth 100 frames 640×480 incl. MP4".into(),
+            format!("{total:.2} s"),
+            "-".into(),
+            "-".into(),
+        ],
+    ])
 }
 
 /// How a benchmark clip is encoded.

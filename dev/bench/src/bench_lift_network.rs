@@ -358,6 +358,37 @@ fn view_lines(views: &BTreeMap<(Split, &'static str), Scores>, names: &[String])
     out
 }
 
+/// The score tables, per input and per part (`names`), and the doubt's tables per input.
+fn score_tables(tally: &Tally<Scores>, names: &[String]) -> Vec<String> {
+    let mut out = vec![
+        "lift alone / network alone / together (the network's 3D body as depth evidence), stated height, true focal: per column MPJPE, PA-MPJPE (mm), frames mirrored, bones in the reference's depth order (where its ends differ by > 5 cm)".to_owned(),
+    ];
+    for (i, input) in INPUT_NAMES.iter().enumerate() {
+        for (c, name) in names.iter().enumerate() {
+            out.push(String::new());
+            out.push(format!("{input}: {name}"));
+            let columns = format!("{:>6} {:>5} {:>5} {:>4}", "mm", "PA", "mirr", "ord");
+            out.extend(Tally::<Scores>::heading(21, &columns));
+            out.extend(tally.lines(21, |s: &Scores| cell(s.0[i].get(c))));
+        }
+    }
+    out.push(String::new());
+    out.push(format!(
+        "together: frames with a bone flagged too long; how often a flagged bone's depth choice is wrong against an unflagged one's; per margin, the share shown unsure and how often an unsure / a sure choice is wrong (the product's margin is {})",
+        videomocap_core::lift::UNSURE_MARGIN
+    ));
+    let doubt_columns = crate::bench_lift::doubt_columns();
+    let doubt_width = doubt_columns.chars().count();
+    for (i, input) in INPUT_NAMES.iter().enumerate() {
+        out.push((*input).to_owned());
+        out.extend(Tally::<Scores>::heading(doubt_width, &doubt_columns));
+        out.extend(tally.lines(doubt_width, |s: &Scores| {
+            crate::bench_lift::doubt_cell(&s.1[i])
+        }));
+    }
+    out
+}
+
 /// Runs the comparison and prints its tables.
 pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs, weights: &[f64]) -> Result<(), ExitError> {
     let threads = crate::bench_suite::machine_threads();
@@ -398,32 +429,7 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs, weights: &[f64]) -> Result
             .or_default()
             .merge_from(&s);
     }
-    let mut out = vec![
-        "lift alone / network alone / together (the network's 3D body as depth evidence), stated height, true focal: per column MPJPE, PA-MPJPE (mm), frames mirrored, bones in the reference's depth order (where its ends differ by > 5 cm)".to_owned(),
-    ];
-    for (i, input) in INPUT_NAMES.iter().enumerate() {
-        for (c, name) in names.iter().enumerate() {
-            out.push(String::new());
-            out.push(format!("{input}: {name}"));
-            let columns = format!("{:>6} {:>5} {:>5} {:>4}", "mm", "PA", "mirr", "ord");
-            out.extend(Tally::<Scores>::heading(21, &columns));
-            out.extend(tally.lines(21, |s: &Scores| cell(s.0[i].get(c))));
-        }
-    }
-    out.push(String::new());
-    out.push(format!(
-        "together: frames with a bone flagged too long; how often a flagged bone's depth choice is wrong against an unflagged one's; per margin, the share shown unsure and how often an unsure / a sure choice is wrong (the product's margin is {})",
-        videomocap_core::lift::UNSURE_MARGIN
-    ));
-    let doubt_columns = crate::bench_lift::doubt_columns();
-    let doubt_width = doubt_columns.chars().count();
-    for (i, input) in INPUT_NAMES.iter().enumerate() {
-        out.push((*input).to_owned());
-        out.extend(Tally::<Scores>::heading(doubt_width, &doubt_columns));
-        out.extend(tally.lines(doubt_width, |s: &Scores| {
-            crate::bench_lift::doubt_cell(&s.1[i])
-        }));
-    }
+    let mut out = score_tables(&tally, &names);
     out.extend(view_lines(&views, &names));
     out.push(String::new());
     out.push(format!(

@@ -13,8 +13,92 @@ use videomocap_core::formats::Marks;
 use videomocap_core::track::{TrackJob, TrackerParams, track_video};
 use videomocap_core::video::{OpenOptions, Video, VideoError};
 
+/// What scrubbing the long clip measured: opening it, 40 random seeks (sorted, ms), stepping
+/// through and revisiting up to 120 frames (frames/s), and the peak memory after.
+struct Scrubbing {
+    info: videomocap_core::video::VideoInfo,
+    open_s: f64,
+    targets: Vec<usize>,
+    seeks: Vec<f64>,
+    step_fps: f64,
+    cached_fps: f64,
+    rss_scrub: f64,
+}
+
+/// Runs the scrubbing benchmark on a long 1080p clip (made once) and prints its table.
 pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     crate::bench::note_debug_build(global);
+    let file = long_clip(a, global)?;
+    let rss_before = peak_rss_mib();
+    let scrubbing = scrub(&file)?;
+    let proxy_rows = proxy_rows(&file, &scrubbing.info, &scrubbing.targets, global)?;
+    let rss_proxy = peak_rss_mib();
+    let (track_label, track_fps) = track_span(&file, scrubbing.info.frame_count)?;
+    let s = &scrubbing;
+    let n = s.info.frame_count;
+    let pct = |q: f64| s.seeks[((s.seeks.len() - 1) as f64 * q).round() as usize];
+    let mut rows: Vec<(String, String)> = Vec::new();
+    let head = [
+        (
+            "clip",
+            format!(
+                "1920×1080, {n} frames ({:.1} min), keyframe every {} frames",
+                n as f64 / 30.0 / 60.0,
+                a.gop
+            ),
+        ),
+        ("open (reads the frame index)", format!("{:.2} s", s.open_s)),
+        ("random seek, median", format!("{:.0} ms", pct(0.5))),
+        (
+            "random seek, 95th percentile",
+            format!("{:.0} ms", pct(0.95)),
+        ),
+        ("random seek, worst of 40", format!("{:.0} ms", pct(1.0))),
+        (
+            "random seeks within 150 ms",
+            format!("{} of 40", s.seeks.iter().filter(|&&v| v <= 150.0).count()),
+        ),
+    ];
+    rows.extend(head.map(|(k, v)| (k.to_owned(), v)));
+    rows.extend(proxy_rows);
+    let tail = [
+        (
+            "step forward one frame at a time",
+            format!("{:.0} frames/s", s.step_fps),
+        ),
+        (
+            "revisit cached frames incl. RGBA copy",
+            format!("{:.0} frames/s", s.cached_fps),
+        ),
+        (track_label.as_str(), format!("{track_fps:.0} frames/s")),
+        (
+            "peak memory (VmHWM) before open",
+            format!("{rss_before:.0} MiB"),
+        ),
+        (
+            "peak memory (VmHWM) after scrubbing",
+            format!("{:.0} MiB", s.rss_scrub),
+        ),
+        (
+            "peak memory (VmHWM) after the proxy",
+            format!("{rss_proxy:.0} MiB"),
+        ),
+        (
+            "peak memory (VmHWM) after tracking",
+            format!("{:.0} MiB", peak_rss_mib()),
+        ),
+    ];
+    rows.extend(tail.map(|(k, v)| (k.to_owned(), v)));
+    println!("{:<40} value", "measure");
+    for (k, v) in rows {
+        println!("{k:<40} {v}");
+    }
+    Ok(())
+}
+
+/// The long 1920×1080 clip of `a.minutes` at 30 frames/s in `out/bench-scrub`, made with
+/// FFmpeg unless an earlier run left it.
+fn long_clip(a: &BenchArgs, global: &GlobalArgs) -> Result<std::path::PathBuf, ExitError> {
     let dir = std::path::Path::new("out/bench-scrub");
     std::fs::create_dir_all(dir).map_err(ExitError::failed)?;
     let frames = (a.minutes * 60.0 * 30.0).round().max(2.0) as usize;
@@ -44,9 +128,14 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         )
         .map_err(ExitError::failed)?;
     }
-    let rss_before = peak_rss_mib();
+    Ok(file)
+}
+
+/// Opens `file`, seeks to 40 random frames, steps through up to 120 frames from the middle
+/// and revisits them five times, as scrubbing back and forth does.
+fn scrub(file: &std::path::Path) -> Result<Scrubbing, ExitError> {
     let t0 = Instant::now();
-    let mut video = Video::open(&file, &OpenOptions::default()).map_err(ExitError::failed)?;
+    let mut video = Video::open(file, &OpenOptions::default()).map_err(ExitError::failed)?;
     let open_s = t0.elapsed().as_secs_f64();
     let n = video.info().frame_count;
     let mut rng = rand::rngs::StdRng::seed_from_u64(7);
@@ -66,7 +155,6 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         video.frame(k).map_err(ExitError::failed)?;
     }
     let step_fps = window as f64 / t.elapsed().as_secs_f64();
-    // Revisit the same frames (up to 120) five times, as scrubbing back and forth does.
     let t = Instant::now();
     for _ in 0..5 {
         for k in start..start + window {
@@ -75,16 +163,23 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         }
     }
     let cached_fps = (5 * window) as f64 / t.elapsed().as_secs_f64();
-    let rss_scrub = peak_rss_mib();
-    drop(video);
+    Ok(Scrubbing {
+        info,
+        open_s,
+        targets,
+        seeks,
+        step_fps,
+        cached_fps,
+        rss_scrub: peak_rss_mib(),
+    })
+}
 
-    let proxy_rows = proxy_rows(&file, &info, &targets, global)?;
-    let rss_proxy = peak_rss_mib();
-
-    // Track a 300-frame span from the middle, as a user tracking one stretch of a long clip.
+/// Tracks a 300-frame span from the middle of `file`'s `n` frames, as a user tracking one
+/// stretch of a long clip: (the row's label, frames/s).
+fn track_span(file: &std::path::Path, n: usize) -> Result<(String, f64), ExitError> {
     let span_len = n.min(300);
     let span_start = (n - span_len) / 2;
-    let mut span = Video::open(&file, &OpenOptions::default())
+    let mut span = Video::open(file, &OpenOptions::default())
         .and_then(|v| v.into_span(span_start, span_len))
         .map_err(ExitError::failed)?;
     let (w, h) = (span.info().width, span.info().height);
@@ -93,68 +188,11 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     track_video(&mut span, &job, &mut |_| {}, &AtomicBool::new(false))
         .map_err(ExitError::failed)?;
     let track_fps = span_len as f64 / t.elapsed().as_secs_f64();
-    let track_label = format!(
+    let label = format!(
         "track frames {span_start}–{} (2 threads)",
         span_start + span_len - 1
     );
-    let pct = |q: f64| seeks[((seeks.len() - 1) as f64 * q).round() as usize];
-    let mut rows: Vec<(String, String)> = Vec::new();
-    let head = [
-        (
-            "clip",
-            format!(
-                "1920×1080, {n} frames ({:.1} min), keyframe every {} frames",
-                n as f64 / 30.0 / 60.0,
-                a.gop
-            ),
-        ),
-        ("open (reads the frame index)", format!("{open_s:.2} s")),
-        ("random seek, median", format!("{:.0} ms", pct(0.5))),
-        (
-            "random seek, 95th percentile",
-            format!("{:.0} ms", pct(0.95)),
-        ),
-        ("random seek, worst of 40", format!("{:.0} ms", pct(1.0))),
-        (
-            "random seeks within 150 ms",
-            format!("{} of 40", seeks.iter().filter(|&&s| s <= 150.0).count()),
-        ),
-    ];
-    rows.extend(head.map(|(k, v)| (k.to_owned(), v)));
-    rows.extend(proxy_rows);
-    let tail = [
-        (
-            "step forward one frame at a time",
-            format!("{step_fps:.0} frames/s"),
-        ),
-        (
-            "revisit cached frames incl. RGBA copy",
-            format!("{cached_fps:.0} frames/s"),
-        ),
-        (track_label.as_str(), format!("{track_fps:.0} frames/s")),
-        (
-            "peak memory (VmHWM) before open",
-            format!("{rss_before:.0} MiB"),
-        ),
-        (
-            "peak memory (VmHWM) after scrubbing",
-            format!("{rss_scrub:.0} MiB"),
-        ),
-        (
-            "peak memory (VmHWM) after the proxy",
-            format!("{rss_proxy:.0} MiB"),
-        ),
-        (
-            "peak memory (VmHWM) after tracking",
-            format!("{:.0} MiB", peak_rss_mib()),
-        ),
-    ];
-    rows.extend(tail.map(|(k, v)| (k.to_owned(), v)));
-    println!("{:<40} value", "measure");
-    for (k, v) in rows {
-        println!("{k:<40} {v}");
-    }
-    Ok(())
+    Ok((label, track_fps))
 }
 
 /// The app's seek proxy on this clip: built once (timed unless an earlier run left it), then
@@ -198,6 +236,50 @@ fn proxy_rows(
     let mut proxy = proxy::open(&proxy_file, info)
         .ok_or_else(|| ExitError::failed(anyhow::anyhow!("the proxy does not fit the clip")))?;
     let (pw, ph) = (proxy.info().width, proxy.info().height);
+    let (previews, fulls) = proxy_seeks(&mut proxy, file, targets)?;
+    drop(proxy);
+    let pct = |v: &[f64], q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
+    let within = previews.iter().filter(|&&s| s <= 150.0).count();
+    Ok(vec![
+        ("seek proxy: build time".to_owned(), proxy_build),
+        (
+            "seek proxy: size".to_owned(),
+            format!(
+                "{pw}×{ph}, keyframe every {} frames, {proxy_mib:.0} MiB",
+                proxy::PROXY_GOP
+            ),
+        ),
+        (
+            "seek shown from the proxy, median".to_owned(),
+            format!("{:.0} ms", pct(&previews, 0.5)),
+        ),
+        (
+            "seek shown from the proxy, 95th pct".to_owned(),
+            format!("{:.0} ms", pct(&previews, 0.95)),
+        ),
+        (
+            "seek shown from the proxy, worst".to_owned(),
+            format!("{:.0} ms", pct(&previews, 1.0)),
+        ),
+        (
+            "seeks shown from the proxy within 150 ms".to_owned(),
+            format!("{within} of {}", previews.len()),
+        ),
+        (
+            "  full frame meanwhile, median / worst".to_owned(),
+            format!("{:.0} ms / {:.0} ms", pct(&fulls, 0.5), pct(&fulls, 1.0)),
+        ),
+    ])
+}
+
+/// Seeks to each of `targets` in the proxy (decoded and turned into RGBA for the texture)
+/// while, as in the app, the full frame decodes on another thread: (the previews' times, the
+/// full frames' times), each sorted, ms.
+fn proxy_seeks(
+    proxy: &mut Video,
+    file: &std::path::Path,
+    targets: &[usize],
+) -> Result<(Vec<f64>, Vec<f64>), ExitError> {
     // As in the app, the full frame decodes on another thread while the preview is shown.
     let (ask, asked) = std::sync::mpsc::channel::<usize>();
     let (answer, answers) = std::sync::mpsc::channel::<Result<f64, VideoError>>();
@@ -235,39 +317,7 @@ fn proxy_rows(
     let _ = worker.join();
     previews.sort_by(f64::total_cmp);
     fulls.sort_by(f64::total_cmp);
-    drop(proxy);
-    let pct = |v: &[f64], q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
-    let within = previews.iter().filter(|&&s| s <= 150.0).count();
-    Ok(vec![
-        ("seek proxy: build time".to_owned(), proxy_build),
-        (
-            "seek proxy: size".to_owned(),
-            format!(
-                "{pw}×{ph}, keyframe every {} frames, {proxy_mib:.0} MiB",
-                proxy::PROXY_GOP
-            ),
-        ),
-        (
-            "seek shown from the proxy, median".to_owned(),
-            format!("{:.0} ms", pct(&previews, 0.5)),
-        ),
-        (
-            "seek shown from the proxy, 95th pct".to_owned(),
-            format!("{:.0} ms", pct(&previews, 0.95)),
-        ),
-        (
-            "seek shown from the proxy, worst".to_owned(),
-            format!("{:.0} ms", pct(&previews, 1.0)),
-        ),
-        (
-            "seeks shown from the proxy within 150 ms".to_owned(),
-            format!("{within} of {}", previews.len()),
-        ),
-        (
-            "  full frame meanwhile, median / worst".to_owned(),
-            format!("{:.0} ms / {:.0} ms", pct(&fulls, 0.5), pct(&fulls, 1.0)),
-        ),
-    ])
+    Ok((previews, fulls))
 }
 
 /// The RGB → RGBA copy the app makes to upload a frame as a texture.

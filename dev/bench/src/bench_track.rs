@@ -9,28 +9,20 @@
 //! when Python's OpenCV is present, and MediaPipe Pose when it is (`bench_baselines`). Tables put dev and test side by side per
 //! clip family. Metrics from [`videomocap_testkit::eval`].
 //!
-//! Speed: frames per second of the tracker at 640×480 and 1080×1920, with frames already in
-//! memory (decoding excluded) and with decoding, on one thread and on all; and how much longer
-//! tracking with decoding takes than decoding alone, timed back to back in paired rounds.
+//! Speed: `bench_track_speed`.
 
 use crate::args::{BenchArgs, GlobalArgs};
 use crate::bench_suite::{BenchClip, Tally, bench_clips};
 use crate::{ExitError, say};
-use anyhow::anyhow;
 use nalgebra::Point2;
-use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
-use std::time::Instant;
-use videomocap_core::formats::FrameIndex;
 use videomocap_core::formats::Marks;
 use videomocap_core::skeleton::{Joint, PerJoint};
 use videomocap_core::track::FloatFrame;
 use videomocap_core::track::{TrackJob, TrackerParams, track_video};
 use videomocap_core::video::{OpenOptions, Video};
-use videomocap_testkit::eval::suite::{CLICK_NOISE_PX, Family, REAL_CLIPS, Split, clicked_marks};
+use videomocap_testkit::eval::suite::{CLICK_NOISE_PX, Family, Split, clicked_marks};
 use videomocap_testkit::eval::{Accuracy, ClipScore, is_limb_joint, score_positions, score_tracks};
-use videomocap_testkit::repo_root;
 use videomocap_testkit::synth::GroundTruth;
 
 /// The fixed-template baseline: each joint's marked square patch (side 8% of the marked
@@ -130,9 +122,6 @@ pub(crate) fn track_opened(
     Ok(out.tracks)
 }
 
-/// Runs per speed figure; the fastest counts.
-const SPEED_RUNS: usize = 3;
-
 /// The tracking benchmarks' threads (all the machine has) and tracker settings (`--tracker-
 /// settings`, else the defaults).
 pub(crate) fn threads_and_settings(a: &BenchArgs) -> Result<(usize, TrackerParams), ExitError> {
@@ -194,191 +183,50 @@ fn score_clip(
     Ok(([from_clicks, from_exact, template], clicks_score, clicked))
 }
 
+/// The accuracy run over the suite's clips: the table's lines so far, the per-clip JSON rows,
+/// the tally by family and split, and per clip the clicked marks, VBA's limb joints and VBA's
+/// scores (for the baselines that follow); the real clips' limb joints apart.
+struct AccuracyRun {
+    lines: Vec<String>,
+    rows_json: Vec<serde_json::Value>,
+    tally: Tally<TrackScores>,
+    clicked: Vec<Marks>,
+    real_limbs: Vec<(String, Accuracy)>,
+    vba_limbs: Vec<Accuracy>,
+    vba_scores: Vec<ClipScore>,
+}
+
 /// Runs the accuracy and speed benchmark and prints its tables.
 pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let (threads, params) = threads_and_settings(a)?;
     let clips = bench_clips(&a.suite_dir, &a.split, a.clip.as_deref(), global)?;
-    let mut tally: Tally<TrackScores> = Tally::default();
-    let mut lines = vec![
-        format!(
-            "suite v4: {} clips ({} dev, {} test) and 2 real clips (dev); marks clicked with {} px of noise unless 'exact'",
-            clips.len() - 2,
-            clips
-                .iter()
-                .filter(|c| c.split == Split::Dev && c.family != Family::Real)
-                .count(),
-            clips.iter().filter(|c| c.split == Split::Test).count(),
-            CLICK_NOISE_PX
-        ),
-        String::new(),
-        format!(
-            "{:<26} {:<5} {:<11} {TRACK_COLUMNS}",
-            "clip", "split", "family"
-        ),
-    ];
-    let mut rows_json = Vec::new();
-    let mut clicked = Vec::new();
-    let mut real_limbs: Vec<(String, Accuracy)> = Vec::new();
-    let mut vba_limbs = Vec::new();
-    let mut vba_scores = Vec::new();
-    for clip in &clips {
-        say(global, &format!("tracking {} …", clip.name));
-        let (s, score, marks) = score_clip(clip, threads, params)?;
-        let limbs = score.limbs();
-        vba_scores.push(score);
-        if clip.family == Family::Real {
-            real_limbs.push((clip.name.clone(), limbs));
-        }
-        vba_limbs.push(limbs);
-        lines.push(format!(
-            "{:<26} {:<5} {:<11} {}",
-            clip.name,
-            clip.split.name(),
-            clip.family.name(),
-            track_cell(&s)
-        ));
-        rows_json.push(serde_json::json!({
-            "clip": clip.name, "split": clip.split.name(), "family": clip.family.name(),
-            "vba": accuracy_json(&s[0]), "vba_exact_marks": accuracy_json(&s[1]),
-            "fixed_template": accuracy_json(&s[2]),
-        }));
-        tally.add(clip, &s);
-        clicked.push(marks);
-    }
-    lines.push(String::new());
-    lines.push(
-        "VBA from clicked marks (PCK@0.2, lost, mean px), from exact marks (PCK@0.2), fixed template from clicked marks (PCK@0.2)"
-            .to_owned(),
-    );
-    lines.extend(Tally::<TrackScores>::heading(TRACK_WIDTH, TRACK_COLUMNS));
-    lines.extend(tally.lines(TRACK_WIDTH, track_cell));
-    if !real_limbs.is_empty() {
-        lines.push(String::new());
-        lines.push(format!(
-            "real clips, the {} limb joints (the four chains and the pelvis), VBA from clicked marks: {}",
-            Joint::ALL.into_iter().filter(|&j| is_limb_joint(j)).count(),
-            real_limbs
-                .iter()
-                .map(|(name, a)| format!("{name} PCK@0.2 {:.3}", a.pck02()))
-                .collect::<Vec<_>>()
-                .join(", ")
-        ));
-    }
-    let opencv = crate::bench_baselines::opencv(&clips, &clicked, &a.suite_dir, global)?;
+    let mut acc = track_clips(&clips, threads, params, global)?;
+    let mut lines = std::mem::take(&mut acc.lines);
+    lines.extend(summary_lines(&acc));
+    let opencv = crate::bench_baselines::opencv(&clips, &acc.clicked, &a.suite_dir, global)?;
     lines.push(String::new());
     lines.extend(crate::bench_baselines::opencv_lines(opencv.as_ref()));
-    let mediapipe = crate::bench_baselines::mediapipe(&clips, &vba_limbs, &a.suite_dir, global)?;
+    let mediapipe =
+        crate::bench_baselines::mediapipe(&clips, &acc.vba_limbs, &a.suite_dir, global)?;
     let mut views = crate::bench_views::ViewTable::new(&["VBA", "MediaPipe"]);
     if let Some((_, mp)) = &mediapipe {
-        for ((clip, ours), theirs) in clips.iter().zip(&vba_scores).zip(mp) {
+        for ((clip, ours), theirs) in clips.iter().zip(&acc.vba_scores).zip(mp) {
             views.add(clip, &[ours, theirs]);
         }
-        lines.push(String::new());
-        lines.push(
-            "per view: VBA from clicked marks against MediaPipe Pose (its own detector, no marks)"
-                .to_owned(),
-        );
-        lines.extend(views.lines());
     }
-    if let Some(((t, per_clip), _)) = &mediapipe {
-        lines.push(String::new());
-        lines.push(
-            "VBA alone (clicked marks) against the network alone (MediaPipe Pose 0.10.21, its own detector, no marks), PCK@0.2 of the 13 limb joints; MediaPipe's lost share and its 16 joints (neck, chest, pelvis and head top derived: scripts/mediapipe_baseline.py)".to_owned(),
-        );
-        lines.extend(Tally::<crate::bench_baselines::Learned>::heading(
-            crate::bench_baselines::LEARNED_WIDTH,
-            crate::bench_baselines::LEARNED_COLUMNS,
-        ));
-        lines.extend(t.lines(
-            crate::bench_baselines::LEARNED_WIDTH,
-            crate::bench_baselines::learned_cell,
-        ));
-        for (name, s) in per_clip.iter().filter(|(n, _)| n.starts_with("real")) {
-            lines.push(format!(
-                "{name:<18} |{}",
-                crate::bench_baselines::learned_cell(s)
-            ));
-        }
-    } else {
-        lines.push("(MediaPipe baseline: python3 with mediapipe not found; `python3 -m pip install mediapipe==0.10.21` adds it)".to_owned());
-    }
-
-    // Speed.
-    lines.push(String::new());
-    lines.push(format!(
-        "{:<48} {:>12}",
-        "speed (all 16 joints; fastest of 3 runs)", "frames/s"
-    ));
-    // The first 640×480 suite clip of those measured (none when `--clip` picked only the real
-    // ones), and the real sample.
-    let is_vga = |c: &&BenchClip| {
-        Video::open(&c.dir.join("video.mp4"), &OpenOptions::default())
-            .is_ok_and(|v| (v.info().width, v.info().height) == (640, 480))
-    };
-    let mut timed: Vec<(&str, PathBuf)> = clips
-        .iter()
-        .filter(|c| c.family != Family::Real)
-        .find(is_vga)
-        .map(|c| ("640×480", c.dir.clone()))
-        .into_iter()
-        .collect();
-    if timed.is_empty() {
-        lines.push("(no 640×480 suite clip among the clips measured: not timed)".to_owned());
-    }
-    timed.push(("1080×1920", repo_root().join(REAL_CLIPS[0].1)));
-    for (label, dir) in &timed {
-        let (label, dir) = (*label, dir.as_path());
-        for decoding in [false, true] {
-            for t in [1, threads] {
-                let n = speed(dir, t, decoding, params)?;
-                let what = if decoding {
-                    "with decoding"
-                } else {
-                    "decoding excluded"
-                };
-                let plural = if t == 1 { "thread" } else { "threads" };
-                lines.push(format!(
-                    "{:<48} {:>12.1}",
-                    format!("track {label}, {t} {plural}, {what}"),
-                    n
-                ));
-            }
-        }
-        if label == "640×480" {
-            // The speed goal counts the backward pass a later key frame brings.
-            let n = speed_both_ways(dir, params)?;
-            lines.push(format!(
-                "{:<48} {:>12.1}",
-                "track 640×480, 1 thread, both ways, dec. excluded", n
-            ));
-        }
-        let d = decode_speed(dir)?;
-        lines.push(format!(
-            "{:<48} {:>12.1}",
-            format!("decode only {label}"),
-            d
-        ));
-        let (median, low, high) = paired_ratio(dir, threads, params)?;
-        lines.push(format!(
-            "{:<48} {:>12.2}",
-            format!("time ratio track+decode / decode {label}"),
-            median
-        ));
-        lines.push(format!(
-            "{:<48} {:>12}",
-            format!("  (median of {RATIO_ROUNDS} paired rounds; range)"),
-            format!("{low:.2}–{high:.2}")
-        ));
-    }
+    lines.extend(mediapipe_lines(mediapipe.as_ref().map(|(t, _)| t), &views));
+    lines.extend(crate::bench_track_speed::speed_lines(
+        &clips, threads, params,
+    )?);
     if global.json {
         println!(
             "{}",
             serde_json::json!({
-                "clips": rows_json,
-                "vba": tally.json(|s| accuracy_json(&s[0])),
-                "vba_exact_marks": tally.json(|s| accuracy_json(&s[1])),
-                "fixed_template": tally.json(|s| accuracy_json(&s[2])),
-                "real_limb_joints": real_limbs
+                "clips": acc.rows_json,
+                "vba": acc.tally.json(|s| accuracy_json(&s[0])),
+                "vba_exact_marks": acc.tally.json(|s| accuracy_json(&s[1])),
+                "fixed_template": acc.tally.json(|s| accuracy_json(&s[2])),
+                "real_limb_joints": acc.real_limbs
                     .iter()
                     .map(|(name, a)| serde_json::json!({"clip": name, "vba": accuracy_json(a)}))
                     .collect::<Vec<_>>(),
@@ -403,167 +251,128 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     Ok(())
 }
 
+/// Tracks and scores every clip: the table's heading and a row per clip.
+fn track_clips(
+    clips: &[BenchClip],
+    threads: usize,
+    params: TrackerParams,
+    global: &GlobalArgs,
+) -> Result<AccuracyRun, ExitError> {
+    let mut acc = AccuracyRun {
+        lines: vec![
+            format!(
+                "suite v4: {} clips ({} dev, {} test) and 2 real clips (dev); marks clicked with {} px of noise unless 'exact'",
+                clips.len() - 2,
+                clips
+                    .iter()
+                    .filter(|c| c.split == Split::Dev && c.family != Family::Real)
+                    .count(),
+                clips.iter().filter(|c| c.split == Split::Test).count(),
+                CLICK_NOISE_PX
+            ),
+            String::new(),
+            format!(
+                "{:<26} {:<5} {:<11} {TRACK_COLUMNS}",
+                "clip", "split", "family"
+            ),
+        ],
+        rows_json: Vec::new(),
+        tally: Tally::default(),
+        clicked: Vec::new(),
+        real_limbs: Vec::new(),
+        vba_limbs: Vec::new(),
+        vba_scores: Vec::new(),
+    };
+    for clip in clips {
+        say(global, &format!("tracking {} …", clip.name));
+        let (s, score, marks) = score_clip(clip, threads, params)?;
+        let limbs = score.limbs();
+        acc.vba_scores.push(score);
+        if clip.family == Family::Real {
+            acc.real_limbs.push((clip.name.clone(), limbs));
+        }
+        acc.vba_limbs.push(limbs);
+        acc.lines.push(format!(
+            "{:<26} {:<5} {:<11} {}",
+            clip.name,
+            clip.split.name(),
+            clip.family.name(),
+            track_cell(&s)
+        ));
+        acc.rows_json.push(serde_json::json!({
+            "clip": clip.name, "split": clip.split.name(), "family": clip.family.name(),
+            "vba": accuracy_json(&s[0]), "vba_exact_marks": accuracy_json(&s[1]),
+            "fixed_template": accuracy_json(&s[2]),
+        }));
+        acc.tally.add(clip, &s);
+        acc.clicked.push(marks);
+    }
+    Ok(acc)
+}
+
+/// The tally's table and the real clips' limb joints.
+fn summary_lines(acc: &AccuracyRun) -> Vec<String> {
+    let mut lines = vec![
+        String::new(),
+        "VBA from clicked marks (PCK@0.2, lost, mean px), from exact marks (PCK@0.2), fixed template from clicked marks (PCK@0.2)"
+            .to_owned(),
+    ];
+    lines.extend(Tally::<TrackScores>::heading(TRACK_WIDTH, TRACK_COLUMNS));
+    lines.extend(acc.tally.lines(TRACK_WIDTH, track_cell));
+    if !acc.real_limbs.is_empty() {
+        lines.push(String::new());
+        lines.push(format!(
+            "real clips, the {} limb joints (the four chains and the pelvis), VBA from clicked marks: {}",
+            Joint::ALL.into_iter().filter(|&j| is_limb_joint(j)).count(),
+            acc.real_limbs
+                .iter()
+                .map(|(name, a)| format!("{name} PCK@0.2 {:.3}", a.pck02()))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+    }
+    lines
+}
+
+/// MediaPipe's lines: the per-view table and VBA alone against the network alone, or a line
+/// saying how to add it when Python's MediaPipe is missing.
+fn mediapipe_lines(
+    mediapipe: Option<&crate::bench_baselines::LearnedScores>,
+    views: &crate::bench_views::ViewTable,
+) -> Vec<String> {
+    let mut lines = Vec::new();
+    let Some((t, per_clip)) = mediapipe else {
+        lines.push("(MediaPipe baseline: python3 with mediapipe not found; `python3 -m pip install mediapipe==0.10.21` adds it)".to_owned());
+        return lines;
+    };
+    lines.push(String::new());
+    lines.push(
+        "per view: VBA from clicked marks against MediaPipe Pose (its own detector, no marks)"
+            .to_owned(),
+    );
+    lines.extend(views.lines());
+    lines.push(String::new());
+    lines.push(
+        "VBA alone (clicked marks) against the network alone (MediaPipe Pose 0.10.21, its own detector, no marks), PCK@0.2 of the 13 limb joints; MediaPipe's lost share and its 16 joints (neck, chest, pelvis and head top derived: scripts/mediapipe_baseline.py)".to_owned(),
+    );
+    lines.extend(Tally::<crate::bench_baselines::Learned>::heading(
+        crate::bench_baselines::LEARNED_WIDTH,
+        crate::bench_baselines::LEARNED_COLUMNS,
+    ));
+    lines.extend(t.lines(
+        crate::bench_baselines::LEARNED_WIDTH,
+        crate::bench_baselines::learned_cell,
+    ));
+    for (name, s) in per_clip.iter().filter(|(n, _)| n.starts_with("real")) {
+        lines.push(format!(
+            "{name:<18} |{}",
+            crate::bench_baselines::learned_cell(s)
+        ));
+    }
+    lines
+}
+
 /// An accuracy as JSON: PCK@0.1, PCK@0.2, lost share, mean error in pixels, samples.
 pub(crate) fn accuracy_json(a: &Accuracy) -> serde_json::Value {
     serde_json::json!({"pck01": a.pck01(), "pck02": a.pck02(), "lost": a.lost(), "mean_px": a.mean_px(), "samples": a.count})
-}
-
-/// A prepared speed measurement of tracking one clip: the job and, when decoding is excluded,
-/// the video with every frame already in its cache.
-struct TrackTimer {
-    dir: PathBuf,
-    job: TrackJob,
-    decoding: bool,
-    preloaded: Option<Video>,
-}
-
-impl TrackTimer {
-    fn new(
-        dir: &Path,
-        threads: usize,
-        decoding: bool,
-        params: TrackerParams,
-    ) -> Result<Self, ExitError> {
-        let marks = Marks::load(&dir.join("marks.json")).map_err(ExitError::failed)?;
-        // Frames in memory are full size: the tracker shrinks them itself (it leaves a video
-        // whose frames are in its cache at full size, as FFmpeg's scaling would empty it).
-        Ok(TrackTimer {
-            dir: dir.to_owned(),
-            job: TrackJob::from_marks(&marks, params, threads),
-            decoding,
-            preloaded: None,
-        })
-    }
-
-    /// Tracks the clip once: (frames, seconds). With decoding every run opens the video
-    /// afresh (its cache would hold the frames); without, the frames are loaded before the
-    /// clock starts and kept for the next run.
-    fn run_once(&mut self) -> Result<(usize, f64), ExitError> {
-        let mut video = match self.preloaded.take() {
-            Some(v) => v,
-            None => {
-                let options = OpenOptions {
-                    cache_bytes: 2 << 30,
-                    ..OpenOptions::default()
-                };
-                Video::open(&self.dir.join("video.mp4"), &options).map_err(ExitError::failed)?
-            }
-        };
-        let n = video.info().frame_count;
-        if !self.decoding {
-            for i in 0..n {
-                let _: Arc<_> = video.frame(i).map_err(ExitError::failed)?.image;
-            }
-        }
-        let t0 = Instant::now();
-        track_video(&mut video, &self.job, &mut |_| {}, &AtomicBool::new(false))
-            .map_err(ExitError::failed)?;
-        let s = t0.elapsed().as_secs_f64();
-        if !self.decoding {
-            self.preloaded = Some(video);
-        }
-        Ok((n, s))
-    }
-}
-
-/// Frames per second of tracking `dir`'s clip: the fastest of [`SPEED_RUNS`] runs (the machine
-/// is shared, and a slow run measures the neighbours, not the tracker).
-fn speed(
-    dir: &Path,
-    threads: usize,
-    decoding: bool,
-    params: TrackerParams,
-) -> Result<f64, ExitError> {
-    let mut timer = TrackTimer::new(dir, threads, decoding, params)?;
-    let mut best = f64::INFINITY;
-    let mut n = 0;
-    for _ in 0..SPEED_RUNS {
-        let (frames, s) = timer.run_once()?;
-        n = frames;
-        best = best.min(s);
-    }
-    Ok(n as f64 / best)
-}
-
-/// Frames per second of tracking `dir`'s suite clip on one thread, decoding excluded, with a
-/// key frame on its last frame (the reference pose there) as well as the marks, so that a
-/// backward pass runs over the whole clip too; fastest of [`SPEED_RUNS`].
-fn speed_both_ways(dir: &Path, params: TrackerParams) -> Result<f64, ExitError> {
-    let mut timer = TrackTimer::new(dir, 1, false, params)?;
-    let gt = GroundTruth::load(&dir.join("gt.json")).map_err(ExitError::failed)?;
-    let n = gt.frames.len();
-    let last = gt
-        .frames
-        .last()
-        .ok_or_else(|| ExitError::failed(anyhow!("{}: no reference frames", dir.display())))?
-        .points2d();
-    for j in Joint::ALL {
-        timer.job.keys.set(FrameIndex(n - 1), j, last[j]);
-    }
-    let mut best = f64::INFINITY;
-    for _ in 0..SPEED_RUNS {
-        let (_, s) = timer.run_once()?;
-        best = best.min(s);
-    }
-    Ok(n as f64 / best)
-}
-
-/// Decodes `dir`'s clip once: (frames, seconds).
-fn decode_once(dir: &Path) -> Result<(usize, f64), ExitError> {
-    let mut video =
-        Video::open(&dir.join("video.mp4"), &OpenOptions::default()).map_err(ExitError::failed)?;
-    let n = video.info().frame_count;
-    let t0 = Instant::now();
-    for i in 0..n {
-        video.frame(i).map_err(ExitError::failed)?;
-    }
-    let s = t0.elapsed().as_secs_f64();
-    if s <= 0.0 {
-        return Err(ExitError::failed(anyhow!("decoding took no time")));
-    }
-    Ok((n, s))
-}
-
-/// Frames per second of decoding `dir`'s clip, the fastest of [`SPEED_RUNS`] runs.
-fn decode_speed(dir: &Path) -> Result<f64, ExitError> {
-    let mut best = f64::INFINITY;
-    let mut n = 0;
-    for _ in 0..SPEED_RUNS {
-        let (frames, s) = decode_once(dir)?;
-        n = frames;
-        best = best.min(s);
-    }
-    Ok(n as f64 / best)
-}
-
-/// Rounds of the paired ratio measurement.
-const RATIO_ROUNDS: usize = 5;
-
-/// The time of tracking with decoding over the time of decoding alone, measured in
-/// [`RATIO_ROUNDS`] rounds that each time both back to back, so both halves of a ratio see the
-/// same neighbours on the shared machine: (median, lowest, highest) of the rounds' ratios.
-/// Fastest-of-n figures taken minutes apart put this ratio anywhere between 1.6 and 2.7; the
-/// paired median still moves between runs (1.55, 1.62 and 2.31 in three runs of one build at
-/// 1080×1920), so quote it with its range.
-fn paired_ratio(
-    dir: &Path,
-    threads: usize,
-    params: TrackerParams,
-) -> Result<(f64, f64, f64), ExitError> {
-    let mut timer = TrackTimer::new(dir, threads, true, params)?;
-    // A first round warms the file cache and the thread pool; it is not counted.
-    decode_once(dir)?;
-    timer.run_once()?;
-    let mut ratios = Vec::with_capacity(RATIO_ROUNDS);
-    for _ in 0..RATIO_ROUNDS {
-        let (_, decode) = decode_once(dir)?;
-        let (_, track) = timer.run_once()?;
-        ratios.push(track / decode);
-    }
-    ratios.sort_by(f64::total_cmp);
-    Ok((
-        ratios[RATIO_ROUNDS / 2],
-        ratios[0],
-        ratios[RATIO_ROUNDS - 1],
-    ))
 }

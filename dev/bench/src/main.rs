@@ -15,6 +15,7 @@ mod bench_scrub;
 mod bench_speed;
 mod bench_suite;
 mod bench_track;
+mod bench_track_speed;
 mod bench_views;
 mod bench_volume;
 mod prior;

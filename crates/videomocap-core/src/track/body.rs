@@ -138,72 +138,20 @@ impl BodyTracker {
         params: Tuning,
         background: Option<Arc<Background>>,
     ) -> BodyTracker {
-        let width = widths(pose, proportions, params.block_width_scale);
-        let stature = stature_px(pose, proportions);
         let mut floats = FloatFrame::default();
         floats.fill_with(image, background.as_deref());
-        let frame = floats.view();
-        let w = params.weights;
-        let part = |block: MorphBlock, kind: BodyPart| {
-            let (a, b) = kind.ends();
-            let fraction = if kind == BodyPart::Trunk {
-                proportions.fraction_between(Joint::Neck, Joint::Chest)
-                    + proportions.fraction_between(Joint::Chest, Joint::Pelvis)
-            } else {
-                proportions.fraction_between(a, b)
-            };
-            let mut template = Template::sample(frame, &block, extent(kind), w);
-            if is_arm(kind) {
-                template.set_foreground(params.arm_foreground);
-            }
-            Part {
-                block,
-                prev_theta: block.theta,
-                template,
-                reliability: 1.0,
-                max_len: (LENGTH_SLACK * fraction * stature).max(block.m * 1.05),
-                extent: extent(kind),
-                short_penalty: match kind {
-                    BodyPart::Head | BodyPart::Trunk => 0.0,
-                    BodyPart::LeftForearm | BodyPart::RightForearm => params.forearm_short_penalty,
-                    _ => params.short_penalty,
-                },
-            }
+        let width = widths(pose, proportions, params.block_width_scale);
+        let start = PartStart {
+            frame: floats.view(),
+            width: &width,
+            stature: stature_px(pose, proportions),
+            proportions,
+            params: &params,
         };
         // The head block runs from the calvaria down to the neck (its anchor is head_top).
-        let head = part(
-            MorphBlock::along(
-                pose[Joint::HeadTop],
-                pose[Joint::Neck],
-                width(BodyPart::Head),
-            ),
-            BodyPart::Head,
-        );
-        let pose_head_m = head.block.m;
-        let trunk_block = MorphBlock::along(
-            pose[Joint::Neck],
-            pose[Joint::Pelvis],
-            width(BodyPart::Trunk),
-        );
-        let trunk = part(trunk_block, BodyPart::Trunk);
-        let hips = {
-            let block = hip_patch(
-                pose[Joint::Pelvis],
-                trunk_block.theta,
-                trunk_block.m,
-                trunk_block.n,
-            );
-            Part {
-                block,
-                prev_theta: block.theta,
-                template: Template::sample(frame, &block, Extent::BLOCK, w),
-                reliability: 1.0,
-                max_len: block.m,
-                extent: Extent::BLOCK,
-                short_penalty: 0.0,
-            }
-        };
-        let trunk_points = TRUNK_JOINTS.map(|j| trunk_block.to_block(pose[j]));
+        let head = start.part(pose[Joint::HeadTop], pose[Joint::Neck], BodyPart::Head);
+        let trunk = start.part(pose[Joint::Neck], pose[Joint::Pelvis], BodyPart::Trunk);
+        let trunk_block = trunk.block;
         let limb_parts = [
             [BodyPart::LeftUpperArm, BodyPart::LeftForearm],
             [BodyPart::RightUpperArm, BodyPart::RightForearm],
@@ -213,26 +161,21 @@ impl BodyTracker {
         let limbs = std::array::from_fn(|c| {
             let [a, b, e] = CHAINS[c];
             [
-                part(
-                    MorphBlock::along(pose[a], pose[b], width(limb_parts[c][0])),
-                    limb_parts[c][0],
-                ),
-                part(
-                    MorphBlock::along(pose[b], pose[e], width(limb_parts[c][1])),
-                    limb_parts[c][1],
-                ),
+                start.part(pose[a], pose[b], limb_parts[c][0]),
+                start.part(pose[b], pose[e], limb_parts[c][1]),
             ]
         });
+        let hips = start.hips(&trunk_block);
         BodyTracker {
             params,
+            marked_head_m: head.block.m,
             head,
             trunk,
             hips,
             limbs,
-            trunk_points,
+            trunk_points: TRUNK_JOINTS.map(|j| trunk_block.to_block(pose[j])),
             root_shift: [(0.0, 0.0); 4],
             predictor: HeadPredictor::default(),
-            marked_head_m: pose_head_m,
             background,
             zoom: 1.0,
             head_velocity: nalgebra::Vector2::zeros(),
@@ -336,22 +279,39 @@ impl BodyTracker {
         }
     }
 
-    /// Tracks the body into the next frame and returns its pose.
+    /// Tracks the body into the next frame and returns its pose: the head, the trunk hung
+    /// from its neck, then the four limb chains from the trunk.
     pub(super) fn step(&mut self, image: &RgbImage) -> PerJoint<JointResult> {
-        let p = self.params;
         // Both frames are taken out of `self` while the parts are updated, and put back at the
         // end with their roles swapped.
         let mut floats = std::mem::take(&mut self.spare);
         floats.fill_with(image, self.background.as_deref());
         let previous = std::mem::take(&mut self.prev);
-        let frame = floats.view();
-        let prev = previous.view();
+        let (frame, prev) = (floats.view(), previous.view());
 
-        // Head: image-difference prediction (eqs. 1–5), then the spiral search path (Fig. 6).
-        // Beyond the paper, the spiral also starts from the constant-velocity prediction and
-        // from the unmoved head, and the best of the three ends wins: the difference image
-        // is fooled when arms move inside Ω, and the spiral stops at the first ring without
-        // improvement, so one wrong start would lose the head.
+        let hips_found = self.step_head(prev, frame);
+        // Beyond the paper: a person walking towards the camera grows in the image. The head
+        // block zooms with them (the spiral searches its length), so every bone's length limit
+        // grows by the head's zoom since the marking; without this the trunk and limbs stop at
+        // their marked-size limits and the hips and feet are left behind.
+        self.zoom = (self.head.block.m / self.marked_head_m.max(1e-9)).max(1.0);
+        let trunk_before = self.step_trunk(frame, hips_found);
+        self.step_limbs(frame, trunk_before);
+
+        self.spare = previous;
+        self.prev = floats;
+        self.pose()
+    }
+
+    /// The head: image-difference prediction (eqs. 1–5), then the spiral search path
+    /// (Fig. 6). Beyond the paper, the spiral also starts from the constant-velocity
+    /// prediction and from the unmoved head, and the best of the three ends wins: the
+    /// difference image is fooled when arms move inside Ω, and the spiral stops at the first
+    /// ring without improvement, so one wrong start would lose the head. Returns the hip
+    /// patch's spiral, run beside the head's (it starts where the patch was, not from the
+    /// head).
+    fn step_head(&mut self, prev: FrameView, frame: FrameView) -> Option<Found> {
+        let p = self.params;
         let motion =
             self.predictor
                 .predict(prev, frame, self.head.block.origin, self.head.block.end());
@@ -362,22 +322,7 @@ impl BodyTracker {
             max_rings: p.head_max_rings,
             m_bounds: (0.0, f64::INFINITY),
         };
-        let starts = [
-            motion.displacement,
-            self.head_velocity * p.velocity_damping,
-            nalgebra::Vector2::zeros(),
-        ];
-        // The starts, less any within a step of an earlier one; the hip patch's spiral (it
-        // starts where the patch was, not from the head) runs beside them.
-        let starts: Vec<MorphBlock> = starts
-            .iter()
-            .enumerate()
-            .filter(|&(k, d)| !starts[..k].iter().any(|e| (e - d).norm() < p.head_step_px))
-            .map(|(_, d)| MorphBlock {
-                origin: self.head.block.origin + d,
-                ..self.head.block
-            })
-            .collect();
+        let starts = self.head_starts(motion.displacement);
         let head_template = &self.head.template;
         let search_head = || -> Vec<Found> {
             let one = |b: &MorphBlock| spiral(head_template, frame, b, &spiral_params);
@@ -405,21 +350,36 @@ impl BodyTracker {
         self.predictor.adapt(motion.displacement, moved);
         self.head_velocity = moved;
         accept(&mut self.head, found, frame, &p);
+        hips_found
+    }
 
-        // Beyond the paper: a person walking towards the camera grows in the image. The head
-        // block zooms with them (the spiral searches its length), so every bone's length limit
-        // grows by the head's zoom since the marking; without this the trunk and limbs stop at
-        // their marked-size limits and the hips and feet are left behind.
-        self.zoom = (self.head.block.m / self.marked_head_m.max(1e-9)).max(1.0);
-        let zoom = self.zoom;
+    /// The head spiral's starting blocks: moved by the image-difference prediction
+    /// `predicted`, by the damped constant velocity and not at all, less any within a step of
+    /// an earlier one.
+    fn head_starts(&self, predicted: nalgebra::Vector2<f64>) -> Vec<MorphBlock> {
+        let p = &self.params;
+        let starts = [
+            predicted,
+            self.head_velocity * p.velocity_damping,
+            nalgebra::Vector2::zeros(),
+        ];
+        starts
+            .iter()
+            .enumerate()
+            .filter(|&(k, d)| !starts[..k].iter().any(|e| (e - d).norm() < p.head_step_px))
+            .map(|(_, d)| MorphBlock {
+                origin: self.head.block.origin + d,
+                ..self.head.block
+            })
+            .collect()
+    }
 
-        // Trunk, anchored at the neck. Its width stays as marked (times the zoom). Letting it
-        // narrow as a body turns side-on, so that the shoulders and hips (placed at fractions
-        // of the width) close in, was tried and not kept: a scan of ±3 % and ±6 % per step
-        // around the last width, down to half the marked width. Suite / real sample PCK@0.2
-        // were 0.903 / 0.780 and 0.880 / 0.792, against 0.903 / 0.805. dance_oblique's far
-        // shoulder went 0.62 → 0.76, but bend_side's bow narrowed the trunk too (0.981 →
-        // 0.933 / 0.679).
+    /// The trunk, anchored at the neck, then the hips held by their patch (`hips_found`, when
+    /// the patch is on). Its width stays as marked (times the zoom): letting it narrow as a
+    /// body turns side-on was tried and not kept (docs/method.md, Tracking, "The trunk's width").
+    /// Returns the trunk's angle and previous angle before this frame.
+    fn step_trunk(&mut self, frame: FrameView, hips_found: Option<Found>) -> (f64, f64) {
+        let p = self.params;
         let neck = self.head.block.end();
         let trunk_before = (self.trunk.block.theta, self.trunk.prev_theta);
         let trunk_pred = predict_anchored(&self.trunk, neck, None, p.velocity_damping);
@@ -434,15 +394,22 @@ impl BodyTracker {
                 m_count: 5,
                 scale_width: false,
             },
-            &prior(&self.trunk, &trunk_pred, &p, zoom),
+            &prior(&self.trunk, &trunk_pred, &p, self.zoom),
         );
         accept(&mut self.trunk, found, frame, &p);
         if let Some(hips_found) = hips_found {
             self.hips_hold(frame, neck, hips_found, &p);
         }
-        let pose_now = self.pose();
+        trunk_before
+    }
 
-        // Limbs, each chain from its root joint on the trunk; chains in parallel.
+    /// The four limb chains, each from its root joint on the trunk, in parallel;
+    /// `trunk_before` is the trunk's angle and previous angle before this frame. A shoulder's
+    /// spring leaves its root shifted from the rigid trunk's place, kept for the next frame.
+    fn step_limbs(&mut self, frame: FrameView, trunk_before: (f64, f64)) {
+        let p = self.params;
+        let zoom = self.zoom;
+        let pose_now = self.pose();
         let trunk_angles = [self.trunk.block.theta, trunk_before.0, trunk_before.1];
         let roots = CHAINS.map(|c| pose_now[c[0]].pos);
         let rigid = CHAIN_ROOTS.map(|k| {
@@ -478,9 +445,65 @@ impl BodyTracker {
                 self.root_shift[c] = (u - u0, v - v0);
             }
         }
-        self.spare = previous;
-        self.prev = floats;
-        self.pose()
+    }
+}
+
+/// What a part started on a key frame is made from: the key frame, the parts' widths, the
+/// subject's stature in pixels and proportions, and the tuning.
+struct PartStart<'a> {
+    frame: FrameView<'a>,
+    width: &'a dyn Fn(BodyPart) -> f64,
+    stature: f64,
+    proportions: &'a Proportions,
+    params: &'a Tuning,
+}
+
+impl PartStart<'_> {
+    /// The body part `kind` as a block from `from` to `to`, its colour model sampled from the
+    /// key frame and its length limit from the proportions.
+    fn part(&self, from: Point2<f64>, to: Point2<f64>, kind: BodyPart) -> Part {
+        let block = MorphBlock::along(from, to, (self.width)(kind));
+        let (a, b) = kind.ends();
+        let fraction = if kind == BodyPart::Trunk {
+            self.proportions.fraction_between(Joint::Neck, Joint::Chest)
+                + self
+                    .proportions
+                    .fraction_between(Joint::Chest, Joint::Pelvis)
+        } else {
+            self.proportions.fraction_between(a, b)
+        };
+        let p = self.params;
+        let mut template = Template::sample(self.frame, &block, extent(kind), p.weights);
+        if is_arm(kind) {
+            template.set_foreground(p.arm_foreground);
+        }
+        Part {
+            block,
+            prev_theta: block.theta,
+            template,
+            reliability: 1.0,
+            max_len: (LENGTH_SLACK * fraction * self.stature).max(block.m * 1.05),
+            extent: extent(kind),
+            short_penalty: match kind {
+                BodyPart::Head | BodyPart::Trunk => 0.0,
+                BodyPart::LeftForearm | BodyPart::RightForearm => p.forearm_short_penalty,
+                _ => p.short_penalty,
+            },
+        }
+    }
+
+    /// The hip patch around the trunk's pelvis end (see [`BodyTracker::hips_hold`]).
+    fn hips(&self, trunk: &MorphBlock) -> Part {
+        let block = hip_patch(trunk.end(), trunk.theta, trunk.m, trunk.n);
+        Part {
+            block,
+            prev_theta: block.theta,
+            template: Template::sample(self.frame, &block, Extent::BLOCK, self.params.weights),
+            reliability: 1.0,
+            max_len: block.m,
+            extent: Extent::BLOCK,
+            short_penalty: 0.0,
+        }
     }
 }
 

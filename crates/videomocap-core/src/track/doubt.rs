@@ -32,6 +32,14 @@ pub const DOUBT_FEATURES: [&str; FEATURE_COUNT] = [
 /// Frames over which a key's nearness fades.
 const KEY_NEAR_FRAMES: f64 = 8.0;
 
+/// What the doubt reads over the whole clip: each frame's torso length in pixels, each bone's
+/// median length in torso lengths, each joint's key frames.
+struct ClipReading {
+    torso: Vec<f64>,
+    median: PerJoint<f64>,
+    key_frames: PerJoint<Vec<usize>>,
+}
+
 /// Per frame and joint, the doubt's evidence ([`DOUBT_FEATURES`]) about `out` (the chosen
 /// tracks) from VBA's tracks `vba`, the network's frames and the keys.
 pub fn doubt_features(
@@ -40,90 +48,114 @@ pub fn doubt_features(
     keys: &KeyFrames,
     out: &Tracks2d,
 ) -> Vec<PerJoint<[f64; FEATURE_COUNT]>> {
-    let n = out.frames.len();
-    let torso: Vec<f64> = (0..n)
-        .map(|t| {
-            let seen = net
-                .get(t)
-                .and_then(|f| f.joints.as_ref())
-                .map_or(0.0, |j| (j[Joint::Neck].pos - j[Joint::Pelvis].pos).norm());
-            out.frames[t].torso_px().max(seen).max(1.0)
-        })
-        .collect();
-    // Each bone's length over the clip (torso lengths, the median).
-    let length = |t: usize, j: Joint| {
-        j.parent()
-            .map(|p| (out.frames[t].points[j].pos - out.frames[t].points[p].pos).norm() / torso[t])
-    };
-    let median: PerJoint<f64> = PerJoint::from_fn(|j| {
-        let mut v: Vec<f64> = (0..n).filter_map(|t| length(t, j)).collect();
-        v.sort_by(f64::total_cmp);
-        v.get(v.len() / 2).copied().unwrap_or(0.0)
-    });
-    let key_frames: PerJoint<Vec<usize>> = PerJoint::from_fn(|j| {
-        out.frames
-            .iter()
-            .enumerate()
-            .filter(|(_, f)| keys.is_key(f.index, j))
-            .map(|(t, _)| t)
-            .collect()
-    });
-    (0..n)
-        .map(|t| {
-            let f = &out.frames[t];
-            PerJoint::from_fn(|j| {
-                let p = f.points[j].pos;
-                let off = |q: nalgebra::Point2<f64>| ((p - q).norm() / torso[t]).min(1.0);
-                let seen = net.get(t).and_then(|s| s.joints.as_ref());
-                let (net_off, net_unsure, swap) = match seen.map(|s| (s[j], s[other_side(j)])) {
-                    Some((own, other)) => {
-                        let swapped = off(other.pos) + 0.05 < off(own.pos);
-                        (
-                            off(own.pos),
-                            1.0 - own.confidence,
-                            if swapped { 1.0 } else { 0.0 },
-                        )
-                    }
-                    None => (1.0, 1.0, 0.0),
-                };
-                let jump = if t > 0 && t + 1 < n {
-                    let mid = nalgebra::center(
-                        &out.frames[t - 1].points[j].pos,
-                        &out.frames[t + 1].points[j].pos,
-                    );
-                    off(mid)
-                } else {
-                    0.0
-                };
-                let length = match length(t, j) {
-                    Some(l) if median[j] > 1e-6 && l > 1e-6 => (l / median[j]).ln().abs().min(2.0),
-                    _ => 0.0,
-                };
-                let key_near = key_frames[j]
-                    .iter()
-                    .map(|&k| k.abs_diff(t))
-                    .min()
-                    .map_or(0.0, |d| (-(d as f64) / KEY_NEAR_FRAMES).exp());
-                let shoulders = net.get(t).and_then(|s| s.joints.as_ref()).map_or(0.0, |s| {
-                    ((s[Joint::LeftShoulder].pos - s[Joint::RightShoulder].pos).norm() / torso[t])
-                        .min(1.0)
-                });
-                let lost = match f.points[j].source {
-                    PointSource::Tracked => 0.0,
-                    _ => 1.0,
-                };
-                [
-                    off(vba.frames[t].points[j].pos),
-                    net_off,
-                    net_unsure,
-                    jump,
-                    length,
-                    key_near,
-                    shoulders,
-                    swap,
-                    lost,
-                ]
-            })
-        })
+    let clip = ClipReading::new(net, keys, out);
+    (0..out.frames.len())
+        .map(|t| PerJoint::from_fn(|j| joint_features(&clip, vba, net, out, t, j)))
         .collect()
+}
+
+impl ClipReading {
+    /// Reads the clip: the torso from the chosen tracks or the network's, whichever is
+    /// longer (at least a pixel).
+    fn new(net: &NetworkFrames, keys: &KeyFrames, out: &Tracks2d) -> ClipReading {
+        let n = out.frames.len();
+        let torso: Vec<f64> = (0..n)
+            .map(|t| {
+                let seen = net
+                    .get(t)
+                    .and_then(|f| f.joints.as_ref())
+                    .map_or(0.0, |j| (j[Joint::Neck].pos - j[Joint::Pelvis].pos).norm());
+                out.frames[t].torso_px().max(seen).max(1.0)
+            })
+            .collect();
+        let median: PerJoint<f64> = PerJoint::from_fn(|j| {
+            let mut v: Vec<f64> = (0..n).filter_map(|t| bone(out, &torso, t, j)).collect();
+            v.sort_by(f64::total_cmp);
+            v.get(v.len() / 2).copied().unwrap_or(0.0)
+        });
+        let key_frames: PerJoint<Vec<usize>> = PerJoint::from_fn(|j| {
+            out.frames
+                .iter()
+                .enumerate()
+                .filter(|(_, f)| keys.is_key(f.index, j))
+                .map(|(t, _)| t)
+                .collect()
+        });
+        ClipReading {
+            torso,
+            median,
+            key_frames,
+        }
+    }
+}
+
+/// Joint `j`'s bone to its parent on frame `t` of `out`, in torso lengths (none for the root).
+fn bone(out: &Tracks2d, torso: &[f64], t: usize, j: Joint) -> Option<f64> {
+    j.parent()
+        .map(|p| (out.frames[t].points[j].pos - out.frames[t].points[p].pos).norm() / torso[t])
+}
+
+/// Joint `j`'s evidence on frame `t`, in the order of [`DOUBT_FEATURES`].
+fn joint_features(
+    clip: &ClipReading,
+    vba: &Tracks2d,
+    net: &NetworkFrames,
+    out: &Tracks2d,
+    t: usize,
+    j: Joint,
+) -> [f64; FEATURE_COUNT] {
+    let n = out.frames.len();
+    let f = &out.frames[t];
+    let torso = clip.torso[t];
+    let p = f.points[j].pos;
+    let off = |q: nalgebra::Point2<f64>| ((p - q).norm() / torso).min(1.0);
+    let seen = net.get(t).and_then(|s| s.joints.as_ref());
+    let (net_off, net_unsure, swap) = match seen.map(|s| (s[j], s[other_side(j)])) {
+        Some((own, other)) => {
+            let swapped = off(other.pos) + 0.05 < off(own.pos);
+            (
+                off(own.pos),
+                1.0 - own.confidence,
+                if swapped { 1.0 } else { 0.0 },
+            )
+        }
+        None => (1.0, 1.0, 0.0),
+    };
+    let jump = if t > 0 && t + 1 < n {
+        let mid = nalgebra::center(
+            &out.frames[t - 1].points[j].pos,
+            &out.frames[t + 1].points[j].pos,
+        );
+        off(mid)
+    } else {
+        0.0
+    };
+    let median = clip.median[j];
+    let length = match bone(out, &clip.torso, t, j) {
+        Some(l) if median > 1e-6 && l > 1e-6 => (l / median).ln().abs().min(2.0),
+        _ => 0.0,
+    };
+    let key_near = clip.key_frames[j]
+        .iter()
+        .map(|&k| k.abs_diff(t))
+        .min()
+        .map_or(0.0, |d| (-(d as f64) / KEY_NEAR_FRAMES).exp());
+    let shoulders = seen.map_or(0.0, |s| {
+        ((s[Joint::LeftShoulder].pos - s[Joint::RightShoulder].pos).norm() / torso).min(1.0)
+    });
+    let lost = match f.points[j].source {
+        PointSource::Tracked => 0.0,
+        _ => 1.0,
+    };
+    [
+        off(vba.frames[t].points[j].pos),
+        net_off,
+        net_unsure,
+        jump,
+        length,
+        key_near,
+        shoulders,
+        swap,
+        lost,
+    ]
 }

@@ -95,32 +95,7 @@ impl HeadPredictor {
             return HeadMotion { alpha_deg, ..still };
         }
         // Runs of the profile above a·p (small gaps of ≤ 2 samples bridged).
-        let cut = a * self.p;
-        let mut runs: Vec<(usize, usize, f64)> = Vec::new(); // start, end (inclusive), mass
-        let mut i = 0;
-        while i < profile.len() {
-            if profile[i] > cut {
-                let start = i;
-                let mut end = i;
-                let mut mass = 0.0;
-                let mut gap = 0;
-                while i < profile.len() && gap <= 2 {
-                    if profile[i] > cut {
-                        end = i;
-                        gap = 0;
-                    } else {
-                        gap += 1;
-                    }
-                    i += 1;
-                }
-                for v in &profile[start..=end] {
-                    mass += v;
-                }
-                runs.push((start, end, mass));
-            } else {
-                i += 1;
-            }
-        }
+        let mut runs = runs_above(&profile, a * self.p);
         if runs.len() < 2 {
             return HeadMotion { alpha_deg, ..still };
         }
@@ -152,6 +127,34 @@ impl HeadPredictor {
         }
         .clamp(P_RANGE.0, P_RANGE.1);
     }
+}
+
+/// The runs of `profile` above `cut` (gaps of up to 2 samples below it bridged): each its
+/// first and last sample above the cut and its mass (the profile summed over the run).
+fn runs_above(profile: &[f64], cut: f64) -> Vec<(usize, usize, f64)> {
+    let mut runs = Vec::new();
+    let mut i = 0;
+    while i < profile.len() {
+        if profile[i] > cut {
+            let start = i;
+            let mut end = i;
+            let mut gap = 0;
+            while i < profile.len() && gap <= 2 {
+                if profile[i] > cut {
+                    end = i;
+                    gap = 0;
+                } else {
+                    gap += 1;
+                }
+                i += 1;
+            }
+            let mass: f64 = profile[start..=end].iter().sum();
+            runs.push((start, end, mass));
+        } else {
+            i += 1;
+        }
+    }
+    runs
 }
 
 #[cfg(test)]
