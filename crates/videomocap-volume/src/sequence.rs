@@ -64,20 +64,58 @@ pub fn assemble(
     fps: f64,
 ) -> Assembled {
     let mut warnings = Vec::new();
-    let name = |i: usize| names.get(i).map_or("?", String::as_str);
     for (i, r) in results.iter().enumerate() {
         if let Err(e) = r {
             warnings.push(format!(
                 "frame {i} ({}): {e}; interpolated or left out",
-                name(i)
+                frame_name(names, i)
             ));
         }
     }
-    // 0. The clip's up: the mean trunk direction (pelvis → neck) of the frames whose curve
-    //    showed all five limbs (of every frame with a pose when none did). A frame whose trunk
-    //    points more than a right angle away from it was named upside down (a leg taken for
-    //    the head when an arm lies against the trunk): it is left out like a frame without a
-    //    pose.
+    let upright = upright(results, names, &mut warnings);
+    let (labelled, order, sides_from) = labels_and_sides(&upright, names, &mut warnings);
+    let fraction = limb_fractions(&labelled);
+    let placed = place_arms(&upright, &labelled, names, &mut warnings);
+    let poses: Vec<Option<PerJoint<Point3<f64>>>> = (0..placed.len())
+        .map(|i| joints(upright[i], placed[i].as_ref(), &fraction))
+        .collect();
+    let mut frames = interpolate(&poses);
+    let bone_lengths_m = make_rigid(&mut frames);
+    Assembled {
+        skeleton: Skeleton3d {
+            // The volume has no camera; a nominal one keeps the file format whole.
+            camera: PinholeCamera::centred(1000.0, 1000, 1000),
+            fps: Some(fps),
+            bone_lengths_m,
+            frames,
+        },
+        slots: order,
+        warnings,
+        sides_from,
+    }
+}
+
+/// Frame `i`'s name in warnings.
+fn frame_name(names: &[String], i: usize) -> &str {
+    names.get(i).map_or("?", String::as_str)
+}
+
+/// A frame's labelled limbs (left arm, right arm, left leg, right leg; an arm `None` where the
+/// curve did not show it), `None` for a frame without a labelled pose.
+type Slots = Option<[Option<Limb>; 4]>;
+
+/// Which fitted limb of a frame went to each slot (see [`Assembled::slots`]).
+type SlotOrder = Option<[Option<usize>; 4]>;
+
+/// Step 0: The clip's up: the mean trunk direction (pelvis → neck) of the frames whose curve showed
+/// all five limbs (of every frame with a pose when none did). A frame whose trunk points more
+/// than a right angle away from it was named upside down (a leg taken for the head when an arm
+/// lies against the trunk): it is left out like a frame without a pose.
+fn upright<'a>(
+    results: &'a [Result<FrameResult, FrameProblem>],
+    names: &[String],
+    warnings: &mut Vec<String>,
+) -> Vec<Option<&'a FrameResult>> {
     let trunk = |f: &FrameResult| (f.fit.torso.b - f.fit.pelvis).try_normalize(1e-9);
     let mean_up = |five: bool| -> Option<Vector3<f64>> {
         results
@@ -89,7 +127,7 @@ pub fn assemble(
             .try_normalize(1e-9)
     };
     let clip_up = mean_up(true).or_else(|| mean_up(false));
-    let results: Vec<Option<&FrameResult>> = results
+    results
         .iter()
         .enumerate()
         .map(|(i, r)| {
@@ -99,18 +137,26 @@ pub fn assemble(
             {
                 warnings.push(format!(
                     "frame {i} ({}): the trunk named points against the clip's up (upside down); interpolated or left out",
-                    name(i)
+                    frame_name(names, i)
                 ));
                 return None;
             }
             Some(f)
         })
-        .collect();
-    // 1. Labels and sides: left = up × front, where front is the way knees bend (or, if no knee ever
-    //    bends, the opposite of the way elbows bend), and the arms take the side of the leg
-    //    below them. Each frame's cues price its labellings; the labels are then chosen over
-    //    the whole clip (see `labels`), the cues with the continuity of the limbs, and frames
-    //    whose limbs do not follow from the frames around them are left out.
+        .collect()
+}
+
+/// Step 1: Labels and sides: left = up × front, where front is the way knees bend (or, if no knee
+/// ever bends, the opposite of the way elbows bend), and the arms take the side of the leg
+/// below them. Each frame's cues price its labellings; the labels are then chosen over the
+/// whole clip (see `labels`), the cues with the continuity of the limbs, and frames whose
+/// limbs do not follow from the frames around them are left out. Returns each frame's labelled
+/// limbs, which fitted limb went to each slot, and how the sides were decided.
+fn labels_and_sides(
+    results: &[Option<&FrameResult>],
+    names: &[String],
+    warnings: &mut Vec<String>,
+) -> (Vec<Slots>, Vec<SlotOrder>, SidesFrom) {
     let bends = |pair: [usize; 2], sign: f64| {
         move |f: &FrameResult| -> Vec<Vector3<f64>> {
             pair.iter()
@@ -150,31 +196,32 @@ pub fn assemble(
         }
         cost
     };
-    let labels = super::labels::label(&results, &cue);
+    let labels = super::labels::label(results, &cue);
     for &i in &labels.left_out {
         warnings.push(format!(
             "frame {i} ({}): its parts do not follow from the frames around it under any labelling (misnamed); interpolated or left out",
-            name(i)
+            frame_name(names, i)
         ));
     }
     let order = labels.order;
-    let results: Vec<Option<&FrameResult>> = results
-        .iter()
-        .zip(&order)
-        .map(|(r, o)| r.filter(|_| o.is_some()))
+    let labelled = (0..results.len())
+        .map(|i| {
+            let (Some(f), Some(o)) = (results[i], order[i]) else {
+                return None;
+            };
+            Some(o.map(|k| k.and_then(|k| f.fit.limbs[k])))
+        })
         .collect();
-    let labelled = |i: usize| -> Option<[Option<Limb>; 4]> {
-        let (Some(f), Some(o)) = (results[i], order[i]) else {
-            return None;
-        };
-        Some(o.map(|k| k.and_then(|k| f.fit.limbs[k])))
-    };
+    (labelled, order, sides_from)
+}
 
-    // 2. Static lengths from articulated frames.
+/// Step 2: Static lengths from articulated frames: per slot, the upper segment's share of the limb
+/// (the subject model's where no frame bent the limb), to place the elbow or knee of a
+/// straight limb.
+fn limb_fractions(labelled: &[Slots]) -> [f64; 4] {
     let mut sums = [[0.0f64; 2]; 4];
     let mut counts = [0usize; 4];
-    for i in 0..results.len() {
-        let Some(limbs) = labelled(i) else { continue };
+    for limbs in labelled.iter().flatten() {
         for (k, l) in limbs.iter().enumerate() {
             if let Some(l) = l
                 && let Some(s) = l.split
@@ -200,114 +247,132 @@ pub fn assemble(
         };
         u / (u + l)
     };
-    let fraction: [f64; 4] = std::array::from_fn(|k| {
+    std::array::from_fn(|k| {
         if counts[k] > 0 {
             sums[k][0] / (sums[k][0] + sums[k][1]).max(1e-12)
         } else {
             default_fraction(k)
         }
-    });
-    // The chest joint (sternum) sits on the trunk axis at the subject's proportion of the way
-    // from the neck to the pelvis; the chest branch node itself lies at the shoulders.
-    let chest_fraction = {
-        let neck_chest = model.length_to(Joint::Neck);
-        let chest_pelvis = model.length_to(Joint::Chest);
-        neck_chest / (neck_chest + chest_pelvis)
-    };
+    })
+}
 
-    // 3. Arms the curve did not show are placed from the frames that saw them (see `place_unseen`).
-    let seen: Vec<Option<[Option<Limb>; 4]>> = (0..results.len()).map(labelled).collect();
-    let trunk_frames: Vec<Option<TrunkFrame>> = (0..results.len())
-        .map(|i| {
-            let (Some(f), Some(l)) = (results[i], &seen[i]) else {
-                return None;
-            };
-            TrunkFrame::new(f, l)
-        })
+/// Step 3: Arms the curve did not show (in `seen`, the labelled limbs of `results`), placed from
+/// the frames that saw them (see `place_unseen`), each with a warning.
+fn place_arms(
+    results: &[Option<&FrameResult>],
+    seen: &[Slots],
+    names: &[String],
+    warnings: &mut Vec<String>,
+) -> Vec<Slots> {
+    let trunk_frames: Vec<Option<TrunkFrame>> = results
+        .iter()
+        .zip(seen)
+        .map(|(f, l)| TrunkFrame::new((*f)?, l.as_ref()?))
         .collect();
-    let mut placed = seen.clone();
+    let mut placed = seen.to_vec();
     for slot in 0..2 {
-        for i in 0..results.len() {
+        for i in 0..seen.len() {
             let (Some(Some(limbs)), Some(trunk)) = (placed.get(i), &trunk_frames[i]) else {
                 continue;
             };
             if limbs[slot].is_some() {
                 continue;
             }
-            let (limb, how) = place_unseen(slot, i, &seen, &trunk_frames, trunk, limbs);
+            let (limb, how) = place_unseen(slot, i, seen, &trunk_frames, trunk, limbs);
             let side = if slot == 0 { "left" } else { "right" };
             warnings.push(format!(
                 "frame {i} ({}): the {side} arm lies against the trunk (the skeleton curve has no branch for it); {how}",
-                name(i)
+                frame_name(names, i)
             ));
             if let Some(Some(l)) = placed.get_mut(i) {
                 l[slot] = Some(limb);
             }
         }
     }
+    placed
+}
 
-    // 4. The 16 joints.
-    let pose = |i: usize| -> Option<PerJoint<Point3<f64>>> {
-        let (Some(f), Some(Some(limbs))) = (results[i], placed.get(i)) else {
-            return None;
-        };
-        let limbs: [Limb; 4] = [limbs[0]?, limbs[1]?, limbs[2]?, limbs[3]?];
-        let mid = |k: usize| {
-            let l = &limbs[k];
-            l.split
-                .unwrap_or_else(|| l.root + (l.end - l.root) * fraction[k])
-        };
-        use Joint::*;
-        Some(PerJoint::from_fn(|j| match j {
-            HeadTop => f.fit.head_top,
-            Neck => f.fit.torso.b,
-            Chest => f.fit.torso.b + (f.fit.pelvis - f.fit.torso.b) * chest_fraction,
-            Pelvis => f.fit.pelvis,
-            LeftShoulder => limbs[0].root,
-            LeftElbow => mid(0),
-            LeftWrist => limbs[0].end,
-            RightShoulder => limbs[1].root,
-            RightElbow => mid(1),
-            RightWrist => limbs[1].end,
-            LeftHip => limbs[2].root,
-            LeftKnee => mid(2),
-            LeftAnkle => limbs[2].end,
-            RightHip => limbs[3].root,
-            RightKnee => mid(3),
-            RightAnkle => limbs[3].end,
-        }))
+/// Step 4: A frame's 16 joints from its fit and its four placed limbs (`fraction`: each limb's
+/// upper share, for a straight one). The chest joint (sternum) sits on the trunk axis at the
+/// subject's proportion of the way from the neck to the pelvis; the chest branch node itself
+/// lies at the shoulders.
+fn joints(
+    f: Option<&FrameResult>,
+    limbs: Option<&[Option<Limb>; 4]>,
+    fraction: &[f64; 4],
+) -> Option<PerJoint<Point3<f64>>> {
+    let (f, limbs) = (f?, limbs?);
+    let limbs: [Limb; 4] = [limbs[0]?, limbs[1]?, limbs[2]?, limbs[3]?];
+    let model = SubjectModel::default();
+    let chest_fraction = {
+        let neck_chest = model.length_to(Joint::Neck);
+        let chest_pelvis = model.length_to(Joint::Chest);
+        neck_chest / (neck_chest + chest_pelvis)
     };
-    let poses: Vec<Option<PerJoint<Point3<f64>>>> = (0..results.len()).map(pose).collect();
+    let mid = |k: usize| {
+        let l = &limbs[k];
+        l.split
+            .unwrap_or_else(|| l.root + (l.end - l.root) * fraction[k])
+    };
+    use Joint::*;
+    Some(PerJoint::from_fn(|j| match j {
+        HeadTop => f.fit.head_top,
+        Neck => f.fit.torso.b,
+        Chest => f.fit.torso.b + (f.fit.pelvis - f.fit.torso.b) * chest_fraction,
+        Pelvis => f.fit.pelvis,
+        LeftShoulder => limbs[0].root,
+        LeftElbow => mid(0),
+        LeftWrist => limbs[0].end,
+        RightShoulder => limbs[1].root,
+        RightElbow => mid(1),
+        RightWrist => limbs[1].end,
+        LeftHip => limbs[2].root,
+        LeftKnee => mid(2),
+        LeftAnkle => limbs[2].end,
+        RightHip => limbs[3].root,
+        RightKnee => mid(3),
+        RightAnkle => limbs[3].end,
+    }))
+}
+
+/// The frames from the first posed to the last: a frame without a pose interpolated between
+/// its posed neighbours (flagged `interpolated`).
+fn interpolate(poses: &[Option<PerJoint<Point3<f64>>>]) -> Vec<Frame3d> {
     let good: Vec<usize> = (0..poses.len()).filter(|&i| poses[i].is_some()).collect();
     let mut frames = Vec::new();
-    if let (Some(&first), Some(&last)) = (good.first(), good.last()) {
-        let mut before = first;
-        for i in first..=last {
-            if let Some(p) = &poses[i] {
-                before = i;
-                frames.push(Frame3d {
-                    index: FrameIndex(i),
-                    points: *p,
-                    flags: Vec::new(),
-                });
-                continue;
-            }
-            // Invariant: a good frame follows (i < last and `last` is good).
-            let after = (i + 1..=last).find(|&k| poses[k].is_some()).unwrap_or(last);
-            let (Some(a), Some(b)) = (&poses[before], &poses[after]) else {
-                continue;
-            };
-            let t = (i - before) as f64 / (after - before) as f64;
+    let (Some(&first), Some(&last)) = (good.first(), good.last()) else {
+        return frames;
+    };
+    let mut before = first;
+    for i in first..=last {
+        if let Some(p) = &poses[i] {
+            before = i;
             frames.push(Frame3d {
                 index: FrameIndex(i),
-                points: PerJoint::from_fn(|j| a[j] + (b[j] - a[j]) * t),
-                flags: vec!["interpolated".to_owned()],
+                points: *p,
+                flags: Vec::new(),
             });
+            continue;
         }
+        // Invariant: a good frame follows (i < last and `last` is good).
+        let after = (i + 1..=last).find(|&k| poses[k].is_some()).unwrap_or(last);
+        let (Some(a), Some(b)) = (&poses[before], &poses[after]) else {
+            continue;
+        };
+        let t = (i - before) as f64 / (after - before) as f64;
+        frames.push(Frame3d {
+            index: FrameIndex(i),
+            points: PerJoint::from_fn(|j| a[j] + (b[j] - a[j]) * t),
+            flags: vec!["interpolated".to_owned()],
+        });
     }
-    // Static lengths (§4's second pass): each bone's median length over the frames; every
-    // frame is rebuilt outwards from the pelvis keeping its bone directions, so that the
-    // skeleton is rigid (and its BVH reproduces it exactly).
+    frames
+}
+
+/// Static lengths (§4's second pass): each bone's median length over the frames; every frame
+/// is rebuilt outwards from the pelvis keeping its bone directions, so that the skeleton is
+/// rigid (and its BVH reproduces it exactly). Returns the lengths by bone key.
+fn make_rigid(frames: &mut [Frame3d]) -> BTreeMap<String, f64> {
     let lengths: Vec<f64> = Bone::ALL
         .iter()
         .map(|b| {
@@ -320,7 +385,7 @@ pub fn assemble(
             v.get(v.len() / 2).copied().unwrap_or(0.01)
         })
         .collect();
-    for f in &mut frames {
+    for f in frames.iter_mut() {
         let old = f.points;
         for (b, len) in Bone::ALL.iter().zip(&lengths) {
             let dir = (old[b.child] - old[b.parent])
@@ -329,23 +394,11 @@ pub fn assemble(
             f.points[b.child] = f.points[b.parent] + dir * *len;
         }
     }
-    let bone_lengths_m: BTreeMap<String, f64> = Bone::ALL
+    Bone::ALL
         .iter()
         .zip(&lengths)
         .map(|(b, l)| (b.key(), l.max(1e-6)))
-        .collect();
-    Assembled {
-        skeleton: Skeleton3d {
-            // The volume has no camera; a nominal one keeps the file format whole.
-            camera: PinholeCamera::centred(1000.0, 1000, 1000),
-            fps: Some(fps),
-            bone_lengths_m,
-            frames,
-        },
-        slots: order,
-        warnings,
-        sides_from,
-    }
+        .collect()
 }
 
 /// A frame's trunk axes: origin at the pelvis, `up` towards the neck, `across` along the hips
