@@ -116,202 +116,282 @@ impl PassContext<'_, '_> {
     }
     /// Tracks over `order` (consecutive frames, forwards or backwards), starting from `pose` on
     /// its first frame and re-started with the hand-placed joints at every key frame on the way
-    /// (the parts they touch; the others go on as they were, `BodyTracker::restart`); returns the results in video pixels, one per frame of `order` (the first is the starting
-    /// pose), and where the pass arrived on each key frame before it was re-started there.
+    /// (the parts they touch; the others go on as they were, `BodyTracker::restart`); returns
+    /// the results in video pixels, one per frame of `order` (the first is the starting pose),
+    /// and where the pass arrived on each key frame before it was re-started there.
     pub(crate) fn pass(
         &mut self,
         order: &[usize],
         pose: &PerJoint<Point2<f64>>,
     ) -> Result<PassOutput, TrackError> {
+        let frames = FrameCheck {
+            path: self.path.clone(),
+            width: self.width,
+            height: self.height,
+        };
+        let mut stepper = Stepper {
+            tracker: None,
+            start: pose,
+            scale: self.scale,
+            params: self.params,
+            background: self.background.clone(),
+            keys: self.keys,
+            cancel: self.cancel,
+            path: self.path.clone(),
+            proportions: Proportions::default(),
+            arrivals: BTreeMap::new(),
+        };
+        let (scale, total) = (self.scale, self.total);
+        let mut out = Vec::with_capacity(order.len());
+        let mut done = self.done;
+        let progress = &mut *self.progress;
+        let mut take = |index: usize, image: Option<Arc<RgbImage>>| -> Result<(), TrackError> {
+            let r = stepper.step(index, image)?;
+            done += 1;
+            emit(progress, done, total, index, &r);
+            out.push(r);
+            Ok(())
+        };
+        if self.threads <= 1 {
+            for &index in order {
+                let image = decoded(self.video, index, &frames, scale)?;
+                if image.is_none() {
+                    self.damaged.push(index);
+                }
+                take(index, image)?;
+            }
+        } else {
+            decode_ahead(
+                self.video,
+                order,
+                &frames,
+                scale,
+                &mut self.damaged,
+                &mut take,
+            )?;
+        }
+        self.done = done;
+        Ok(PassOutput {
+            results: out,
+            arrivals: stepper.arrivals,
+        })
+    }
+}
+
+/// Tells the progress callback that frame `index` is done, with its joints `r`.
+fn emit(
+    progress: &mut (dyn FnMut(&TrackProgress) + Send),
+    done: usize,
+    total: usize,
+    index: usize,
+    r: &PerJoint<JointResult>,
+) {
+    progress(&TrackProgress {
+        done,
+        total,
+        frame: Some(FrameTracks {
+            index: FrameIndex(index),
+            body3d: None,
+            points: r.map(|_, j| TrackedPoint {
+                pos: j.pos,
+                confidence: j.reliability,
+                source: PointSource::Tracked,
+            }),
+        }),
+    });
+}
+
+/// The size a pass's frames must arrive at, and the file to name when one does not.
+struct FrameCheck {
+    path: PathBuf,
+    width: u32,
+    height: u32,
+}
+
+impl FrameCheck {
+    /// An error naming the file and frame when `image` is not the size the pass began at.
+    fn check(&self, index: usize, image: &RgbImage) -> Result<(), TrackError> {
+        if image.width() != self.width || image.height() != self.height {
+            Err(TrackError::FrameSize {
+                path: self.path.clone(),
+                frame: index,
+                got_w: image.width(),
+                got_h: image.height(),
+                width: self.width,
+                height: self.height,
+            })
+        } else {
+            Ok(())
+        }
+    }
+}
+
+/// Frame `index` of `video`, checked and shrunk to the working scale; `None` where the file is
+/// damaged.
+fn decoded(
+    video: &mut Video,
+    index: usize,
+    frames: &FrameCheck,
+    scale: Scale,
+) -> Result<Option<Arc<RgbImage>>, TrackError> {
+    undamaged(video.frame(index))?
+        .map(|frame| {
+            frames.check(index, &frame.image)?;
+            Ok(scale.shrink(frame.image))
+        })
+        .transpose()
+}
+
+/// Decodes (and shrinks) the frames of `order` on another thread while `take` tracks them
+/// here, in order; damaged frames are noted in `damaged`.
+fn decode_ahead(
+    video: &mut Video,
+    order: &[usize],
+    frames: &FrameCheck,
+    scale: Scale,
+    damaged: &mut Vec<usize>,
+    take: &mut dyn FnMut(usize, Option<Arc<RgbImage>>) -> Result<(), TrackError>,
+) -> Result<(), TrackError> {
+    let stop_flag = AtomicBool::new(false);
+    let stop = &stop_flag;
+    std::thread::scope(|s| -> Result<(), TrackError> {
+        let (tx, rx) = std::sync::mpsc::sync_channel::<Decoded>(6);
+        s.spawn(move || send_decoded(video, order, frames, scale, &tx, stop));
+        let result = (|| {
+            for _ in 0..order.len() {
+                let (index, image) = rx.recv().map_err(|_| TrackError::Cancelled)??;
+                if image.is_none() {
+                    damaged.push(index);
+                }
+                take(index, image)?;
+            }
+            Ok(())
+        })();
+        stop.store(true, Ordering::Relaxed);
+        drop(rx);
+        result
+    })
+}
+
+/// A frame decoded ahead: its index and image (`None` where the file is damaged), or an error.
+type Decoded = Result<(usize, Option<Arc<RgbImage>>), TrackError>;
+
+/// The decoding thread: a forward chunk is sent frame by frame as decoded; a backward one is
+/// gathered and sent in reverse. Stops when `stop` is set or the receiver has gone.
+fn send_decoded(
+    video: &mut Video,
+    order: &[usize],
+    frames: &FrameCheck,
+    scale: Scale,
+    tx: &std::sync::mpsc::SyncSender<Decoded>,
+    stop: &AtomicBool,
+) {
+    for chunk in decode_order(order) {
+        let mut images = Vec::with_capacity(if chunk.reverse { chunk.decode.len() } else { 0 });
+        for &index in &chunk.decode {
+            if stop.load(Ordering::Relaxed) {
+                return;
+            }
+            let item = decoded(video, index, frames, scale).map(|image| (index, image));
+            if chunk.reverse {
+                images.push(item);
+            } else if tx.send(item).is_err() {
+                return;
+            }
+        }
+        if chunk.reverse {
+            images.reverse();
+        }
+        for item in images {
+            if tx.send(item).is_err() {
+                return;
+            }
+        }
+    }
+}
+
+/// The body tracker stepping through one pass's frames: started on the first from `start`,
+/// re-started at each key frame on the way.
+struct Stepper<'a> {
+    tracker: Option<BodyTracker>,
+    /// The pass's starting pose, video pixels.
+    start: &'a PerJoint<Point2<f64>>,
+    scale: Scale,
+    params: Tuning,
+    background: Option<Arc<Background>>,
+    keys: &'a KeyFrames,
+    cancel: &'a AtomicBool,
+    path: PathBuf,
+    proportions: Proportions,
+    /// Where the pass arrived on each key frame before it was re-started there.
+    arrivals: BTreeMap<usize, PerJoint<JointResult>>,
+}
+
+impl Stepper<'_> {
+    /// Frame `index`'s joints in video pixels. A damaged frame (`image` `None`) keeps the last
+    /// pose, lost: the tracker waits for the next frame.
+    fn step(
+        &mut self,
+        index: usize,
+        image: Option<Arc<RgbImage>>,
+    ) -> Result<PerJoint<JointResult>, TrackError> {
+        if self.cancel.load(Ordering::Relaxed) {
+            return Err(TrackError::Cancelled);
+        }
         let scale = self.scale;
-        let params = self.params;
-        let background = self.background.clone();
-        let keys = self.keys;
-        let cancel = self.cancel;
-        let (path, width, height) = (self.path.clone(), self.width, self.height);
         let to_video = |r: PerJoint<JointResult>| {
             r.map(|_, j| JointResult {
                 pos: scale.to_video(j.pos),
                 reliability: j.reliability,
             })
         };
-        let mut out = Vec::with_capacity(order.len());
-        let mut arrivals = BTreeMap::new();
-        let mut tracker: Option<BodyTracker> = None;
-        let proportions = Proportions::default();
-        let check = |index: usize, image: &RgbImage| {
-            if image.width() != width || image.height() != height {
-                Err(TrackError::FrameSize {
-                    path: path.clone(),
+        let Some(image) = image else {
+            let t = self
+                .tracker
+                .as_ref()
+                .ok_or_else(|| TrackError::StartFrameDamaged {
+                    path: self.path.clone(),
                     frame: index,
-                    got_w: image.width(),
-                    got_h: image.height(),
-                    width,
-                    height,
-                })
-            } else {
-                Ok(())
-            }
+                })?;
+            return Ok(to_video(t.pose().map(|_, j| JointResult {
+                pos: j.pos,
+                reliability: 0.0,
+            })));
         };
-        let mut handle = |ctx_done: &mut usize,
-                          index: usize,
-                          image: Option<Arc<RgbImage>>|
-         -> Result<PerJoint<JointResult>, TrackError> {
-            if cancel.load(Ordering::Relaxed) {
-                return Err(TrackError::Cancelled);
+        let Some(t) = self.tracker.as_mut() else {
+            let work = self.start.map(|_, p| scale.to_work(*p));
+            let t = BodyTracker::new(
+                &image,
+                &work,
+                &self.proportions,
+                self.params,
+                self.background.clone(),
+            );
+            let mut r = t.pose();
+            for j in Joint::ALL {
+                r[j].reliability = 1.0;
             }
-            let Some(image) = image else {
-                // A damaged frame: the last pose, lost; the tracker waits for the next frame.
-                let t = tracker
-                    .as_ref()
-                    .ok_or_else(|| TrackError::StartFrameDamaged {
-                        path: path.clone(),
-                        frame: index,
-                    })?;
-                *ctx_done += 1;
-                return Ok(to_video(t.pose().map(|_, j| JointResult {
-                    pos: j.pos,
-                    reliability: 0.0,
-                })));
-            };
-            let result = match tracker.as_mut() {
-                None => {
-                    let work = pose.map(|_, p| scale.to_work(*p));
-                    let t =
-                        BodyTracker::new(&image, &work, &proportions, params, background.clone());
-                    let mut r = t.pose();
-                    for j in Joint::ALL {
-                        r[j].reliability = 1.0;
-                    }
-                    tracker = Some(t);
-                    r
+            self.tracker = Some(t);
+            return Ok(to_video(r));
+        };
+        let mut r = t.step(&image);
+        if let Some(key) = self.keys.frames.get(&FrameIndex(index)) {
+            self.arrivals.insert(index, to_video(r));
+            let tracked = r.map(|_, j| j.pos);
+            let work_keys = key.map(|_, k| k.map(|p| scale.to_work(p)));
+            let fixed = tracked.map(|j, p| work_keys[j].unwrap_or(*p));
+            let placed = work_keys.map(|_, k| k.is_some());
+            t.restart(&image, &fixed, &placed, &self.proportions);
+            for j in Joint::ALL {
+                if work_keys[j].is_some() {
+                    r[j] = JointResult {
+                        pos: fixed[j],
+                        reliability: 1.0,
+                    };
                 }
-                Some(t) => {
-                    let mut r = t.step(&image);
-                    if keys.frames.contains_key(&FrameIndex(index)) {
-                        arrivals.insert(index, to_video(r));
-                        let tracked = r.map(|_, j| j.pos);
-                        let work_keys =
-                            keys.frames[&FrameIndex(index)].map(|_, k| k.map(|p| scale.to_work(p)));
-                        let fixed = tracked.map(|j, p| work_keys[j].unwrap_or(*p));
-                        let placed = work_keys.map(|_, k| k.is_some());
-                        t.restart(&image, &fixed, &placed, &proportions);
-                        for j in Joint::ALL {
-                            if work_keys[j].is_some() {
-                                r[j] = JointResult {
-                                    pos: fixed[j],
-                                    reliability: 1.0,
-                                };
-                            }
-                        }
-                    }
-                    r
-                }
-            };
-            *ctx_done += 1;
-            Ok(to_video(result))
-        };
-        let mut done = self.done;
-        let total = self.total;
-        let progress = &mut *self.progress;
-        let mut emit = |done: usize, index: usize, r: &PerJoint<JointResult>| {
-            progress(&TrackProgress {
-                done,
-                total,
-                frame: Some(FrameTracks {
-                    index: FrameIndex(index),
-                    body3d: None,
-                    points: r.map(|_, j| TrackedPoint {
-                        pos: j.pos,
-                        confidence: j.reliability,
-                        source: PointSource::Tracked,
-                    }),
-                }),
-            });
-        };
-        let damaged = &mut self.damaged;
-        if self.threads <= 1 {
-            for &index in order {
-                let image = match undamaged(self.video.frame(index))? {
-                    Some(frame) => {
-                        check(index, &frame.image)?;
-                        Some(scale.shrink(frame.image))
-                    }
-                    None => {
-                        damaged.push(index);
-                        None
-                    }
-                };
-                let r = handle(&mut done, index, image)?;
-                emit(done, index, &r);
-                out.push(r);
             }
-        } else {
-            // Decode (and shrink) ahead on another thread.
-            let video = &mut *self.video;
-            let order_owned = order.to_vec();
-            let stop_flag = AtomicBool::new(false);
-            let stop = &stop_flag;
-            std::thread::scope(|s| -> Result<(), TrackError> {
-                type Decoded = Result<(usize, Option<Arc<RgbImage>>), TrackError>;
-                let (tx, rx) = std::sync::mpsc::sync_channel::<Decoded>(6);
-                s.spawn(move || {
-                    for chunk in decode_order(&order_owned) {
-                        // A forward chunk is sent frame by frame as decoded; a backward one
-                        // is gathered and sent in reverse.
-                        let mut images =
-                            Vec::with_capacity(if chunk.reverse { chunk.decode.len() } else { 0 });
-                        for &index in &chunk.decode {
-                            if stop.load(Ordering::Relaxed) {
-                                return;
-                            }
-                            let item = undamaged(video.frame(index)).and_then(|frame| {
-                                frame
-                                    .map(|frame| {
-                                        check(index, &frame.image)?;
-                                        Ok(scale.shrink(frame.image))
-                                    })
-                                    .transpose()
-                                    .map(|image| (index, image))
-                            });
-                            if chunk.reverse {
-                                images.push(item);
-                            } else if tx.send(item).is_err() {
-                                return;
-                            }
-                        }
-                        if chunk.reverse {
-                            images.reverse();
-                        }
-                        for item in images {
-                            if tx.send(item).is_err() {
-                                return;
-                            }
-                        }
-                    }
-                });
-                let result = (|| {
-                    for _ in 0..order.len() {
-                        let (index, image) = rx.recv().map_err(|_| TrackError::Cancelled)??;
-                        if image.is_none() {
-                            damaged.push(index);
-                        }
-                        let r = handle(&mut done, index, image)?;
-                        emit(done, index, &r);
-                        out.push(r);
-                    }
-                    Ok(())
-                })();
-                stop.store(true, Ordering::Relaxed);
-                drop(rx);
-                result
-            })?;
         }
-        self.done = done;
-        Ok(PassOutput {
-            results: out,
-            arrivals,
-        })
+        Ok(to_video(r))
     }
 }
 
