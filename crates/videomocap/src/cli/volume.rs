@@ -10,20 +10,7 @@ use std::sync::atomic::AtomicBool;
 use videomocap_volume::{SequenceError, VolumeParams, process_directory};
 
 pub(super) fn run(a: &VolumeArgs, global: &GlobalArgs) -> Result<(), ExitError> {
-    let meta = std::fs::metadata(&a.input)
-        .map_err(|e| ExitError::bad_input(anyhow!("{}: cannot open: {e}", a.input.display())))?;
-    if !meta.is_dir() {
-        return Err(ExitError::bad_input(anyhow!(
-            "{}: expected a directory of per-frame point clouds (.ply, .xyz, .voxels.json)",
-            a.input.display()
-        )));
-    }
-    if !(a.fps.is_finite() && a.fps > 0.0) {
-        return Err(ExitError::bad_input(anyhow!(
-            "--fps must be positive, got {}",
-            a.fps
-        )));
-    }
+    check_args(a)?;
     let params = VolumeParams::default();
     let bar = progress_bar(global, 0, "volumes");
     let processed = process_directory(
@@ -49,6 +36,41 @@ pub(super) fn run(a: &VolumeArgs, global: &GlobalArgs) -> Result<(), ExitError> 
     let skeleton_path = a.out_dir.join("skeleton3d.json");
     let skeleton = &processed.assembled.skeleton;
     skeleton.save(&skeleton_path).map_err(ExitError::failed)?;
+    summary(&processed, global);
+    say(global, &format!("wrote {}", skeleton_path.display()));
+    let outputs = Outputs3d {
+        bvh: Some(a.out_dir.join("motion.bvh")),
+        csv: Some(a.out_dir.join("joints3d.csv")),
+        trc: Some(a.out_dir.join("motion.trc")),
+        rig: a.rig,
+    };
+    let written = write_3d(skeleton, &skeleton_path, None, &outputs)?;
+    report_3d(&written, global);
+    Ok(())
+}
+
+/// The input must be a directory and the frame rate positive.
+fn check_args(a: &VolumeArgs) -> Result<(), ExitError> {
+    let meta = std::fs::metadata(&a.input)
+        .map_err(|e| ExitError::bad_input(anyhow!("{}: cannot open: {e}", a.input.display())))?;
+    if !meta.is_dir() {
+        return Err(ExitError::bad_input(anyhow!(
+            "{}: expected a directory of per-frame point clouds (.ply, .xyz, .voxels.json)",
+            a.input.display()
+        )));
+    }
+    if !(a.fps.is_finite() && a.fps > 0.0) {
+        return Err(ExitError::bad_input(anyhow!(
+            "--fps must be positive, got {}",
+            a.fps
+        )));
+    }
+    Ok(())
+}
+
+/// How many frames gave a curve and a pose, the time per frame, and how the articulated fit
+/// went.
+fn summary(processed: &videomocap_volume::Processed, global: &GlobalArgs) {
     let (five, ok) = (processed.five_limb_frames(), processed.posed_frames());
     let (iso, rest) = processed
         .results
@@ -89,14 +111,4 @@ pub(super) fn run(a: &VolumeArgs, global: &GlobalArgs) -> Result<(), ExitError> 
             "warning: the articulated fit could not start (no frame with a five-limb curve and points); the skeleton is the curve's",
         ),
     }
-    say(global, &format!("wrote {}", skeleton_path.display()));
-    let outputs = Outputs3d {
-        bvh: Some(a.out_dir.join("motion.bvh")),
-        csv: Some(a.out_dir.join("joints3d.csv")),
-        trc: Some(a.out_dir.join("motion.trc")),
-        rig: a.rig,
-    };
-    let written = write_3d(skeleton, &skeleton_path, None, &outputs)?;
-    report_3d(&written, global);
-    Ok(())
 }
