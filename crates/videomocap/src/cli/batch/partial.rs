@@ -4,7 +4,8 @@
 //! A process that is killed (a Slurm time limit, `scancel`, a power cut) leaves its temporary
 //! folders behind. Each holds an owner file (host, pid, id) that a live process rewrites every
 //! [`HEARTBEAT`]; every batch run removes the temporary folders whose owner is dead: a process
-//! of this host that no longer exists, or, from any host (a cluster's nodes share the output
+//! of this host that no longer exists (named by the owner file, or by the folder's name when a
+//! process was killed before it wrote the file), or, from any host (a cluster's nodes share the output
 //! folder but not their process tables), an owner file older than [`STALE_AFTER`].
 
 use serde::{Deserialize, Serialize};
@@ -103,16 +104,29 @@ fn process_exists(pid: u32) -> Option<bool> {
         .then(|| Path::new(&format!("/proc/{pid}")).exists())
 }
 
+/// The process of this host (`here`) whose folder `dir` is, read from the folder's name
+/// (`<prefix><id>-<host>-<pid>`): a folder without its owner file yet (killed between making
+/// the folder and writing the file) or any more (sealed) still names its writer.
+fn pid_in_name(dir: &Path, here: &str) -> Option<u32> {
+    let name = dir.file_name()?.to_str()?;
+    let (rest, pid) = name.rsplit_once('-')?;
+    let pid: u32 = pid.parse().ok()?;
+    rest.ends_with(&format!("-{here}")).then_some(pid)
+}
+
 /// Whether a temporary folder's writer is gone, from its owner file (or, without one, the
-/// folder's own time).
+/// writer named by the folder's name, else the folder's own time).
 fn is_dead(dir: &Path, here: &str, now: SystemTime) -> bool {
     let owner_path = dir.join(OWNER);
     let owner: Option<Owner> = std::fs::read_to_string(&owner_path)
         .ok()
         .and_then(|t| serde_json::from_str(&t).ok());
-    if let Some(o) = &owner
-        && o.host == here
-        && let Some(exists) = process_exists(o.pid)
+    let local_pid = match &owner {
+        Some(o) => (o.host == here).then_some(o.pid),
+        None => pid_in_name(dir, here),
+    };
+    if let Some(pid) = local_pid
+        && let Some(exists) = process_exists(pid)
     {
         return !exists;
     }
@@ -195,6 +209,33 @@ mod tests {
         let later = SystemTime::now() + STALE_AFTER + Duration::from_secs(1);
         assert!(is_dead(&elsewhere, &here, later));
         assert!(!is_dead(&live.path, &here, later), "a live local pid wins");
+    }
+
+    #[test]
+    fn a_folder_killed_before_its_owner_file_names_its_dead_writer() {
+        let out = tempfile::tempdir().expect("temp dir");
+        let here = host_name();
+        let mut child = std::process::Command::new("true").spawn().expect("true");
+        let dead_pid = child.id();
+        child.wait().expect("wait");
+        // Made, then killed before the owner file was written (an id with dashes in it).
+        let dead = out
+            .path()
+            .join(format!(".partial-take-2-{here}-{dead_pid}"));
+        std::fs::create_dir_all(&dead).expect("dir");
+        // This process's folder without its owner file (sealed): alive.
+        let live = out
+            .path()
+            .join(format!(".partial-x-{here}-{}", std::process::id()));
+        std::fs::create_dir_all(&live).expect("dir");
+        // Another host's without an owner file, made just now: it may be running there.
+        let elsewhere = out
+            .path()
+            .join(format!(".partial-y-other{here}-{dead_pid}"));
+        std::fs::create_dir_all(&elsewhere).expect("dir");
+        assert_eq!(remove_dead(out.path()), 1);
+        assert!(!dead.exists());
+        assert!(live.exists() && elsewhere.exists());
     }
 
     #[test]
