@@ -228,3 +228,50 @@ fn the_network_run_ahead_of_vba_changes_nothing() {
         assert!(without.network.unwrap().iter().all(|f| f.crop.is_some()));
     }
 }
+
+/// The network is left out where it adds nothing (issue 95, item 3): sitting down, some
+/// frames go without it, never two in a row nor on the marked frame, and each has the
+/// network's evidence all the same (its neighbours' midway, or the network after all); the
+/// marks and a correction of a limb on a frame left out stay where they were placed, and that
+/// correction leaves the network's chain as it was: every frame keeps its crop, and a frame the
+/// network ran on in both runs saw the same (a re-track runs none of them again).
+#[test]
+fn the_network_is_left_out_on_some_frames_and_keys_stay_where_they_were_placed() {
+    let dir = tempfile::tempdir().unwrap();
+    let clip = render_small_clip(dir.path(), ProceduralMotion::SitDown, 16, View::Oblique).unwrap();
+    let marks = Marks::load(&clip.marks).unwrap();
+    let network = Arc::new(PoseNetwork::bundled().unwrap());
+    let mut video = Video::open(&clip.video, &OpenOptions::default()).unwrap();
+    let job = TrackJob::from_marks(&marks, TrackerParams::default(), 2)
+        .with_network(Some(network.clone()));
+    let first = track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false)).unwrap();
+    let seen = first.network.clone().unwrap();
+    let left_out: Vec<usize> = (0..seen.len()).filter(|&t| seen[t].skipped).collect();
+    assert!(!left_out.is_empty(), "no frame left out");
+    assert!(!seen[0].skipped);
+    assert!(left_out.windows(2).all(|w| w[1] > w[0] + 1), "{left_out:?}");
+    assert!(left_out.iter().all(|&t| seen[t].joints.is_some()));
+    for j in Joint::ALL {
+        assert_eq!(first.tracks.frames[0].points[j].pos, marks.points[j]);
+    }
+    // The left wrist corrected on a frame left out.
+    let t = left_out[0];
+    let mut keys = KeyFrames::from_marks(&marks);
+    let moved =
+        first.tracks.frames[t].points[Joint::LeftWrist].pos + nalgebra::Vector2::new(4.0, 0.0);
+    keys.set(FrameIndex(t), Joint::LeftWrist, moved);
+    let retrack = TrackJob {
+        keys,
+        previous_network: Some(seen.clone()),
+        ..job
+    };
+    let again = track_video(&mut video, &retrack, &mut |_| {}, &AtomicBool::new(false)).unwrap();
+    assert_eq!(again.tracks.frames[t].points[Joint::LeftWrist].pos, moved);
+    let after = again.network.unwrap();
+    for (s, (a, b)) in seen.iter().zip(&after).enumerate() {
+        assert_eq!(a.crop, b.crop, "frame {s}");
+        if !a.skipped && !b.skipped {
+            assert_eq!(a, b, "frame {s}");
+        }
+    }
+}

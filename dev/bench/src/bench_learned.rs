@@ -167,6 +167,8 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         "clip", "split", "VBA", "net", "together"
     )];
     let (mut net_seconds, mut net_frames) = (0.0, 0usize);
+    // The product's frames the network's chain left out, of all its frames.
+    let mut product_frames = [0.0; 2];
     let mut clip_scores = Vec::with_capacity(clips.len());
     let mut dump = vec![format!(
         "clip,frame,joint,{},off",
@@ -174,7 +176,7 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     )];
     for clip in &clips {
         say(global, &format!("{} …", clip.name));
-        let (s, full, seconds) = score_clip(
+        let (s, full, [seconds, skipped, frames]) = score_clip(
             clip,
             threads,
             params,
@@ -184,6 +186,8 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             a.doubt_dump.is_some().then_some(&mut dump),
         )?;
         net_seconds += seconds;
+        product_frames[0] += skipped;
+        product_frames[1] += frames;
         net_frames += count_frames(clip)?;
         lines.push(format!(
             "{:<26} {:<5}               {:>6.3} {:>6.3} {:>9.3}",
@@ -229,6 +233,14 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         1000.0 * net_seconds / net_frames.max(1) as f64,
         net_frames as f64 / net_seconds.max(1e-9)
     ));
+    if product_frames[1] > 0.0 {
+        lines.push(format!(
+            "together: the network left out on {:.0} of {:.0} frames ({:.1} %)",
+            product_frames[0],
+            product_frames[1],
+            100.0 * product_frames[0] / product_frames[1]
+        ));
+    }
     for l in lines {
         println!("{l}");
     }
@@ -431,7 +443,7 @@ fn score_clip(
     settings: &[EvidenceParams],
     reuse: bool,
     dump: Option<&mut Vec<String>>,
-) -> Result<(Scores, [ClipScore; 3], f64), ExitError> {
+) -> Result<(Scores, [ClipScore; 3], [f64; 3]), ExitError> {
     let gt = GroundTruth::load(&clip.dir.join("gt.json")).map_err(ExitError::failed)?;
     let marks = Marks::load(&clip.dir.join("marks.json")).map_err(ExitError::failed)?;
     let clicked = clicked_marks(&marks, CLICK_NOISE_PX, &clip.name);
@@ -440,15 +452,18 @@ fn score_clip(
         vba_and_network(clip, threads, params, &network, &clicked, &keys, reuse)?;
     // Together as the product tracks (`track_video` with the network), unless only the
     // weighing is swept from the caches.
+    let (mut skipped, mut frames) = (0, 0);
     let product = if reuse {
         weigh(&vba, &net, &keys, &EvidenceParams::default())
     } else {
         let mut video = Video::open(&clip.dir.join("video.mp4"), &OpenOptions::default())
             .map_err(ExitError::failed)?;
         let job = TrackJob::from_marks(&clicked, params, threads).with_network(Some(network));
-        track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false))
-            .map_err(ExitError::failed)?
-            .tracks
+        let out = track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false))
+            .map_err(ExitError::failed)?;
+        let seen = out.network.unwrap_or_default();
+        (skipped, frames) = (seen.iter().filter(|f| f.skipped).count(), seen.len());
+        out.tracks
     };
     if let Some(dump) = dump {
         dump_doubt(dump, clip, &gt, &vba, &net, &keys, &product);
@@ -476,5 +491,9 @@ fn score_clip(
             &score_tracks(&gt, &together).map_err(ExitError::failed)?,
         ));
     }
-    Ok(((scores, pointing), full, net_seconds))
+    Ok((
+        (scores, pointing),
+        full,
+        [net_seconds, skipped as f64, frames as f64],
+    ))
 }

@@ -8,11 +8,17 @@
 //! the last two happens: those frames can be run before VBA's passes end. The worker runs them
 //! and stops each chain where it would need VBA, going on from the next full key frame.
 //!
+//! It leaves out the frames the chain's rule leaves out (`chain::may_skip`, which reads only the
+//! keys and the network's output, so it skips what `run_network` skips), and once the chain is
+//! done runs the skipped frames the network's own checks send back to it
+//! (`chain::needs_network` without VBA), while VBA may still be running.
+//!
 //! What it finds is only a cache for `run_network` (a frame is taken from it when its crop is
 //! exactly the one `run_network` makes there, the network's output depending on nothing else):
 //! the result is the same whether the worker got far, not far, or did not run at all, however
 //! the threads were scheduled.
 
+use super::chain::{SkipRule, may_skip, needs_network, skipped};
 use super::evidence::{NetFrame, NetworkFrames, look, refuses};
 use crate::formats::{FrameIndex, KeyFrames};
 use crate::network::{Crop, PoseNetwork};
@@ -34,12 +40,18 @@ pub(crate) fn run_ahead(
 ) -> Vec<Option<NetFrame>> {
     let n = video.info().frame_count;
     let previous = previous.filter(|p| p.len() == n);
+    let rule = SkipRule::default();
     let mut out: Vec<Option<NetFrame>> = vec![None; n];
     // The crop the chain proposes for frame `t` (`None`: no chain runs there).
     let mut next: Option<Crop> = None;
-    for (t, slot) in out.iter_mut().enumerate() {
-        if stop.load(Ordering::Relaxed) || cancel.load(Ordering::Relaxed) {
+    let halted = || stop.load(Ordering::Relaxed) || cancel.load(Ordering::Relaxed);
+    for t in 0..n {
+        if halted() {
             break;
+        }
+        if next.is_some() && may_skip(&rule, keys, n, t, |s| out[s].as_ref()) {
+            out[t] = Some(skipped(next));
+            continue;
         }
         let key = keys.frames.get(&FrameIndex(t));
         // A full key's crop: VBA's body there is the marks themselves.
@@ -60,7 +72,21 @@ pub(crate) fn run_ahead(
             continue;
         }
         next = frame.next;
-        *slot = Some(frame);
+        out[t] = Some(frame);
+    }
+    // The skipped frames the network's own checks send back to it.
+    for t in 1..n.saturating_sub(1) {
+        let Some(crop) = out[t].as_ref().filter(|f| f.skipped).map(|f| f.crop) else {
+            continue;
+        };
+        if halted() {
+            break;
+        }
+        if out[t + 1].is_some()
+            && needs_network(&rule, out[t - 1].as_ref(), out[t + 1].as_ref(), None)
+        {
+            out[t] = Some(look(video, network, t, crop, previous));
+        }
     }
     out
 }
@@ -83,6 +109,7 @@ pub(crate) fn merged(
                     joints: None,
                     next: None,
                     world: None,
+                    skipped: false,
                 })
         })
         .collect()

@@ -5,7 +5,6 @@
 //! other-side point (its left/right swaps), by dynamic programming: each candidate's own
 //! confidence, the continuity of the motion, and keys that always win.
 
-use super::shared::TrackError;
 use crate::camera::point_in_frame;
 use crate::formats::{
     FrameIndex, FrameTracks, KeyFrames, NetworkBody, PointSource, TrackedPoint, Tracks2d,
@@ -14,7 +13,6 @@ use crate::network::{Crop, NetJoint, PoseNetwork};
 use crate::skeleton::{Joint, PerJoint};
 use crate::video::Video;
 use nalgebra::{Point2, Vector3};
-use std::sync::atomic::{AtomicBool, Ordering};
 
 /// How the evidence is weighed. Costs are in the unit of one torso² of motion between frames.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -64,6 +62,10 @@ pub struct NetFrame {
     /// no person, or a cache written before the body was kept).
     #[serde(default)]
     pub world: Option<PerJoint<Vector3<f64>>>,
+    /// Not run: the chain left the frame out (`track::chain`); its joints, if any, are its two
+    /// neighbours' midway, and `crop` the one it would have been shown.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub skipped: bool,
 }
 
 impl NetFrame {
@@ -84,49 +86,7 @@ pub type NetworkFrames = Vec<NetFrame>;
 /// network follows someone else, or nobody: the frame is shown the marked body instead.
 const REFUSED_TORSO: f64 = 0.5;
 
-/// Runs the network on every frame of `video`, each crop the one the network proposed on the
-/// frame before (its own tracking region), so that it follows the person the user marked: on a
-/// key frame with every joint placed, after a frame where it found no person, and where a key's
-/// pelvis or head top is far from the network's (it followed someone else), the crop is made
-/// from VBA's body there (with the user's joints). A frame whose crop is exactly the one it had
-/// in `reuse` (an earlier run on this video) is taken from it instead of run again. `tick` is
-/// called once per frame.
-pub fn run_network(
-    video: &mut Video,
-    tracks: &Tracks2d,
-    network: &PoseNetwork,
-    keys: &KeyFrames,
-    reuse: Option<&NetworkFrames>,
-    tick: &mut dyn FnMut(),
-    cancel: &AtomicBool,
-) -> Result<NetworkFrames, TrackError> {
-    let n = tracks.frames.len();
-    let previous = reuse.filter(|p| p.len() == n);
-    let mut out: NetworkFrames = Vec::with_capacity(n);
-    let mut next: Option<Crop> = None;
-    for (t, f) in tracks.frames.iter().enumerate() {
-        if cancel.load(Ordering::Relaxed) {
-            return Err(TrackError::Cancelled);
-        }
-        tick();
-        let key = keys.frames.get(&f.index);
-        let full = key.is_some_and(|k| k.iter().all(|(_, p)| p.is_some()));
-        let marked = || Crop::around(&f.points.map(|_, p| p.pos));
-        let crop = match next {
-            Some(c) if !full => Some(c),
-            _ => marked(),
-        };
-        let mut frame = look(video, network, t, crop, previous);
-        if key.is_some_and(|k| !full && refuses(k, &frame)) && crop != marked() {
-            frame = look(video, network, t, marked(), previous);
-        }
-        next = frame.next;
-        out.push(frame);
-    }
-    Ok(out)
-}
-
-/// What the network sees on frame `t` in `crop`: taken from `reuse` when it holds frame `t`
+/// What the network sees on frame `t` in `crop`: taken from `reuse` when it ran on frame `t`
 /// with exactly that crop (the network's output depends on nothing else), else run.
 pub(crate) fn look(
     video: &mut Video,
@@ -141,9 +101,13 @@ pub(crate) fn look(
             joints: None,
             next: None,
             world: None,
+            skipped: false,
         };
     };
-    if let Some(b) = reuse.and_then(|p| p.get(t)).filter(|b| b.crop == Some(c)) {
+    if let Some(b) = reuse
+        .and_then(|p| p.get(t))
+        .filter(|b| b.crop == Some(c) && !b.skipped)
+    {
         return b.clone();
     }
     let pose = video
@@ -156,6 +120,7 @@ pub(crate) fn look(
         next: pose.as_ref().and_then(|p| p.next_crop),
         world: pose.as_ref().map(|p| p.world),
         joints: pose.map(|p| p.joints),
+        skipped: false,
     }
 }
 
@@ -431,6 +396,7 @@ mod tests {
                     confidence: 0.95,
                 })),
                 next: None,
+                skipped: false,
             })
             .collect()
     }
@@ -482,6 +448,7 @@ mod tests {
                 joints: None,
                 next: None,
                 world: None,
+                skipped: false,
             };
             20
         ];
@@ -506,6 +473,7 @@ mod tests {
                 joints: None,
                 next: None,
                 world: None,
+                skipped: false,
             };
             12
         ];

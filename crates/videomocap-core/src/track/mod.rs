@@ -14,6 +14,7 @@
 //! - `limb`: one limb chain per frame, upper then lower segment, refined as one figure
 //! - `body`: the top-down tracker (head → trunk → limbs)
 //! - `evidence`: the pose network's evidence weighed in
+//! - `chain`: the network's chain over the clip, run only where it adds
 //! - `ahead`: the network run on its own thread while VBA's passes run
 //! - `doubt`: the evidence of each joint-frame's doubt, for calibrating it (`bench learned
 //!   --doubt-dump`)
@@ -28,6 +29,7 @@ mod ahead;
 mod background;
 mod block;
 mod body;
+mod chain;
 mod doubt;
 mod evidence;
 mod frame;
@@ -44,8 +46,9 @@ mod shared;
 mod similarity;
 pub(crate) mod smooth;
 
+pub use chain::run_network;
 pub use doubt::{DOUBT_FEATURES, FEATURE_COUNT, doubt_features};
-pub use evidence::{EvidenceParams, NetFrame, NetworkFrames, run_network, weigh};
+pub use evidence::{EvidenceParams, NetFrame, NetworkFrames, weigh};
 pub use occlusion::{SpanKind, WeakSpan, weak_spans};
 pub use params::TrackerParams;
 pub use run::{KeyFrames, TrackJob, TrackOutput, track_video};

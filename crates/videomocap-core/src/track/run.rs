@@ -18,7 +18,8 @@
 use super::ahead::{merged, run_ahead};
 use super::background::KnownBackground;
 use super::body::{JointResult, stature_px};
-use super::evidence::{EvidenceParams, NetworkFrames, flag_jumps, run_network, weigh};
+use super::chain::run_network;
+use super::evidence::{EvidenceParams, NetworkFrames, flag_jumps, weigh};
 use super::fuse::fuse;
 use super::occlusion::{WeakSpan, fill_weak_runs, weak_spans};
 use super::params::TrackerParams;
