@@ -155,6 +155,28 @@ fn network_alone(
     Ok(out)
 }
 
+/// The per-view table: VBA, the network and the two together per clip (`clip_scores`), and
+/// MediaPipe when it ran.
+fn view_table(
+    clips: &[BenchClip],
+    clip_scores: &[[ClipScore; 3]],
+    mediapipe: Option<&[ClipScore]>,
+) -> crate::bench_views::ViewTable {
+    let mut views = crate::bench_views::ViewTable::new(if mediapipe.is_some() {
+        &["VBA", "net", "together", "MediaPipe"]
+    } else {
+        &["VBA", "net", "together"]
+    });
+    for (k, (clip, full)) in clips.iter().zip(clip_scores).enumerate() {
+        let mut row: Vec<&ClipScore> = full.iter().collect();
+        if let Some(mp) = mediapipe {
+            row.push(&mp[k]);
+        }
+        views.add(clip, &row);
+    }
+    views
+}
+
 /// Runs the comparison and prints its tables.
 pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let (threads, params) = threads_and_settings(a)?;
@@ -204,18 +226,7 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         std::fs::write(path, dump.join("\n") + "\n").map_err(ExitError::failed)?;
     }
     let mediapipe = crate::bench_baselines::mediapipe_scores(&clips, &a.suite_dir, global)?;
-    let mut views = crate::bench_views::ViewTable::new(if mediapipe.is_some() {
-        &["VBA", "net", "together", "MediaPipe"]
-    } else {
-        &["VBA", "net", "together"]
-    });
-    for (k, (clip, full)) in clips.iter().zip(&clip_scores).enumerate() {
-        let mut row: Vec<&ClipScore> = full.iter().collect();
-        if let Some(mp) = &mediapipe {
-            row.push(&mp[k]);
-        }
-        views.add(clip, &row);
-    }
+    let views = view_table(&clips, &clip_scores, mediapipe.as_deref());
     lines.extend(tables(&tally, a.reuse, mediapipe.is_some(), &views));
     lines.push(String::new());
     lines.extend(opencv_table(&clips, a, global)?);

@@ -183,17 +183,6 @@ pub fn weigh(
     params: &EvidenceParams,
 ) -> Tracks2d {
     let n = tracks.frames.len();
-    // Frames to the nearest key of joint `j`, for the key's fading certainty: a key that places
-    // other joints leaves this one's VBA track as it was (a correction of one joint moves no
-    // other, issue 90).
-    let to_key = |index: FrameIndex, j: Joint| {
-        keys.frames
-            .iter()
-            .filter(|(_, k)| k[j].is_some())
-            .map(|(k, _)| k.get().abs_diff(index.get()))
-            .min()
-            .map_or(f64::INFINITY, |d| d as f64)
-    };
     // The body's size on each frame, for the motion costs: the larger of VBA's torso and the
     // network's (a VBA trunk that collapsed onto a point would make every move of the
     // network's joints look huge).
@@ -214,48 +203,7 @@ pub fn weigh(
     }
     for j in Joint::ALL {
         let candidates: Vec<Vec<Candidate>> = (0..n)
-            .map(|t| {
-                let f = &tracks.frames[t];
-                let p = f.points[j];
-                let keyed = keys.frames.get(&f.index).and_then(|k| k[j]);
-                let vba_doubt = if keyed.is_some() {
-                    0.0
-                } else {
-                    let r = match p.source {
-                        PointSource::Lost => 0.0,
-                        _ => f64::from(p.confidence),
-                    };
-                    params.vba_doubt
-                        * (1.0 - r)
-                        * (1.0 - (-to_key(f.index, j) / params.key_fade_frames).exp())
-                };
-                let mut c = vec![Candidate {
-                    pos: p.pos,
-                    cost: vba_doubt,
-                    confidence: p.confidence,
-                    from_network: false,
-                }];
-                // A joint VBA carried off the frame stays off it: at the image's edge the network
-                // puts an arm that left inside the frame, and sure of it.
-                if keyed.is_some() || p.source == PointSource::OffFrame {
-                    return c;
-                }
-                if let Some(pose) = net.get(t).and_then(|f| f.joints.as_ref()) {
-                    for (side, extra) in [(j, 0.0), (other_side(j), params.swap_cost)] {
-                        if side == j && extra > 0.0 {
-                            continue;
-                        }
-                        let q = pose[side];
-                        c.push(Candidate {
-                            pos: q.pos,
-                            cost: params.net_doubt * (1.0 - q.confidence) + extra,
-                            confidence: q.confidence as f32,
-                            from_network: true,
-                        });
-                    }
-                }
-                c
-            })
+            .map(|t| candidates(tracks, net, keys, params, t, j))
             .collect();
         let chosen = choose(&candidates, &torso, params);
         for (t, c) in chosen.into_iter().enumerate() {
@@ -275,6 +223,71 @@ pub fn weigh(
         }
     }
     out
+}
+
+/// Frames from `index` to the nearest key of joint `j`, for the key's fading certainty: a key
+/// that places other joints leaves this one's VBA track as it was (a correction of one joint
+/// moves no other, issue 90).
+fn to_key(keys: &KeyFrames, index: FrameIndex, j: Joint) -> f64 {
+    keys.frames
+        .iter()
+        .filter(|(_, k)| k[j].is_some())
+        .map(|(k, _)| k.get().abs_diff(index.get()))
+        .min()
+        .map_or(f64::INFINITY, |d| d as f64)
+}
+
+/// Joint `j`'s candidates on frame `t`: VBA's place, its doubt growing as its reliability
+/// falls and its key fades; then, unless the joint is keyed or VBA carried it off the frame,
+/// the network's joint and its other-side joint (for a swap).
+fn candidates(
+    tracks: &Tracks2d,
+    net: &NetworkFrames,
+    keys: &KeyFrames,
+    params: &EvidenceParams,
+    t: usize,
+    j: Joint,
+) -> Vec<Candidate> {
+    let f = &tracks.frames[t];
+    let p = f.points[j];
+    let keyed = keys.frames.get(&f.index).and_then(|k| k[j]);
+    let vba_doubt = if keyed.is_some() {
+        0.0
+    } else {
+        let r = match p.source {
+            PointSource::Lost => 0.0,
+            _ => f64::from(p.confidence),
+        };
+        params.vba_doubt
+            * (1.0 - r)
+            * (1.0 - (-to_key(keys, f.index, j) / params.key_fade_frames).exp())
+    };
+    let mut c = vec![Candidate {
+        pos: p.pos,
+        cost: vba_doubt,
+        confidence: p.confidence,
+        from_network: false,
+    }];
+    // A joint VBA carried off the frame stays off it: at the image's edge the network puts an
+    // arm that left inside the frame, and sure of it.
+    if keyed.is_some() || p.source == PointSource::OffFrame {
+        return c;
+    }
+    if let Some(pose) = net.get(t).and_then(|f| f.joints.as_ref()) {
+        for (side, extra) in [(j, 0.0), (other_side(j), params.swap_cost)] {
+            if side == j && extra > 0.0 {
+                continue;
+            }
+            let q = pose[side];
+            c.push(Candidate {
+                pos: q.pos,
+                cost: params.net_doubt * (1.0 - q.confidence) + extra,
+                confidence: q.confidence as f32,
+                from_network: true,
+            });
+        }
+    }
+    c
 }
 
 /// A joint further than this (torso lengths) from the middle of its places on the frames

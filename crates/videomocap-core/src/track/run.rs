@@ -19,7 +19,7 @@ use super::ahead::{merged, run_ahead};
 use super::background::KnownBackground;
 use super::body::{JointResult, stature_px};
 use super::chain::run_network;
-use super::evidence::{EvidenceParams, NetworkFrames, flag_jumps, weigh};
+use super::evidence::{EvidenceParams, NetFrame, NetworkFrames, flag_jumps, weigh};
 use super::fuse::fuse;
 use super::occlusion::{WeakSpan, fill_weak_runs, weak_spans};
 use super::params::TrackerParams;
@@ -121,27 +121,8 @@ pub fn track_video(
     let info = video.info().clone();
     let network = job.network.as_deref().filter(|_| job.params.network);
     // 1. VBA's passes, forwards and backwards, made one per joint; meanwhile the network runs
-    // ahead on its own reader of the video where it needs nothing of VBA (`ahead`: a cache for
-    // step 2, the result the same without it).
-    // Only with a second thread to run on: a job given one CPU (a batch task on one core) stays
-    // on one thread (`tests/batch_threads.rs`).
-    let reader = network
-        .filter(|_| job.threads >= 2)
-        .and_then(|_| video.reopen(AHEAD_CACHE_BYTES));
-    let stop = AtomicBool::new(false);
-    let (passes, ahead) = std::thread::scope(|s| {
-        let stop = &stop;
-        let worker = network.zip(reader).map(|(net, mut reader)| {
-            let previous = job.previous_network.as_ref();
-            s.spawn(move || run_ahead(&mut reader, net, &job.keys, previous, stop, cancel))
-        });
-        let passes = track_at_working_scale(video, &info, job, network.is_some(), progress, cancel);
-        if passes.is_err() {
-            stop.store(true, Ordering::Relaxed);
-        }
-        // A worker that panicked leaves no cache: the network's frames are run in step 2.
-        (passes, worker.and_then(|w| w.join().ok()))
-    });
+    // ahead on its own reader of the video where it needs nothing of VBA.
+    let (passes, ahead) = passes_with_network_ahead(video, &info, job, network, progress, cancel);
     if (video.info().width, video.info().height) != (info.width, info.height) {
         // Back to the size the caller had (full size unless it shrank the video itself).
         video.output_size(Some((info.width, info.height)));
@@ -173,20 +154,9 @@ pub fn track_video(
         }
         None => None,
     };
-    // 3. Short weak runs interpolated, long ones reported.
+    // 3.–5. Weak runs filled, smoothing, jumps shown weak.
     let mut frames = tracks.frames;
-    let max_gap = (job.params.max_gap_s * info.fps).round().max(1.0) as usize;
-    let is_key = |f: FrameIndex, j: Joint| job.keys.is_key(f, j);
-    let spans = fill_weak_runs(&mut frames, job.params.weak_reliability, max_gap, &is_key);
-    // 4. Smoothed (when asked for): the filled runs with the rest.
-    smooth_tracks(&mut frames, job.params.smooth_s * info.fps, 0, &is_key);
-    // 5. With the network: a joint that jumps is shown weak where it is (for review).
-    let spans = if net.is_some() {
-        flag_jumps(&mut frames, &job.keys);
-        weak_spans(&frames, job.params.weak_reliability, &is_key)
-    } else {
-        spans
-    };
+    let spans = finish_frames(&mut frames, job, info.fps, net.is_some());
     Ok(TrackOutput {
         damaged,
         background,
@@ -198,6 +168,60 @@ pub fn track_video(
         shrink,
         network: net,
     })
+}
+
+/// [`track_video`]'s first step: VBA's passes ([`track_at_working_scale`]) while the network
+/// runs ahead on its own reader of the video where it needs nothing of VBA (`ahead`: a cache
+/// for the second step, the result the same without it). Only with a second thread to run on:
+/// a job given one CPU (a batch task on one core) stays on one thread
+/// (`tests/batch_threads.rs`). A worker that panicked leaves no cache: the network's frames
+/// are run in the second step.
+fn passes_with_network_ahead(
+    video: &mut Video,
+    info: &VideoInfo,
+    job: &TrackJob,
+    network: Option<&PoseNetwork>,
+    progress: &mut (dyn FnMut(&TrackProgress) + Send),
+    cancel: &AtomicBool,
+) -> (Result<Passes, TrackError>, Option<Vec<Option<NetFrame>>>) {
+    let reader = network
+        .filter(|_| job.threads >= 2)
+        .and_then(|_| video.reopen(AHEAD_CACHE_BYTES));
+    let stop = AtomicBool::new(false);
+    std::thread::scope(|s| {
+        let stop = &stop;
+        let worker = network.zip(reader).map(|(net, mut reader)| {
+            let previous = job.previous_network.as_ref();
+            s.spawn(move || run_ahead(&mut reader, net, &job.keys, previous, stop, cancel))
+        });
+        let passes = track_at_working_scale(video, info, job, network.is_some(), progress, cancel);
+        if passes.is_err() {
+            stop.store(true, Ordering::Relaxed);
+        }
+        (passes, worker.and_then(|w| w.join().ok()))
+    })
+}
+
+/// [`track_video`]'s last steps on the weighed `frames`: short weak runs interpolated and long
+/// ones reported (3), the tracks smoothed when asked, the filled runs with the rest (4), and
+/// with the network (`with_network`) a joint that jumps shown weak where it is, for review
+/// (5). Returns the weak runs to report.
+fn finish_frames(
+    frames: &mut [FrameTracks],
+    job: &TrackJob,
+    fps: f64,
+    with_network: bool,
+) -> Vec<WeakSpan> {
+    let max_gap = (job.params.max_gap_s * fps).round().max(1.0) as usize;
+    let is_key = |f: FrameIndex, j: Joint| job.keys.is_key(f, j);
+    let spans = fill_weak_runs(frames, job.params.weak_reliability, max_gap, &is_key);
+    smooth_tracks(frames, job.params.smooth_s * fps, 0, &is_key);
+    if with_network {
+        flag_jumps(frames, &job.keys);
+        weak_spans(frames, job.params.weak_reliability, &is_key)
+    } else {
+        spans
+    }
 }
 
 /// VBA's result before the network, the filling of weak runs and smoothing.
@@ -386,22 +410,7 @@ fn track_at_working_scale(
         (info.width, info.height)
     };
     let params = job.params.tuning(info.fps, job.threads);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(job.threads.max(1))
-        .build()
-        .ok();
-    // The backward pass runs from the last key frame down to the start of the clip.
-    let last_key = job
-        .keys
-        .frames
-        .keys()
-        .next_back()
-        .map_or(start, |k| k.get());
-    let backward_frames: Vec<usize> = if last_key > 0 {
-        (0..=last_key).rev().collect()
-    } else {
-        Vec::new()
-    };
+    let backward_frames = backward_order(job, start);
     let mut ctx = PassContext {
         video,
         scale,
@@ -418,22 +427,40 @@ fn track_at_working_scale(
         cancel,
         background: None,
     };
-    let tau = params.foreground_tau;
-    let known = job.background.as_ref().and_then(|k| k.get((ww, wh), tau));
-    ctx.background = match known {
-        _ if job.params.arm_foreground <= 0.0 => None,
-        Some(known) => known,
-        None => ctx.estimate_background(n, tau)?.map(Arc::new),
-    };
-    let background = (job.params.arm_foreground > 0.0)
-        .then(|| KnownBackground::new((ww, wh), tau, ctx.background.clone()));
+    let background = with_background(&mut ctx, job, (ww, wh), n)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(job.threads.max(1))
+        .build()
+        .ok();
     let (results, arrivals) = match &pool {
         Some(pool) => {
             pool.install(|| run_passes(&mut ctx, job, &first_pose, start, &backward_frames))?
         }
         None => run_passes(&mut ctx, job, &first_pose, start, &backward_frames)?,
     };
-    // Each joint's frames from the pass that holds there.
+    let tracks = fused(&results, &arrivals, &first_pose, job, info);
+    let mut damaged = std::mem::take(&mut ctx.damaged);
+    damaged.sort_unstable();
+    damaged.dedup();
+    Ok(Passes {
+        tracks,
+        done: ctx.done,
+        total: ctx.total,
+        shrink,
+        damaged,
+        background,
+    })
+}
+
+/// Each joint's frames from the pass that holds there (`fuse`), as tracks of the whole clip.
+fn fused(
+    results: &[PassResults; 2],
+    arrivals: &[Arrivals; 2],
+    first_pose: &PerJoint<Point2<f64>>,
+    job: &TrackJob,
+    info: &VideoInfo,
+) -> Tracks2d {
+    let n = info.frame_count;
     let torso_px = (first_pose[Joint::Neck] - first_pose[Joint::Pelvis]).norm();
     let raw = fuse(
         [&results[0], &results[1]],
@@ -443,7 +470,7 @@ fn track_at_working_scale(
         torso_px,
         job.params.weak_reliability,
     );
-    let frames = frames_of(raw, &first_pose, job, info);
+    let frames = frames_of(raw, first_pose, job, info);
     let source = SourceInfo {
         path: info.path.clone(),
         width: info.width,
@@ -451,17 +478,43 @@ fn track_at_working_scale(
         fps: info.fps,
         frame_count: n,
     };
-    let mut damaged = std::mem::take(&mut ctx.damaged);
-    damaged.sort_unstable();
-    damaged.dedup();
-    Ok(Passes {
-        tracks: Tracks2d { source, frames },
-        done: ctx.done,
-        total: ctx.total,
-        shrink,
-        damaged,
-        background,
-    })
+    Tracks2d { source, frames }
+}
+
+/// The backward pass's frames: from the last key frame down to the start of the clip (none
+/// when the last key is the first frame; `start` when there is no key).
+fn backward_order(job: &TrackJob, start: usize) -> Vec<usize> {
+    let last_key = job
+        .keys
+        .frames
+        .keys()
+        .next_back()
+        .map_or(start, |k| k.get());
+    if last_key > 0 {
+        (0..=last_key).rev().collect()
+    } else {
+        Vec::new()
+    }
+}
+
+/// The static camera's background for the passes (`ctx.background`), at the working `size`:
+/// none when the arms' foreground lane is off, the job's known one when it fits, else
+/// estimated from the clip's `n` frames. Returns it to hand to the next job.
+fn with_background(
+    ctx: &mut PassContext<'_, '_>,
+    job: &TrackJob,
+    size: (u32, u32),
+    n: usize,
+) -> Result<Option<KnownBackground>, TrackError> {
+    let tau = ctx.params.foreground_tau;
+    let known = job.background.as_ref().and_then(|k| k.get(size, tau));
+    ctx.background = match known {
+        _ if job.params.arm_foreground <= 0.0 => None,
+        Some(known) => known,
+        None => ctx.estimate_background(n, tau)?.map(Arc::new),
+    };
+    Ok((job.params.arm_foreground > 0.0)
+        .then(|| KnownBackground::new(size, tau, ctx.background.clone())))
 }
 
 /// A pose with the joints placed by hand on frame `f` put in.
