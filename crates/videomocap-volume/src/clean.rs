@@ -11,8 +11,8 @@
 //!    [`CleanParams::support_radius_m`], horizontally, of a point in the two layers above that.
 //!    Feet and a hand on the floor have a limb over them; the sheet does not.
 //! 2. **Points no neighbouring frame has** (ghost voxels where silhouette cones cross, a
-//!    passer-by's blob joined for one frame): a point stays when the frame before or after has a
-//!    point within [`CleanParams::neighbour_radius_m`] (after step 1).
+//!    passer-by's blob joined for one frame): a point stays when one of the two frames before or
+//!    after has a point within [`CleanParams::neighbour_radius_m`] (after step 1).
 //!
 //! Each frame's pipeline then keeps its largest connected component, as before.
 
@@ -39,7 +39,7 @@ pub struct CleanParams {
     /// it, metres: a foot's reach forward of the shin (0.16: no point within 10 cm of the true
     /// skeleton is removed on the dev carving the rule was drawn on).
     pub support_radius_m: f64,
-    /// A point stays when the frame before or after has a point this near, metres (a limb's
+    /// A point stays when one of the two frames before or after has a point this near, metres (a limb's
     /// travel in one frame at 15 fps: 0.25 removes 12 of 51,000 body voxels of jumping jacks
     /// at 40 mm, 0.2 removes 142).
     pub neighbour_radius_m: f64,
@@ -217,8 +217,10 @@ fn remove_sheet(cloud: &mut Vec<Point3<f64>>, sheet: &Sheet, params: &CleanParam
     before - cloud.len()
 }
 
-/// Per frame, per point: whether the frame before or after has a point within `radius_m`
-/// (every point of a frame whose neighbours are both empty or absent stays).
+/// Per frame, per point: whether one of the two frames before or after has a point within
+/// `radius_m` (two each way: a neighbour missing part of the body, half of it outside the
+/// carving volume, takes nothing off the next; every point of a frame whose neighbours are all
+/// empty or absent stays).
 fn lonely_mask(clouds: &[Vec<Point3<f64>>], radius_m: f64) -> Vec<Vec<bool>> {
     let trees: Vec<Option<ImmutableKdTree<f64, 3>>> = clouds
         .par_iter()
@@ -231,11 +233,12 @@ fn lonely_mask(clouds: &[Vec<Point3<f64>>], radius_m: f64) -> Vec<Vec<bool>> {
     (0..clouds.len())
         .into_par_iter()
         .map(|t| {
-            let near: Vec<&ImmutableKdTree<f64, 3>> = [t.checked_sub(1), Some(t + 1)]
-                .into_iter()
-                .flatten()
-                .filter_map(|s| trees.get(s).and_then(Option::as_ref))
-                .collect();
+            let near: Vec<&ImmutableKdTree<f64, 3>> =
+                [t.checked_sub(2), t.checked_sub(1), Some(t + 1), Some(t + 2)]
+                    .into_iter()
+                    .flatten()
+                    .filter_map(|s| trees.get(s).and_then(Option::as_ref))
+                    .collect();
             clouds[t]
                 .iter()
                 .map(|p| {
