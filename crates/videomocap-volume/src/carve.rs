@@ -1,10 +1,11 @@
 //! Voxel carving (paper §2, after Penny et al.): calibrated cameras and one silhouette mask per
 //! camera; each voxel's pixel in every camera is looked up once (the paper's lookup table), a
-//! voxel is kept when enough silhouettes contain it, and only the largest connected component
-//! survives (§5's clean-up). A carving set-up on disk is a directory holding `cameras.json`
+//! voxel is kept when enough silhouettes contain it, and only one connected component survives
+//! (§5's clean-up: the largest, or the marked person's, followed over the clip). A carving set-up on disk is a directory holding `cameras.json`
 //! (with the box to carve) and `masks/<camera name>/`, one mask image per frame.
 
 use super::VolumeError;
+use super::follow::follow;
 use super::voxel::{Kept, VoxelGrid};
 use image::GrayImage;
 use nalgebra::{Matrix3, Point3, Vector3};
@@ -326,6 +327,13 @@ impl Carver {
         min_votes: usize,
         person: Option<Point3<f64>>,
     ) -> (VoxelGrid, Kept) {
+        let mut grid = self.occupancy(masks, min_votes);
+        let kept = grid.keep_component(person);
+        (grid, kept)
+    }
+
+    /// The voxels at least `min_votes` masks contain, every component kept.
+    fn occupancy(&self, masks: &[GrayImage], min_votes: usize) -> VoxelGrid {
         let mut grid = self.template.clone();
         for (i, o) in grid.occupied.iter_mut().enumerate() {
             let votes = self
@@ -344,15 +352,15 @@ impl Carver {
                 .count();
             *o = votes >= min_votes;
         }
-        let kept = grid.keep_component(person);
-        (grid, kept)
+        grid
     }
 }
 
 /// Carves every frame of `setup` at `voxel_m` (a voxel stays when `min_votes` masks contain it;
-/// `None` = all cameras; the component nearest `person` is kept, or the largest) into
+/// `None` = all cameras; one component kept per frame: the person marked at `person` followed
+/// through the clip (see the `follow` module), or the largest) into
 /// `out_dir/<first camera's mask name>.voxels.json`, frames in parallel, calling
-/// `progress(done, total)`; returns what each frame kept and dropped. Stops at the first
+/// `progress(done, total)` as frames are carved; returns what each frame kept and dropped. Stops at the first
 /// unreadable or wrongly sized mask, naming it; `cancel` stops between frames.
 pub fn carve_sequence(
     setup: &CarvingSetup,
@@ -379,7 +387,7 @@ pub fn carve_sequence(
     std::fs::create_dir_all(out_dir).map_err(VolumeError::io(out_dir))?;
     let done = AtomicUsize::new(0);
     let total = setup.frames.len();
-    (0..total)
+    let blobs: Vec<Vec<Vec<usize>>> = (0..total)
         .into_par_iter()
         .map(|k| {
             if cancel.load(Ordering::Relaxed) {
@@ -388,13 +396,36 @@ pub fn carve_sequence(
                     problem: "cancelled".into(),
                 });
             }
-            let (grid, kept) = carver.carve(&setup.read_masks(k)?, votes, person);
+            let blobs = carver.occupancy(&setup.read_masks(k)?, votes).components();
+            progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+            Ok(blobs)
+        })
+        .collect::<Result<_, _>>()?;
+    let chosen: Vec<Option<usize>> = match person {
+        Some(p) => follow(&carver.template, &blobs, &p),
+        None => blobs
+            .iter()
+            .map(|b| {
+                b.iter()
+                    .enumerate()
+                    .max_by_key(|(_, c)| c.len())
+                    .map(|(k, _)| k)
+            })
+            .collect(),
+    };
+    (0..total)
+        .into_par_iter()
+        .map(|k| {
+            let mut grid = carver.template.clone();
+            for &i in blobs[k].iter().flatten() {
+                grid.occupied[i] = true;
+            }
+            let kept = grid.keep_only(&blobs[k], chosen[k]);
             let stem = setup.frames[k][0].file_stem().map_or_else(
                 || format!("frame_{k:04}"),
                 |s| s.to_string_lossy().into_owned(),
             );
             grid.save(&out_dir.join(format!("{stem}.voxels.json")))?;
-            progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
             Ok(kept)
         })
         .collect()

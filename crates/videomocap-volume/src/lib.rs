@@ -9,8 +9,10 @@
 pub mod articulated;
 pub mod bodies;
 pub mod carve;
+pub mod clean;
 pub mod cloud;
 pub mod curve;
+mod follow;
 mod handles;
 pub mod isomap;
 pub mod labels;
@@ -20,6 +22,7 @@ pub mod voxel;
 
 pub use articulated::{ArticulatedParams, FitPoints, Fitted, fit_points};
 pub use bodies::{BodyFit, BodyParams, Part};
+pub use clean::{CleanParams, Cleaned, clean_clip};
 pub use cloud::{PointCloud, list_frames, read_cloud};
 pub use curve::{CurveParams, SkeletonCurve};
 pub use isomap::{IsomapParams, Neighbourhood};
@@ -95,6 +98,9 @@ pub struct VolumeParams {
     pub curve_points: usize,
     /// The subject's articulated body fitted over the clip.
     pub articulated: ArticulatedParams,
+    /// What carving adds taken off the clip's clouds first (the floor sheet, points no
+    /// neighbouring frame has); `None`: the clouds as read.
+    pub clean: Option<CleanParams>,
 }
 
 impl Default for VolumeParams {
@@ -108,6 +114,7 @@ impl Default for VolumeParams {
             min_points: 100,
             curve_points: usize::MAX,
             articulated: ArticulatedParams::default(),
+            clean: Some(CleanParams::default()),
         }
     }
 }
@@ -261,6 +268,8 @@ pub struct Processed {
     pub curve_skeleton: videomocap_core::formats::Skeleton3d,
     /// The articulated fit, when the curve posed a frame to start it.
     pub fitted: Option<Fitted>,
+    /// What the cleaning took off the clouds before the pipeline.
+    pub cleaned: Cleaned,
 }
 
 impl Processed {
@@ -382,20 +391,25 @@ pub fn process_directory(
     cancel: &AtomicBool,
 ) -> Result<Processed, SequenceError> {
     let files = list_frames(dir)?;
-    let done = AtomicUsize::new(0);
-    let (results, points): (Vec<Result<FrameResult, FrameProblem>>, Vec<FitPoints>) = files
+    let mut clouds: Vec<Result<PointCloud, String>> = files
         .par_iter()
-        .map(|f| {
+        .map(|f| read_cloud(f).map_err(|e| e.to_string()))
+        .collect();
+    let cleaned = clean_read(&mut clouds, params);
+    let done = AtomicUsize::new(0);
+    let (results, points): (Vec<Result<FrameResult, FrameProblem>>, Vec<FitPoints>) = clouds
+        .par_iter()
+        .map(|c| {
             if cancel.load(Ordering::Relaxed) {
                 return (
                     Err(FrameProblem::Unreadable("cancelled".into())),
                     FitPoints::default(),
                 );
             }
-            let r = match read_cloud(f) {
-                Ok(points) => process_frame_for_fit(&points, params),
+            let r = match c {
+                Ok(points) => process_frame_for_fit(points, params),
                 Err(e) => (
-                    Err(FrameProblem::Unreadable(e.to_string())),
+                    Err(FrameProblem::Unreadable(e.clone())),
                     FitPoints::default(),
                 ),
             };
@@ -426,13 +440,34 @@ pub fn process_directory(
                 .into_owned()
         })
         .collect();
-    let (assembled, curve_skeleton, fitted) =
+    let (mut assembled, curve_skeleton, fitted) =
         assemble_and_fit(&results, &points, &names, fps, params);
+    assembled.warnings.extend(cleaned.warnings());
     Ok(Processed {
         files,
         results,
         assembled,
         curve_skeleton,
         fitted,
+        cleaned,
     })
+}
+
+/// The readable clouds of `clouds` cleaned together as `params.clean` says (an unreadable
+/// frame counts as an empty one); what was taken off.
+fn clean_read(clouds: &mut [Result<PointCloud, String>], params: &VolumeParams) -> Cleaned {
+    let Some(clean) = &params.clean else {
+        return Cleaned::default();
+    };
+    let mut readable: Vec<Vec<Point3<f64>>> = clouds
+        .iter_mut()
+        .map(|c| c.as_mut().map(std::mem::take).unwrap_or_default())
+        .collect();
+    let cleaned = clean_clip(&mut readable, clean);
+    for (c, r) in clouds.iter_mut().zip(readable) {
+        if let Ok(c) = c {
+            *c = r;
+        }
+    }
+    cleaned
 }

@@ -93,73 +93,92 @@ impl VoxelGrid {
     /// nearest `near` (the person the user points at), or the largest when `near` is `None`;
     /// says what it dropped.
     pub fn keep_component(&mut self, near: Option<Point3<f64>>) -> Kept {
+        let components = self.components();
+        let chosen = match near {
+            Some(p) => self.nearest_component(&components, &p),
+            None => components
+                .iter()
+                .enumerate()
+                .max_by_key(|(_, c)| c.len())
+                .map(|(k, _)| k),
+        };
+        self.keep_only(&components, chosen)
+    }
+
+    /// The 26-connected components of the occupied voxels (flat indices), in the order of
+    /// their first voxel.
+    pub(crate) fn components(&self) -> Vec<Vec<usize>> {
         let [nx, ny, nz] = self.dims;
-        let mut label = vec![0u32; self.occupied.len()];
-        let mut sizes = vec![0usize]; // label 0 = none
+        let mut seen = vec![false; self.occupied.len()];
+        let mut out = Vec::new();
         let mut stack = Vec::new();
         for start in 0..self.occupied.len() {
-            if !self.occupied[start] || label[start] != 0 {
+            if !self.occupied[start] || seen[start] {
                 continue;
             }
-            let id = sizes.len() as u32;
-            sizes.push(0);
-            label[start] = id;
+            let mut component = Vec::new();
+            seen[start] = true;
             stack.push(start);
             while let Some(i) = stack.pop() {
-                sizes[id as usize] += 1;
+                component.push(i);
                 let (x, y, z) = (i % nx, (i / nx) % ny, i / (nx * ny));
-                for dz in -1i64..=1 {
-                    for dy in -1i64..=1 {
-                        for dx in -1i64..=1 {
-                            let (a, b, c) = (x as i64 + dx, y as i64 + dy, z as i64 + dz);
-                            if a < 0 || b < 0 || c < 0 {
-                                continue;
-                            }
-                            let (a, b, c) = (a as usize, b as usize, c as usize);
-                            if a >= nx || b >= ny || c >= nz {
-                                continue;
-                            }
+                for c in z.saturating_sub(1)..(z + 2).min(nz) {
+                    for b in y.saturating_sub(1)..(y + 2).min(ny) {
+                        for a in x.saturating_sub(1)..(x + 2).min(nx) {
                             let j = self.index(a, b, c);
-                            if self.occupied[j] && label[j] == 0 {
-                                label[j] = id;
+                            if self.occupied[j] && !seen[j] {
+                                seen[j] = true;
                                 stack.push(j);
                             }
                         }
                     }
                 }
             }
+            out.push(component);
         }
-        let chosen = match near {
-            Some(p) => (0..label.len())
-                .filter(|&i| label[i] != 0)
-                .min_by(|&a, &b| {
-                    let d = |i: usize| {
-                        let (x, y, z) = (i % nx, (i / nx) % ny, i / (nx * ny));
-                        (self.centre(x, y, z) - p).norm_squared()
-                    };
-                    d(a).total_cmp(&d(b))
-                })
-                .map(|i| label[i] as usize),
-            None => sizes
-                .iter()
-                .enumerate()
-                .max_by_key(|(_, s)| **s)
-                .map(|(k, _)| k),
-        };
-        let Some(best) = chosen else {
+        out
+    }
+
+    /// Centre of the voxel of flat index `i`.
+    pub(crate) fn centre_of(&self, i: usize) -> Point3<f64> {
+        let [nx, ny, _] = self.dims;
+        self.centre(i % nx, (i / nx) % ny, i / (nx * ny))
+    }
+
+    /// Which of `components` holds the voxel nearest `p` (the first such voxel in grid order).
+    pub(crate) fn nearest_component(
+        &self,
+        components: &[Vec<usize>],
+        p: &Point3<f64>,
+    ) -> Option<usize> {
+        components
+            .iter()
+            .enumerate()
+            .flat_map(|(k, c)| c.iter().map(move |&i| (i, k)))
+            .map(|(i, k)| (i, k, (self.centre_of(i) - p).norm_squared()))
+            .min_by(|a, b| a.2.total_cmp(&b.2).then(a.0.cmp(&b.0)))
+            .map(|(_, k, _)| k)
+    }
+
+    /// Leaves only component `chosen` of `components` occupied (none when `None`); says what
+    /// was dropped.
+    pub(crate) fn keep_only(&mut self, components: &[Vec<usize>], chosen: Option<usize>) -> Kept {
+        let Some(best) = chosen.filter(|&k| k < components.len()) else {
             return Kept::default();
         };
         let mut dropped_voxels = 0;
-        for (o, l) in self.occupied.iter_mut().zip(&label) {
-            if *o && *l as usize != best {
-                *o = false;
-                dropped_voxels += 1;
+        for (k, c) in components.iter().enumerate() {
+            if k != best {
+                dropped_voxels += c.len();
+                for &i in c {
+                    self.occupied[i] = false;
+                }
             }
         }
         Kept {
-            voxels: sizes.get(best).copied().unwrap_or(0),
+            voxels: components[best].len(),
             dropped_voxels,
-            dropped_components: sizes.len().saturating_sub(2),
+            dropped_components: components.len().saturating_sub(1),
         }
     }
 

@@ -28,8 +28,8 @@ pub(crate) enum JobEvent {
     Tracked(Result<TrackOutput, String>),
     /// Lifting finished.
     Lifted(Result<(LiftOutput, Option<SubjectFit>), String>),
-    /// A point-volume sequence was processed.
-    Volume(Result<Processed, String>),
+    /// A point-volume sequence was processed (boxed: far larger than the other events).
+    Volume(Result<Box<Processed>, String>),
     /// The pose network could not be loaded (why): tracking goes on with VBA alone.
     NetworkUnavailable(String),
 }
@@ -151,6 +151,7 @@ impl Job {
                 repaint.request_repaint();
             };
             let result = process_directory(&dir, &VolumeParams::default(), fps, &progress, &flag)
+                .map(Box::new)
                 .map_err(|e| e.to_string());
             let _ = tx.send(JobEvent::Volume(result));
             ctx.request_repaint();

@@ -126,7 +126,7 @@ impl State {
                                 p.posed_frames(),
                                 p.assembled.warnings.len()
                             );
-                            v.set(p);
+                            v.set(*p);
                         }
                         (Err(e), Some(v)) => {
                             v.fail(&e);

@@ -274,8 +274,9 @@ pub struct CarveArgs {
     /// limb one view's segmentation missed, at the cost of a fatter hull).
     #[arg(long)]
     pub min_votes: Option<usize>,
-    /// X,Y,Z (metres, the set-up's world): keep the blob nearest this point, the person the
-    /// carve is for (default: the largest blob). What is dropped is reported.
+    /// X,Y,Z (metres, the set-up's world): the person the carve is for: the blob nearest this
+    /// point on the frame it comes nearest, followed through the clip (on each frame the blob
+    /// continuing the previous frame's); default: the largest blob. What is dropped is reported.
     #[arg(long)]
     pub person: Option<String>,
 }

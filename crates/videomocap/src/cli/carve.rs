@@ -127,7 +127,7 @@ fn report(global: &GlobalArgs, kept: &[Counts], by_person: bool) {
                 kept[most].dropped_voxels,
                 kept[most].dropped_components,
                 if by_person {
-                    "the one nearest --person"
+                    "the person nearest --person, followed over the clip"
                 } else {
                     "the largest (--person X,Y,Z keeps the one nearest a point)"
                 }
