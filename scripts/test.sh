@@ -7,6 +7,7 @@ export PATH="$HOME/.cargo/bin:$PATH"
 cargo fmt --check
 # Each stage's files form a line, not a circle (issue 92).
 python3 scripts/module_cycles.py
+python3 scripts/house_count.py --strict
 cargo clippy --locked --workspace --all-targets --quiet -- -D warnings
 # The stages build without FFmpeg (image sequences only) and never pull in the GUI.
 cargo check --locked -p videomocap-core --no-default-features --quiet

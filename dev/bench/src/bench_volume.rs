@@ -10,7 +10,6 @@ use crate::bench_suite::Merge;
 use crate::bench_suite::{BenchClip, Tally, parse_split};
 use crate::{ExitError, say};
 use rayon::prelude::*;
-use std::time::Instant;
 use videomocap_core::skeleton::SubjectModel;
 use videomocap_testkit::eval::suite::{Split, Suite};
 use videomocap_testkit::eval::volume::{CarveCase, VolumeScore, carve_and_score, score_volume};
@@ -20,8 +19,7 @@ use videomocap_testkit::synth::{
     load_motion, procedural, stature_of, subject_stature, volume_truth, voxelise,
 };
 use videomocap_volume::{
-    VolumeParams, assemble_and_fit, clean_clip, five_limb_frames, process_frame,
-    process_frame_for_fit,
+    VolumeParams, assemble_and_fit, clean_clip, five_limb_frames, process_frame_for_fit,
 };
 
 /// Frames per sequence (the paper's sequences had about 50).
@@ -198,6 +196,20 @@ fn suite_takes(
     global: &GlobalArgs,
     lines: &mut Vec<String>,
 ) -> Result<serde_json::Value, ExitError> {
+    let takes = suite_bench_takes(split, only)?;
+    let mut json = serde_json::Map::new();
+    voxel_tables(&takes, params, only, global, lines, &mut json);
+    carved_tables(&takes, params, only, global, lines, &mut json)?;
+    Ok(serde_json::Value::Object(json))
+}
+
+/// One take of the suite: its name, the clip it stands for in the tables, its motion and the
+/// subject's stature.
+type Take = (String, BenchClip, Motion, f64);
+
+/// The suite v4 takes of `split` (`None`: both) that `only` lets through, each once: its
+/// first clip's body and start, [`FRAMES`] frames at [`FPS`] fps.
+fn suite_bench_takes(split: Option<Split>, only: &Only) -> Result<Vec<Take>, ExitError> {
     let suite = Suite::load(&repo_root()).map_err(ExitError::failed)?;
     let mut takes = Vec::new();
     let mut seen = std::collections::BTreeSet::new();
@@ -224,7 +236,18 @@ fn suite_takes(
         };
         takes.push((clip.take.clone(), bench, motion, stature));
     }
-    let mut json = serde_json::Map::new();
+    Ok(takes)
+}
+
+/// The volumes of the takes at each of [`SUITE_VOXELS`]: a table each into `lines` and `json`.
+fn voxel_tables(
+    takes: &[Take],
+    params: &VolumeParams,
+    only: &Only,
+    global: &GlobalArgs,
+    lines: &mut Vec<String>,
+    json: &mut serde_json::Map<String, serde_json::Value>,
+) {
     for (voxel_m, noise_voxels, hole_fraction) in SUITE_VOXELS {
         let voxel = VoxelParams {
             voxel_m,
@@ -246,7 +269,7 @@ fn suite_takes(
         }
         let mut tally: Tally<Both> = Tally::default();
         let mut per_take = serde_json::Map::new();
-        for (take, bench, motion, stature) in &takes {
+        for (take, bench, motion, stature) in takes {
             say(global, &format!("volumes of take {take} at {label} …"));
             let r = run_sequence(take, motion, *stature, voxel, params);
             let both = Both {
@@ -263,10 +286,21 @@ fn suite_takes(
         let title = format!(
             "suite v4 takes at {label} (the bodies of their first clips, {FRAMES} frames at {FPS} fps)"
         );
-        push_table(lines, &mut json, &title, &label, &tally, per_take, voxel_mm);
+        push_table(lines, json, &title, &label, &tally, per_take, voxel_mm);
     }
-    // Carved from silhouettes: 4 and 8 clean views, and 4 views with the faults of real
-    // segmentation (every mask must hold a voxel, or one may miss it).
+}
+
+/// The takes carved from silhouettes: 4 and 8 clean views, and 4 views with the faults of real
+/// segmentation (every mask must hold a voxel, or one may miss it), of the capsule bodies and
+/// the MakeHuman mesh; a table each into `lines` and `json`.
+fn carved_tables(
+    takes: &[Take],
+    params: &VolumeParams,
+    only: &Only,
+    global: &GlobalArgs,
+    lines: &mut Vec<String>,
+    json: &mut serde_json::Map<String, serde_json::Value>,
+) -> Result<(), ExitError> {
     let faulty = CarveCase {
         faults: SilhouetteFaults::typical(),
         ..CarveCase::clean(4, 0.04)
@@ -289,7 +323,7 @@ fn suite_takes(
         }
         let mut tally: Tally<Both> = Tally::default();
         let mut per_take = serde_json::Map::new();
-        for (take, bench, motion, _) in &takes {
+        for (take, bench, motion, _) in takes {
             say(global, &format!("take {take} carved from {label} …"));
             let r = carve_and_score(motion, &case, params).map_err(ExitError::failed)?;
             let both = Both {
@@ -314,9 +348,9 @@ fn suite_takes(
             "suite v4 takes carved at 40 mm from {label} (640×480 cameras on a ring{what})"
         );
         let key = format!("carved {label}");
-        push_table(lines, &mut json, &title, &key, &tally, per_take, 40.0);
+        push_table(lines, json, &title, &key, &tally, per_take, 40.0);
     }
-    Ok(serde_json::Value::Object(json))
+    Ok(())
 }
 
 /// One table of the suite's takes: `title`, the family rows of `tally` (voxel sizes of
@@ -363,12 +397,27 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
             FPS,
         );
         if only.table("speed") {
-            speed_table(&march, &params, global, &mut lines);
+            crate::bench_volume_speed::speed_table(&march, &params, global, &mut lines);
         }
         print_tables(global, suite_json, &lines);
         return Ok(());
     }
     let motions = motions()?;
+    let mut lines = motion_table(&motions, &params, global);
+    let suite_json = suite_takes(&params, None, &Only::default(), global, &mut lines)?;
+    lines.extend(carved_paper_table(&motions, &params, global)?);
+    crate::bench_volume_speed::speed_table(&motions[0].1, &params, global, &mut lines);
+    print_tables(global, suite_json, &lines);
+    Ok(())
+}
+
+/// The paper's motions and others at 30, 40 and 50 mm voxels: a row each, then the paper's
+/// three and the others summed up.
+fn motion_table(
+    motions: &[(String, Motion, bool)],
+    params: &VolumeParams,
+    global: &GlobalArgs,
+) -> Vec<String> {
     let mut lines = Vec::new();
     lines.push(format!(
         "Volume pipeline accuracy ({FRAMES} frames per sequence at {FPS} fps; error: left/right matched once per sequence, and per frame)"
@@ -389,7 +438,7 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let mut paper_voxels = (0.0, 0usize);
     let mut others = VolumeScore::default();
     for voxel_m in [0.03, 0.04, 0.05] {
-        for (name, motion, is_paper) in &motions {
+        for (name, motion, is_paper) in motions {
             say(
                 global,
                 &format!("{name}, {:.0} mm voxels …", voxel_m * 1000.0),
@@ -398,7 +447,7 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
                 voxel_m,
                 ..VoxelParams::default()
             };
-            let r = run_sequence(name, motion, stature_of(motion), voxel, &params);
+            let r = run_sequence(name, motion, stature_of(motion), voxel, params);
             let s = &r.score;
             lines.push(format!(
                 "{:<20} {:>4.0}mm {:>7.0} {:>8.1}% {:>9.1} {:>9.2} {:>8.1} {:>9.1}% {:>9}",
@@ -435,10 +484,17 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         100.0 * others.consistency()
     ));
     lines.push(String::new());
-    let suite_json = suite_takes(&params, None, &Only::default(), global, &mut lines)?;
+    lines
+}
 
-    // Carved from silhouettes (paper §2): the visual hull is fatter than the body and fills
-    // gaps a camera cannot see through.
+/// The paper's motions carved from 4 and 8 clean views (paper §2): the visual hull is fatter
+/// than the body and fills gaps a camera cannot see through.
+fn carved_paper_table(
+    motions: &[(String, Motion, bool)],
+    params: &VolumeParams,
+    global: &GlobalArgs,
+) -> Result<Vec<String>, ExitError> {
+    let mut lines = Vec::new();
     lines.push(
         "Carved from silhouettes (40 mm voxels; synthetic 640×480 cameras spread over half a turn, 20° down; a voxel stays when every mask holds it)".to_owned(),
     );
@@ -446,13 +502,13 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         "{:<20} {:>6} {:>9} {:>9} {:>9} {:>9} {:>10}",
         "sequence", "views", "voxels", "topology", "mean mm", "voxels", "labels ok"
     ));
-    for (name, motion, is_paper) in &motions {
+    for (name, motion, is_paper) in motions {
         if !*is_paper {
             continue;
         }
         for views in [4, 8] {
             say(global, &format!("{name} carved from {views} views …"));
-            let r = carve_and_score(motion, &CarveCase::clean(views, 0.04), &params)
+            let r = carve_and_score(motion, &CarveCase::clean(views, 0.04), params)
                 .map_err(ExitError::failed)?;
             let (s, voxels) = (r.score, r.voxels);
             lines.push(format!(
@@ -469,73 +525,7 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     }
     lines.push(String::new());
 
-    speed_table(&motions[0].1, &params, global, &mut lines);
-    print_tables(global, suite_json, &lines);
-    Ok(())
-}
-
-/// Speed on one core: voxel sizes chosen so that a marching frame has about N points; the
-/// paper's pipeline as it was (the curve on every point) against the product's (the curve on at
-/// most `curve_points`, then the articulated fit over the clip), same frames, same run.
-fn speed_table(
-    march: &Motion,
-    params: &VolumeParams,
-    global: &GlobalArgs,
-    lines: &mut Vec<String>,
-) {
-    let stature = stature_of(march);
-    let mut rng = <rand::rngs::StdRng as rand::SeedableRng>::seed_from_u64(3);
-    let at_40 = voxelise(&march.frames[0], stature, &VoxelParams::default(), &mut rng).len();
-    let before = VolumeParams {
-        curve_points: usize::MAX,
-        ..*params
-    };
-    lines.push("Speed on one core (marching, 10 consecutive frames): the curve on every point (before) and the product (curve on fewer points + the fitted body)".to_owned());
-    lines.push(format!(
-        "{:>8} {:>8} {:>8} {:>12} {:>12} {:>9} {:>7}",
-        "N target", "voxel", "points", "before ms", "after ms", "fit ms", "ratio"
-    ));
-    for target in [3_000.0, 11_000.0, 30_000.0] {
-        let voxel_m = 0.04 * (at_40 as f64 / target).cbrt();
-        let voxel = VoxelParams {
-            voxel_m,
-            ..VoxelParams::default()
-        };
-        let clouds: Vec<_> = march
-            .frames
-            .iter()
-            .take(10)
-            .map(|j| voxelise(j, stature, &voxel, &mut rng))
-            .collect();
-        say(global, &format!("speed at N ≈ {target:.0} …"));
-        let t0 = Instant::now();
-        for c in &clouds {
-            let _ = process_frame(c, &before);
-        }
-        let old = t0.elapsed().as_secs_f64();
-        let t0 = Instant::now();
-        let (results, points): (Vec<_>, Vec<_>) = clouds
-            .iter()
-            .map(|c| process_frame_for_fit(c, params))
-            .unzip();
-        let t1 = Instant::now();
-        let names: Vec<String> = (0..clouds.len()).map(|i| i.to_string()).collect();
-        let _ = assemble_and_fit(&results, &points, &names, march.fps, params);
-        let fit = t1.elapsed().as_secs_f64();
-        let new = t0.elapsed().as_secs_f64();
-        let n = clouds.len().max(1) as f64;
-        lines.push(format!(
-            "{:>8.0} {:>6.1}mm {:>8.0} {:>12.1} {:>12.1} {:>9.1} {:>7.2}",
-            target,
-            voxel_m * 1000.0,
-            clouds.iter().map(Vec::len).sum::<usize>() as f64 / n,
-            1000.0 * old / n,
-            1000.0 * new / n,
-            1000.0 * fit / n,
-            new / old.max(1e-12)
-        ));
-    }
-    lines.push(String::new());
+    Ok(lines)
 }
 
 /// Prints the tables, or with `--json` the suite's figures and the tables as JSON.

@@ -18,6 +18,7 @@ mod bench_track;
 mod bench_track_speed;
 mod bench_views;
 mod bench_volume;
+mod bench_volume_speed;
 mod prior;
 mod report;
 mod score;
