@@ -64,11 +64,6 @@ fn timed_track(path: &Path, job: &TrackJob) -> anyhow::Result<(f64, TrackOutput)
     Ok((started.elapsed().as_secs_f64(), out))
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
-}
-
 /// Runs the measurement (see the module's text).
 pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
     let runs = a.runs.max(1);
@@ -118,7 +113,10 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         }
         alone.push(timed_track(&clip, &vba_alone).map_err(ExitError::failed)?.0);
     }
-    let (with, alone) = (median(with), median(alone));
+    let (with, alone) = (
+        crate::bench_speed::median(with),
+        crate::bench_speed::median(alone),
+    );
     if global.json {
         let v = serde_json::json!({
             "frames": n, "threads": THREADS, "runs": runs, "first_track_s": first_s,

@@ -244,9 +244,8 @@ const RATIO_ROUNDS: usize = 5;
 /// The time of tracking with decoding over the time of decoding alone, measured in
 /// [`RATIO_ROUNDS`] rounds that each time both back to back, so both halves of a ratio see the
 /// same neighbours on the shared machine: (median, lowest, highest) of the rounds' ratios.
-/// Fastest-of-n figures taken minutes apart put this ratio anywhere between 1.6 and 2.7; the
-/// paired median still moves between runs (1.55, 1.62 and 2.31 in three runs of one build at
-/// 1080×1920), so quote it with its range.
+/// The paired median still moves between runs on a shared machine, so quote it with its range
+/// (the runs behind this: docs/log.md).
 fn paired_ratio(
     dir: &Path,
     threads: usize,

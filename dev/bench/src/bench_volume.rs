@@ -239,6 +239,14 @@ fn suite_bench_takes(split: Option<Split>, only: &Only) -> Result<Vec<Take>, Exi
     Ok(takes)
 }
 
+/// One take's row of a suite table as JSON: its scores ([`take_json`]), family and split.
+fn take_row(bench: &BenchClip, both: &Both) -> serde_json::Value {
+    let mut j = take_json(both);
+    j["family"] = bench.family.name().into();
+    j["split"] = bench.split.name().into();
+    j
+}
+
 /// The volumes of the takes at each of [`SUITE_VOXELS`]: a table each into `lines` and `json`.
 fn voxel_tables(
     takes: &[Take],
@@ -278,10 +286,7 @@ fn voxel_tables(
                 flagged: r.flagged,
             };
             tally.add(bench, &both);
-            let mut j = take_json(&both);
-            j["family"] = bench.family.name().into();
-            j["split"] = bench.split.name().into();
-            per_take.insert(take.clone(), j);
+            per_take.insert(take.clone(), take_row(bench, &both));
         }
         let title = format!(
             "suite v4 takes at {label} (the bodies of their first clips, {FRAMES} frames at {FPS} fps)"
@@ -332,11 +337,9 @@ fn carved_tables(
                 flagged: r.flagged,
             };
             tally.add(bench, &both);
-            let mut j = take_json(&both);
+            let mut j = take_row(bench, &both);
             j["voxels"] = r.voxels.into();
             j["dropped_voxels"] = r.dropped.into();
-            j["family"] = bench.family.name().into();
-            j["split"] = bench.split.name().into();
             per_take.insert(take.clone(), j);
         }
         let what = if case.faults.any() {

@@ -9,7 +9,7 @@
 //! shoulders (where left and right are easy to swap), whether the choice is the network's
 //! other-side joint, and whether the joint is tracked at all.
 
-use super::evidence::{NetworkFrames, other_side};
+use super::evidence::NetworkFrames;
 use crate::formats::{KeyFrames, PointSource, Tracks2d};
 use crate::skeleton::{Joint, PerJoint};
 
@@ -110,7 +110,7 @@ fn joint_features(
     let p = f.points[j].pos;
     let off = |q: nalgebra::Point2<f64>| ((p - q).norm() / torso).min(1.0);
     let seen = net.get(t).and_then(|s| s.joints.as_ref());
-    let (net_off, net_unsure, swap) = match seen.map(|s| (s[j], s[other_side(j)])) {
+    let (net_off, net_unsure, swap) = match seen.map(|s| (s[j], s[j.mirrored()])) {
         Some((own, other)) => {
             let swapped = off(other.pos) + 0.05 < off(own.pos);
             (

@@ -145,26 +145,6 @@ pub(crate) fn refuses(key: &PerJoint<Option<Point2<f64>>>, seen: &NetFrame) -> b
         .any(|&(j, p)| (joints[j].pos - p).norm() > REFUSED_TORSO * torso)
 }
 
-/// The joint on the body's other side (itself for the trunk's).
-pub(crate) fn other_side(j: Joint) -> Joint {
-    use Joint::*;
-    match j {
-        LeftShoulder => RightShoulder,
-        RightShoulder => LeftShoulder,
-        LeftElbow => RightElbow,
-        RightElbow => LeftElbow,
-        LeftWrist => RightWrist,
-        RightWrist => LeftWrist,
-        LeftHip => RightHip,
-        RightHip => LeftHip,
-        LeftKnee => RightKnee,
-        RightKnee => LeftKnee,
-        LeftAnkle => RightAnkle,
-        RightAnkle => LeftAnkle,
-        other => other,
-    }
-}
-
 /// One candidate for a joint on a frame: position and the cost of its own doubt.
 #[derive(Debug, Clone, Copy)]
 struct Candidate {
@@ -274,7 +254,7 @@ fn candidates(
         return c;
     }
     if let Some(pose) = net.get(t).and_then(|f| f.joints.as_ref()) {
-        for (side, extra) in [(j, 0.0), (other_side(j), params.swap_cost)] {
+        for (side, extra) in [(j, 0.0), (j.mirrored(), params.swap_cost)] {
             if side == j && extra > 0.0 {
                 continue;
             }

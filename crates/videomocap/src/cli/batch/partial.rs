@@ -169,14 +169,19 @@ mod tests {
             .expect("owner");
     }
 
+    /// The pid of a process of this host that has exited.
+    fn exited_pid() -> u32 {
+        let mut child = std::process::Command::new("true").spawn().expect("true");
+        let pid = child.id();
+        child.wait().expect("wait");
+        pid
+    }
+
     #[test]
     fn folders_of_dead_processes_go_and_those_of_live_ones_stay() {
         let out = tempfile::tempdir().expect("temp dir");
         let here = host_name();
-        // A process of this host that has exited.
-        let mut child = std::process::Command::new("true").spawn().expect("true");
-        let dead_pid = child.id();
-        child.wait().expect("wait");
+        let dead_pid = exited_pid();
         let dead = out.path().join(format!(".partial-a-{here}-{dead_pid}"));
         write_owner(
             &dead,
@@ -215,9 +220,7 @@ mod tests {
     fn a_folder_killed_before_its_owner_file_names_its_dead_writer() {
         let out = tempfile::tempdir().expect("temp dir");
         let here = host_name();
-        let mut child = std::process::Command::new("true").spawn().expect("true");
-        let dead_pid = child.id();
-        child.wait().expect("wait");
+        let dead_pid = exited_pid();
         // Made, then killed before the owner file was written (an id with dashes in it).
         let dead = out
             .path()
