@@ -4,6 +4,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 export PATH="$HOME/.cargo/bin:$PATH"
+# A fresh clone gains nothing from incremental caches, which double the build's disk use
+# (a CI run once failed linking on a full disk).
+export CARGO_INCREMENTAL=0
 cargo fmt --check
 # Each stage's files form a line, not a circle (issue 92).
 python3 scripts/module_cycles.py
