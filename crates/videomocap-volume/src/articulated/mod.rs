@@ -9,10 +9,11 @@
 //!    capsule onto the frame's points, started from the frame before (the previous frames'
 //!    motion) and from the curve's own pose on this frame (its labels chosen over the whole
 //!    clip, its sides taken facing the way the frame before faces); the better fit is kept.
-//!    Which way the body faces is decided once for the clip: it is tracked from its first
-//!    frame's best fit and from that fit turned round (a track never turns the body round
-//!    between two frames); the track whose fits cost clearly less over the clip is kept, and
-//!    when neither does, the one facing as the curve does on more frames. What tells front from
+//!    Which way the body faces is decided stretch by stretch (`facing`): the clip is tracked
+//!    from its first frame's best fit and from that fit turned round (a track never turns the
+//!    body round between two frames), and each stretch of frames takes the track whose fits
+//!    explain its points better, a change of track paying a price; where the two fit about as
+//!    well, the curve's facing decides and a warning names the stretch. What tells front from
 //!    back: the feet (a capsule forward of each ankle) on a real body's volume, the knees' bend
 //!    (the thighs cannot turn half round about themselves) on a bent leg.
 //! 3. **Flags**: a frame whose fit leaves many points off the body or a capsule without points
@@ -20,6 +21,7 @@
 //!    dropped.
 
 mod body;
+mod facing;
 mod model;
 mod points;
 mod solve;
@@ -28,6 +30,7 @@ pub use model::{Pose, SubjectBody};
 pub use points::{FitPoints, fit_points};
 
 use crate::sequence::Assembled;
+use facing::facing_chosen;
 use nalgebra::{Point3, Rotation3, Vector3};
 use solve::{FrameData, Quality};
 use std::collections::BTreeMap;
@@ -86,6 +89,8 @@ fn frame_data(p: &FitPoints) -> FrameData {
 struct Done {
     pose: Pose,
     quality: Quality,
+    /// Whether its fit started from the curve's pose rather than the previous frame's.
+    from_curve: bool,
 }
 
 /// Fits the subject's body to every frame of the clip. `points[i]` are frame i's points (`None`
@@ -119,64 +124,30 @@ pub fn fit_clip(
         params,
     };
     let facing = track(&clip, None);
-    // The body turned round on the first frame, tracked the same way: the clip's front is the
-    // one whose fits explain the points clearly better, or else the one the curve shows.
-    let (done, from_curve) = match facing.done[first] {
+    // The body turned round on the first frame, tracked the same way: each stretch of the clip
+    // takes the track whose fits explain its points better (`facing_chosen`).
+    let mut facing_warnings = Vec::new();
+    let done = match facing.done[first] {
         Some(f) => {
             let other = track(&clip, Some(turned_round(&f.pose)));
-            if facing_kept(&facing, &other, &curve_pose) {
-                (facing.done, facing.from_curve)
-            } else {
-                (other.done, other.from_curve)
-            }
+            let pick = facing_chosen(&facing, &other, &curve_pose);
+            facing_warnings = facing::unsure(&facing, &other, &pick, names);
+            pick.iter()
+                .enumerate()
+                .map(|(i, &b)| if b { other.done[i] } else { facing.done[i] })
+                .collect()
         }
-        _ => (facing.done, facing.from_curve),
+        _ => facing.done,
     };
-    let (skeleton, warnings) = skeleton_of(&done, points, &body, names, params, curve)?;
+    let from_curve = done.iter().flatten().filter(|d| d.from_curve).count();
+    let (skeleton, mut warnings) = skeleton_of(&done, points, &body, names, params, curve)?;
+    warnings.extend(facing_warnings);
     Some(Fitted {
         skeleton,
         body,
         warnings,
         from_curve,
     })
-}
-
-/// How much better (the mean over frames of the log of the ratio of the two fits' costs) one
-/// facing must explain the points to decide the clip's front; below it the two facings fit
-/// about as well (a capsule body standing straight) and the curve's front is kept.
-const FACING_MARGIN: f64 = 0.1;
-
-/// Whether track `a` faces the clip's front rather than `b` (the same clip turned round): the
-/// one whose fits cost clearly less over the frames both fitted; when neither does, the one
-/// facing the way the curve's pose faces on more frames.
-fn facing_kept(a: &Tracked, b: &Tracked, curve: &[Option<PerJoint<Point3<f64>>>]) -> bool {
-    let logs: Vec<f64> = a
-        .done
-        .iter()
-        .zip(&b.done)
-        .filter_map(|(x, y)| Some((x.as_ref()?.quality.cost, y.as_ref()?.quality.cost)))
-        .filter(|(x, y)| *x > 0.0 && *y > 0.0)
-        .map(|(x, y)| (y / x).ln())
-        .collect();
-    let mean = logs.iter().sum::<f64>() / logs.len().max(1) as f64;
-    let with_curve = |t: &Tracked| {
-        t.done
-            .iter()
-            .zip(curve)
-            .filter(|(d, c)| match (d, c) {
-                (Some(d), Some(c)) => {
-                    let front = |r: &Rotation3<f64>| r * Vector3::z();
-                    front(&d.pose.pelvis).dot(&front(&Pose::from_joints(c).pelvis)) > 0.0
-                }
-                _ => false,
-            })
-            .count()
-    };
-    if mean.abs() > FACING_MARGIN {
-        mean > 0.0
-    } else {
-        with_curve(a) >= with_curve(b)
-    }
 }
 
 /// What every frame's fit starts from.
@@ -192,10 +163,6 @@ struct Clip<'a> {
 /// The clip's fits from one start on its first frame.
 struct Tracked {
     done: Vec<Option<Done>>,
-    /// Frames whose fit started from the curve's pose.
-    from_curve: usize,
-    /// The fits' summed cost.
-    cost: f64,
 }
 
 /// Every frame fitted from the frame before (the first frame from `start`, or its best start
@@ -205,8 +172,6 @@ fn track(clip: &Clip, start: Option<Pose>) -> Tracked {
     let first = clip.first;
     let mut out = Tracked {
         done: vec![None; n],
-        from_curve: 0,
-        cost: 0.0,
     };
     let order: Vec<(usize, Option<usize>)> = (first..n)
         .map(|i| (i, i.checked_sub(1).filter(|&p| p >= first)))
@@ -237,13 +202,10 @@ fn track(clip: &Clip, start: Option<Pose>) -> Tracked {
                 clip.params,
             ),
         };
-        if f.from_curve && prev.is_some() {
-            out.from_curve += 1;
-        }
-        out.cost += f.fit.quality.cost;
         out.done[i] = Some(Done {
             pose: f.fit.pose,
             quality: f.fit.quality,
+            from_curve: f.from_curve && prev.is_some(),
         });
     }
     out
@@ -268,7 +230,8 @@ pub(crate) struct Started {
 const FACINGS: usize = 8;
 
 /// The best fit of `body` to the frame `d` from its starts: the previous frame's pose `prev`,
-/// the curve's `curve` (facing the way `prev` faces; kept only when clearly better than the
+/// the curve's `curve` (facing the way `prev` faces, and without `prev` both ways, since on a
+/// real body's volume the curve's pose faces backwards; kept only when clearly better than the
 /// previous frame's); and when neither fits well (or neither exists, or `search`), the body
 /// standing upright (+Y, the project's world) at the points' centre in [`FACINGS`] facings
 /// (with `prev`, only those less than a right angle from its facing).
@@ -287,23 +250,27 @@ pub(crate) fn best_start(
     });
     if let Some(c) = curve {
         // The curve's sides are its weakest reading: its pose is taken facing the way the
-        // previous frame's fit faces.
-        let mut start = Pose::from_joints(c);
-        if let Some(p) = prev
-            && (start.pelvis * Vector3::z()).dot(&(p.pelvis * Vector3::z())) < 0.0
-        {
-            start = Pose::from_joints(&swapped_sides(c));
-        }
-        let f = run(&start);
-        // The curve's start replaces the previous frame's only when clearly better.
-        if best
-            .as_ref()
-            .is_none_or(|b| f.quality.cost < 0.98 * b.fit.quality.cost)
-        {
-            best = Some(Started {
-                fit: f,
-                from_curve: true,
-            });
+        // previous frame's fit faces, and with no previous frame both ways (the cheaper kept).
+        let (ahead, round) = (Pose::from_joints(c), Pose::from_joints(&swapped_sides(c)));
+        let starts = match prev {
+            Some(p) if (ahead.pelvis * Vector3::z()).dot(&(p.pelvis * Vector3::z())) < 0.0 => {
+                vec![round]
+            }
+            Some(_) => vec![ahead],
+            None => vec![ahead, round],
+        };
+        for start in starts {
+            let f = run(&start);
+            // The curve's start replaces the previous frame's only when clearly better.
+            if best
+                .as_ref()
+                .is_none_or(|b| f.quality.cost < 0.98 * b.fit.quality.cost)
+            {
+                best = Some(Started {
+                    fit: f,
+                    from_curve: true,
+                });
+            }
         }
     }
     let poor = best
@@ -457,44 +424,4 @@ fn skeleton_of(
         },
         warnings,
     ))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A track of `n` frames facing +z (`back`: −z), each frame's fit costing `cost`.
-    fn tracked(n: usize, back: bool, cost: f64) -> Tracked {
-        let mut pose = Pose::default_standing();
-        if back {
-            pose = turned_round(&pose);
-        }
-        let quality = Quality {
-            cost,
-            unexplained: 0.0,
-            worst_gap: (0, 0.0),
-        };
-        Tracked {
-            done: vec![Some(Done { pose, quality }); n],
-            from_curve: 0,
-            cost: cost * n as f64,
-        }
-    }
-
-    #[test]
-    fn the_facing_that_fits_clearly_better_is_kept_and_the_curve_breaks_a_tie() {
-        let body = body::typical(1.75).expect("a typical body");
-        let front = Pose::default_standing().posed(&body).joints;
-        let curve_back =
-            vec![Some(turned_round(&Pose::default_standing()).posed(&body).joints); 10];
-        let curve_front = vec![Some(front); 10];
-        // Clearly cheaper: kept whatever the curve shows.
-        let (a, b) = (tracked(10, false, 1.0), tracked(10, true, 1.5));
-        assert!(facing_kept(&a, &b, &curve_back));
-        assert!(!facing_kept(&b, &a, &curve_front));
-        // About as cheap: the curve's facing.
-        let (a, b) = (tracked(10, false, 1.0), tracked(10, true, 0.97));
-        assert!(facing_kept(&a, &b, &curve_front));
-        assert!(!facing_kept(&a, &b, &curve_back));
-    }
 }
