@@ -263,31 +263,40 @@ fn body_columns(r: &mut Row, seg: usize, t: f64, n: &Vector3<f64>, posed: &Posed
 struct Normal {
     h: DMatrix<f64>,
     g: DVector<f64>,
-    quality: Quality,
 }
 
 /// Weight of the coverage residuals against the points': all coverage together weighs this
 /// share of all points.
 const COVER_SHARE: f64 = 0.5;
 
-fn normal(pose: &Pose, body: &SubjectBody, data: &FrameData, with_body: bool) -> Normal {
-    let dof = POSE_DOF + if with_body { BODY_DOF } else { 0 };
+/// One residual: its value `r` at axis point `c` (parameter `t` on segment `seg`), falling as
+/// `c` moves along `n`, with its weight `w`.
+struct Residual {
+    seg: usize,
+    c: Point3<f64>,
+    t: f64,
+    n: Vector3<f64>,
+    r: f64,
+    w: f64,
+}
+
+/// A pose's residuals and quality: a Levenberg–Marquardt trial needs only the quality; the
+/// normal equations ([`Evaluated::normal`]) are built only for a step that is kept.
+struct Evaluated {
+    posed: Posed,
+    residuals: Vec<Residual>,
+    quality: Quality,
+}
+
+/// Every point's distance to the nearest capsule's surface (Cauchy-weighted) and every capsule's
+/// coverage, at `pose`.
+fn evaluate(pose: &Pose, body: &SubjectBody, data: &FrameData) -> Evaluated {
     let posed = pose.posed(body);
     let caps = capsules(&posed, body);
-    let mut h = DMatrix::zeros(dof, dof);
-    let mut g = DVector::zeros(dof);
     let sigma2 = data.sigma_m * data.sigma_m;
     let mut cost = 0.0;
     let mut far = 0usize;
-    let mut add = |row: &Row, res: f64, w: f64| {
-        for a in 0..row.n {
-            let va = row.val[a] * w;
-            g[row.idx[a]] += va * res;
-            for b in 0..row.n {
-                h[(row.idx[a], row.idx[b])] += va * row.val[b];
-            }
-        }
-    };
+    let mut residuals = Vec::with_capacity(data.points.len() + caps.len() * COVER_AT.len());
     for p in &data.points {
         let mut best = (f64::INFINITY, 0, Point3::origin(), 0.0);
         for (s, c) in caps.iter().enumerate() {
@@ -297,8 +306,8 @@ fn normal(pose: &Pose, body: &SubjectBody, data: &FrameData, with_body: bool) ->
                 best = (d, s, q, t);
             }
         }
-        let (d, s, q, t) = best;
-        let Some(n) = (p - q).try_normalize(1e-9) else {
+        let (d, seg, c, t) = best;
+        let Some(n) = (p - c).try_normalize(1e-9) else {
             continue;
         };
         let w = 1.0 / (1.0 + d * d / sigma2);
@@ -306,18 +315,25 @@ fn normal(pose: &Pose, body: &SubjectBody, data: &FrameData, with_body: bool) ->
         if d.abs() > 2.0 * data.sigma_m {
             far += 1;
         }
-        add(&row(s, &q, t, &n, &posed, with_body), d, w);
+        residuals.push(Residual {
+            seg,
+            c,
+            t,
+            n,
+            r: d,
+            w,
+        });
     }
     let samples = (caps.len() * COVER_AT.len()) as f64;
     let w_cover = COVER_SHARE * data.points.len() as f64 / samples;
     let mut worst_gap = (0, 0.0f64);
-    for (s, c) in caps.iter().enumerate() {
+    for (seg, cap) in caps.iter().enumerate() {
         for t in COVER_AT {
-            let at = c.a + (c.b - c.a) * t;
+            let at = cap.a + (cap.b - cap.a) * t;
             let Some(q) = data.nearest(&at) else { continue };
-            let gap = (q - at).norm() - c.r;
+            let gap = (q - at).norm() - cap.r;
             if gap > worst_gap.1 {
-                worst_gap = (s, gap);
+                worst_gap = (seg, gap);
             }
             if gap <= 0.0 {
                 continue;
@@ -326,17 +342,50 @@ fn normal(pose: &Pose, body: &SubjectBody, data: &FrameData, with_body: bool) ->
                 continue;
             };
             cost += 0.5 * w_cover * gap * gap;
-            add(&row(s, &at, t, &n, &posed, with_body), gap, w_cover);
+            residuals.push(Residual {
+                seg,
+                c: at,
+                t,
+                n,
+                r: gap,
+                w: w_cover,
+            });
         }
     }
-    Normal {
-        h,
-        g,
+    Evaluated {
+        posed,
+        residuals,
         quality: Quality {
             cost,
             unexplained: far as f64 / data.points.len().max(1) as f64,
             worst_gap,
         },
+    }
+}
+
+impl Evaluated {
+    /// The normal equations `JᵀWJ`, `JᵀWr` of the residuals; of `JᵀWJ` only the lower triangle,
+    /// which is all the Cholesky factorisation reads.
+    fn normal(&self, with_body: bool) -> Normal {
+        let dof = POSE_DOF + if with_body { BODY_DOF } else { 0 };
+        let mut h = DMatrix::zeros(dof, dof);
+        let mut g = DVector::zeros(dof);
+        let hs = h.as_mut_slice();
+        for e in &self.residuals {
+            let row = row(e.seg, &e.c, e.t, &e.n, &self.posed, with_body);
+            let (idx, val) = (&row.idx[..row.n], &row.val[..row.n]);
+            for (&ia, &a) in idx.iter().zip(val) {
+                let va = a * e.w;
+                g[ia] += va * e.r;
+                for (&ib, &b) in idx.iter().zip(val) {
+                    // Column-major: entry (ia, ib), lower triangle only.
+                    if ia >= ib {
+                        hs[ib * dof + ia] += va * b;
+                    }
+                }
+            }
+        }
+        Normal { h, g }
     }
 }
 
@@ -401,11 +450,12 @@ pub(crate) fn fit(
     iterations: usize,
     with_body: bool,
 ) -> Fit {
-    let mut eq = normal(pose, body, data, with_body);
+    let first = evaluate(pose, body, data);
+    let mut eq = first.normal(with_body);
     let mut cur = Fit {
         pose: *pose,
         body: body.clone(),
-        quality: eq.quality,
+        quality: first.quality,
     };
     let mut lambda = 1e-3;
     for _ in 0..iterations {
@@ -419,7 +469,7 @@ pub(crate) fn fit(
         };
         let d = -chol.solve(&eq.g);
         let (p, b) = step(&cur.pose, &cur.body, &d);
-        let next = normal(&p, &b, data, with_body);
+        let next = evaluate(&p, &b, data);
         if next.quality.cost < cur.quality.cost {
             let gain = (cur.quality.cost - next.quality.cost) / cur.quality.cost.max(1e-12);
             cur = Fit {
@@ -427,7 +477,7 @@ pub(crate) fn fit(
                 body: b,
                 quality: next.quality,
             };
-            eq = next;
+            eq = next.normal(with_body);
             lambda = (lambda * 0.3).max(1e-7);
             if gain < 1e-4 {
                 break;
