@@ -93,6 +93,7 @@ fn correct_clip(
     let mut tracks = first.tracks;
     let background = first.background;
     let mut seen = first.network;
+    let mut passes = first.passes;
     let mut keys = KeyFrames::from_marks(&marks);
     let mut done = BTreeSet::from([marks.frame.get()]);
     let score = |tracks: &Tracks2d| -> Result<Accuracy, ExitError> {
@@ -123,6 +124,7 @@ fn correct_clip(
             background: background.clone(),
             network: network.clone(),
             previous_network: seen.take(),
+            previous_passes: passes.take(),
         };
         let mut waiting: BTreeSet<usize> = next_to(c.frame, n).collect();
         // Timed as the app re-tracks: the job opens the video, reuses the background of the
@@ -144,6 +146,7 @@ fn correct_clip(
         out.moved_out += moved_out(&gt, &before, &result.tracks, KEPT_TORSO);
         tracks = result.tracks;
         seen = result.network;
+        passes = result.passes;
         out.redraw_s
             .push(arrived_s.unwrap_or_else(|| started.elapsed().as_secs_f64()));
         out.scores.push(score(&tracks)?);

@@ -24,6 +24,7 @@ use super::fuse::fuse;
 use super::occlusion::{WeakSpan, fill_weak_runs, weak_spans};
 use super::params::TrackerParams;
 use super::pass::{PassContext, Scale};
+use super::replay::{FrameStore, PassesSeen, Recorded, SeenRun};
 use super::shared::{TrackError, TrackProgress};
 use super::smooth::smooth_tracks;
 use crate::camera::point_in_frame;
@@ -60,6 +61,10 @@ pub struct TrackJob {
     /// frame whose crop is exactly the one it had then is not run again (a cache: the result is
     /// the same with or without it).
     pub previous_network: Option<NetworkFrames>,
+    /// What VBA's passes computed in an earlier run of this video ([`TrackOutput::passes`]):
+    /// a pass's frames before the first whose keys changed are not tracked again, nor its
+    /// frames decoded again (a cache: the result is the same with or without it).
+    pub previous_passes: Option<PassesSeen>,
 }
 
 impl TrackJob {
@@ -76,6 +81,7 @@ impl TrackJob {
             background: None,
             network: None,
             previous_network: None,
+            previous_passes: None,
         }
     }
 
@@ -104,6 +110,9 @@ pub struct TrackOutput {
     /// What the pose network saw on each frame (`None`: tracked with VBA alone): give it to
     /// the next job on this video ([`TrackJob::previous_network`]).
     pub network: Option<NetworkFrames>,
+    /// What VBA's passes computed (`None` when a frame could not be decoded): give it to the
+    /// next job on this video ([`TrackJob::previous_passes`]).
+    pub passes: Option<PassesSeen>,
 }
 
 /// Tracks the video from its key frames.
@@ -134,6 +143,7 @@ pub fn track_video(
         shrink,
         damaged,
         background,
+        seen,
     } = passes?;
     // 2. The network's evidence weighed in, the user's marks deciding whose body it is.
     let net = match network {
@@ -167,6 +177,7 @@ pub fn track_video(
         spans,
         shrink,
         network: net,
+        passes: seen,
     })
 }
 
@@ -234,6 +245,7 @@ struct Passes {
     shrink: f64,
     damaged: Vec<usize>,
     background: Option<KnownBackground>,
+    seen: Option<PassesSeen>,
 }
 
 /// The shrink factor that brings the marked person to the working stature (1 when they are no
@@ -293,12 +305,13 @@ fn run_passes(
     ctx: &mut PassContext,
     job: &TrackJob,
     first_pose: &PerJoint<Point2<f64>>,
-    start: usize,
-    backward_frames: &[usize],
-) -> Result<([PassResults; 2], [Arrivals; 2]), TrackError> {
+    (start, backward_frames): (usize, &[usize]),
+    earlier: [Option<&Recorded>; 2],
+) -> Result<RanPasses, TrackError> {
     let n = ctx.video.info().frame_count;
     let mut results: [PassResults; 2] = [vec![None; n], vec![None; n]];
     let mut arrivals: [Arrivals; 2] = Default::default();
+    let mut recorded: [Option<Recorded>; 2] = [None, None];
     let starting = |results: &[Option<PerJoint<JointResult>>], f: usize| {
         let base = results[f].unwrap_or_else(|| {
             first_pose.map(|_, p| JointResult {
@@ -316,7 +329,8 @@ fn run_passes(
         };
         // Both passes start from the forward pass's pose there.
         let (pose, before) = starting(&results[0], first);
-        let out = ctx.pass(order, &pose)?;
+        let (out, record) = ctx.pass(order, &pose, earlier[k])?;
+        recorded[k] = Some(record);
         for (f, r) in order.iter().zip(out.results) {
             results[k][*f] = Some(r);
         }
@@ -329,8 +343,11 @@ fn run_passes(
             }
         }
     }
-    Ok((results, arrivals))
+    Ok((results, arrivals, recorded))
 }
+
+/// Per pass its results per frame and arrivals at keys, and the pass as it ran (`replay`).
+type RanPasses = ([PassResults; 2], [Arrivals; 2], [Option<Recorded>; 2]);
 
 /// The fused results as tracks in video pixels: a key's joints as placed (confidence 1), a
 /// joint outside the image off the frame (confidence 0), a frame no pass reached at the first
@@ -411,6 +428,9 @@ fn track_at_working_scale(
     };
     let params = job.params.tuning(info.fps, job.threads);
     let backward_frames = backward_order(job, start);
+    let run = SeenRun::new(info.path.clone(), n, params, scale, decoded);
+    let earlier = job.previous_passes.as_ref().and_then(|p| p.for_run(&run));
+    let (earlier_frames, earlier_passes) = earlier.unwrap_or((&[], [None, None]));
     let mut ctx = PassContext {
         video,
         scale,
@@ -426,22 +446,29 @@ fn track_at_working_scale(
         progress,
         cancel,
         background: None,
+        earlier_frames,
+        store: FrameStore::new(n, earlier_frames),
     };
     let background = with_background(&mut ctx, job, (ww, wh), n)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(job.threads.max(1))
         .build()
         .ok();
-    let (results, arrivals) = match &pool {
+    let orders = (start, backward_frames.as_slice());
+    let (results, arrivals, recorded) = match &pool {
         Some(pool) => {
-            pool.install(|| run_passes(&mut ctx, job, &first_pose, start, &backward_frames))?
+            pool.install(|| run_passes(&mut ctx, job, &first_pose, orders, earlier_passes))?
         }
-        None => run_passes(&mut ctx, job, &first_pose, start, &backward_frames)?,
+        None => run_passes(&mut ctx, job, &first_pose, orders, earlier_passes)?,
     };
     let tracks = fused(&results, &arrivals, &first_pose, job, info);
     let mut damaged = std::mem::take(&mut ctx.damaged);
     damaged.sort_unstable();
     damaged.dedup();
+    // A damaged frame's pass results are not kept: a re-track would not know it was damaged.
+    let seen = damaged
+        .is_empty()
+        .then(|| PassesSeen::new(run, ctx.store.into_frames(), recorded));
     Ok(Passes {
         tracks,
         done: ctx.done,
@@ -449,6 +476,7 @@ fn track_at_working_scale(
         shrink,
         damaged,
         background,
+        seen,
     })
 }
 
@@ -540,6 +568,7 @@ mod tests {
             background: None,
             network: None,
             previous_network: None,
+            previous_passes: None,
         }
     }
 
