@@ -19,6 +19,7 @@ use videomocap_testkit::synth::{ProceduralMotion, View, render_small_clip};
 struct Counting {
     inner: Box<dyn VideoSource>,
     decoded: Arc<AtomicUsize>,
+    reopened: Arc<AtomicUsize>,
 }
 
 impl VideoSource for Counting {
@@ -32,20 +33,32 @@ impl VideoSource for Counting {
         self.decoded.fetch_add(1, Ordering::Relaxed);
         self.inner.decode(index)
     }
+    /// A second reader counting into the same counts (a re-track's backward pass runs on one,
+    /// beside the forward pass).
+    fn reopen(&self) -> Option<Box<dyn VideoSource>> {
+        self.reopened.fetch_add(1, Ordering::Relaxed);
+        Some(Box::new(Counting {
+            inner: self.inner.reopen()?,
+            decoded: self.decoded.clone(),
+            reopened: self.reopened.clone(),
+        }))
+    }
 }
 
 /// Tracks the clip at `path` as the app does (the video opened anew for each run), returning
-/// the result and the frames decoded.
-fn track(path: &std::path::Path, job: &TrackJob) -> (TrackOutput, usize) {
-    let decoded = Arc::new(AtomicUsize::new(0));
+/// the result, the frames decoded and the second readers made.
+fn track(path: &std::path::Path, job: &TrackJob) -> (TrackOutput, usize, usize) {
+    let (decoded, reopened) = (Arc::default(), Arc::default());
     let source = Counting {
         inner: Box::new(ImageSequence::open(path, DEFAULT_SEQUENCE_FPS).unwrap()),
-        decoded: decoded.clone(),
+        decoded: Arc::clone(&decoded),
+        reopened: Arc::clone(&reopened),
     };
     // No frame cache in the video: every frame a run reads is decoded or taken from the job.
     let mut video = Video::from_source(Box::new(source), 0);
     let out = track_video(&mut video, job, &mut |_| {}, &AtomicBool::new(false)).unwrap();
-    (out, decoded.load(Ordering::Relaxed))
+    let count = |c: &AtomicUsize| c.load(Ordering::Relaxed);
+    (out, count(&decoded), count(&reopened))
 }
 
 fn text(t: &Tracks2d) -> String {
@@ -68,7 +81,7 @@ fn an_edit_history_with_the_passes_cache_gives_the_tracks_of_fresh_runs() {
             ..TrackerParams::default()
         };
         let job = TrackJob::from_marks(&marks, params, 2);
-        let (first, _) = track(&clip.video, &job);
+        let (first, _, _) = track(&clip.video, &job);
         let at = |f: usize, j: Joint| first.tracks.frames[f].points[j].pos;
         let shift = nalgebra::Vector2::new(3.0, -2.0);
         // Corrections: a wrist mid-clip (the backward pass starts there), a pelvis later (the
@@ -111,7 +124,7 @@ fn an_edit_history_with_the_passes_cache_gives_the_tracks_of_fresh_runs() {
         );
         history.push(keys.clone());
         let (mut background, mut passes) = (first.background.clone(), first.passes.clone());
-        let mut last = None;
+        let (mut last, mut at_once) = (None, 0);
         for (step, keys) in history.into_iter().enumerate() {
             let cached = TrackJob {
                 keys: keys.clone(),
@@ -119,12 +132,13 @@ fn an_edit_history_with_the_passes_cache_gives_the_tracks_of_fresh_runs() {
                 previous_passes: passes.clone(),
                 ..job.clone()
             };
-            let (again, decoded) = track(&clip.video, &cached);
+            let (again, decoded, reopened) = track(&clip.video, &cached);
+            at_once += reopened;
             assert_eq!(
                 decoded, 0,
                 "step {step}: every frame was kept, none decoded"
             );
-            let (fresh, _) = track(
+            let (fresh, _, _) = track(
                 &clip.video,
                 &TrackJob {
                     keys,
@@ -139,6 +153,8 @@ fn an_edit_history_with_the_passes_cache_gives_the_tracks_of_fresh_runs() {
         }
         // The history's edits changed the tracks (so the comparisons above could fail).
         assert_ne!(text(&last.unwrap()), text(&first.tracks));
+        // The re-tracks with a backward pass ran their two passes at once (each on a reader).
+        assert!(at_once >= 6, "{at_once} second readers");
     }
 }
 
@@ -154,7 +170,7 @@ fn a_passes_cache_from_other_settings_is_not_used() {
         ..TrackerParams::default()
     };
     let job = TrackJob::from_marks(&marks, params, 2);
-    let (first, decoded_first) = track(&clip.video, &job);
+    let (first, decoded_first, _) = track(&clip.video, &job);
     assert!(decoded_first >= 12);
     let other = TrackJob {
         params: TrackerParams {
@@ -163,14 +179,14 @@ fn a_passes_cache_from_other_settings_is_not_used() {
         },
         ..job.clone()
     };
-    let (cached, decoded) = track(
+    let (cached, decoded, _) = track(
         &clip.video,
         &TrackJob {
             previous_passes: first.passes.clone(),
             ..other.clone()
         },
     );
-    let (fresh, _) = track(&clip.video, &other);
+    let (fresh, _, _) = track(&clip.video, &other);
     assert!(decoded >= 12, "{decoded} frames decoded");
     assert_eq!(text(&cached.tracks), text(&fresh.tracks));
 }

@@ -90,10 +90,8 @@ fn correct_clip(
         &AtomicBool::new(false),
     )
     .map_err(ExitError::failed)?;
-    let mut tracks = first.tracks;
-    let background = first.background;
-    let mut seen = first.network;
-    let mut passes = first.passes;
+    let (mut tracks, background) = (first.tracks, first.background);
+    let (mut seen, mut passes) = (first.network, first.passes);
     let mut keys = KeyFrames::from_marks(&marks);
     let mut done = BTreeSet::from([marks.frame.get()]);
     let score = |tracks: &Tracks2d| -> Result<Accuracy, ExitError> {
@@ -145,8 +143,7 @@ fn correct_clip(
             .map_err(ExitError::failed)?;
         out.moved_out += moved_out(&gt, &before, &result.tracks, KEPT_TORSO);
         tracks = result.tracks;
-        seen = result.network;
-        passes = result.passes;
+        (seen, passes) = (result.network, result.passes);
         out.redraw_s
             .push(arrived_s.unwrap_or_else(|| started.elapsed().as_secs_f64()));
         out.scores.push(score(&tracks)?);

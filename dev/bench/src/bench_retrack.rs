@@ -122,6 +122,44 @@ pub(crate) fn run(a: &BenchArgs, global: &GlobalArgs) -> Result<(), ExitError> {
         }
         alone.push(timed_track(&clip, &vba_alone).map_err(ExitError::failed)?.0);
     }
+    report(
+        global,
+        Measured {
+            n,
+            middle,
+            runs,
+            first_s,
+            times: [without, with, alone],
+            rerun,
+            identical,
+        },
+    )
+}
+
+/// What [`run`] measured: the first track's time, and per re-track (without the passes cache,
+/// with it, VBA alone with it) each run's time.
+struct Measured {
+    n: usize,
+    middle: usize,
+    runs: usize,
+    first_s: f64,
+    times: [Vec<f64>; 3],
+    rerun: usize,
+    identical: bool,
+}
+
+/// Prints the medians and their ratio (a line, or JSON); an error when the tracks with the
+/// cache differed from those without it.
+fn report(global: &GlobalArgs, m: Measured) -> Result<(), ExitError> {
+    let Measured {
+        n,
+        middle,
+        runs,
+        first_s,
+        times: [without, with, alone],
+        rerun,
+        identical,
+    } = m;
     let median = crate::bench_speed::median;
     let (without, with, alone) = (median(without), median(with), median(alone));
     let ratio = with / without.max(1e-9);

@@ -222,8 +222,7 @@ impl BodyTracker {
         self.trunk_points = TRUNK_JOINTS.map(|j| self.trunk.block.to_block(pose[j]));
     }
 
-    /// This tracker without its frame buffers, a checkpoint for a re-track (`replay`): the
-    /// frame it last saw makes them again ([`BodyTracker::resumed`]).
+    /// This tracker without its frame buffers, for a re-track ([`BodyTracker::resumed`]).
     pub(super) fn checkpoint(&mut self) -> BodyTracker {
         let frames = (
             std::mem::take(&mut self.prev),
@@ -234,8 +233,7 @@ impl BodyTracker {
         copy
     }
 
-    /// A checkpoint tracking again: `image` is the frame it last saw, converted as
-    /// [`BodyTracker::step`] converts it (the spare buffer's contents are never read).
+    /// A checkpoint tracking again from `image`, the frame it last saw (`step`'s conversion).
     pub(super) fn resumed(mut self, image: &RgbImage) -> BodyTracker {
         self.prev.fill_with(image, self.background.as_deref());
         self

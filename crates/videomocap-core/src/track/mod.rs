@@ -23,6 +23,7 @@
 //! - `run`: tracking a video from its key frames, the order of the steps, re-tracking
 //! - `pass`: one pass over consecutive frames, forwards or backwards, re-started at key frames
 //! - `replay`: what the passes computed, kept for a re-track (a cache)
+//! - `passes`: the two passes, one after the other or at once
 //! - `fuse`: the forward and backward passes made one, per joint between its key frames
 //! - `shared`: the errors and progress every step uses (below them all)
 
@@ -41,6 +42,7 @@ mod occlusion;
 mod params;
 mod part;
 mod pass;
+mod passes;
 mod replay;
 mod run;
 mod search;

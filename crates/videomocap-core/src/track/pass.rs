@@ -5,7 +5,7 @@
 use super::background::{self, Background};
 use super::body::{BodyTracker, JointResult};
 use super::params::Tuning;
-use super::replay::{FrameStore, Recorded, checkpoint_interval};
+use super::replay::{FrameStore, Recorded, Resume, checkpoint_interval};
 use super::shared::{TrackError, TrackProgress};
 use crate::formats::{FrameIndex, FrameTracks, KeyFrames, PointSource, TrackedPoint};
 use crate::skeleton::{Joint, PerJoint, Proportions};
@@ -156,28 +156,12 @@ impl PassContext<'_, '_> {
         };
         let (scale, total) = (self.scale, self.total);
         let mut out = Vec::with_capacity(order.len());
+        let from = match resume {
+            Some(r) => self.take_up(order, r, &frames, &mut stepper, &mut out)?,
+            None => 0,
+        };
         let mut done = self.done;
         let progress = &mut *self.progress;
-        let mut from = 0;
-        if let Some(r) = resume {
-            for (&index, result) in order.iter().zip(r.results) {
-                done += 1;
-                emit(progress, done, total, index, result);
-            }
-            out.extend_from_slice(r.results);
-            stepper.arrivals = r.arrivals;
-            stepper.checkpoints = r.checkpoints;
-            from = r.at + 1;
-            if from < order.len() {
-                let index = order[r.at];
-                let image = frame_at(self.video, self.earlier_frames, index, &frames, scale)?
-                    .ok_or(TrackError::StartFrameDamaged {
-                        path: self.path.clone(),
-                        frame: index,
-                    })?;
-                stepper.tracker = Some(r.tracker.clone().resumed(&image));
-            }
-        }
         let store = &mut self.store;
         let mut take = |index: usize, image: Option<Arc<RgbImage>>| -> Result<(), TrackError> {
             if let Some(image) = &image {
@@ -222,6 +206,39 @@ impl PassContext<'_, '_> {
             },
             recorded,
         ))
+    }
+}
+
+impl PassContext<'_, '_> {
+    /// Takes up an earlier run of the pass over `order` where `r` says: its results (told to
+    /// the progress) into `out`, its arrivals and checkpoints into `stepper`, and the tracker
+    /// there on the frame it last saw. Returns the position in `order` to go on from.
+    fn take_up(
+        &mut self,
+        order: &[usize],
+        r: Resume,
+        frames: &FrameCheck,
+        stepper: &mut Stepper,
+        out: &mut Vec<PerJoint<JointResult>>,
+    ) -> Result<usize, TrackError> {
+        for (&index, result) in order.iter().zip(r.results) {
+            self.done += 1;
+            emit(self.progress, self.done, self.total, index, result);
+        }
+        out.extend_from_slice(r.results);
+        stepper.arrivals = r.arrivals;
+        stepper.checkpoints = r.checkpoints;
+        let from = r.at + 1;
+        if from < order.len() {
+            let index = order[r.at];
+            let image = frame_at(self.video, self.earlier_frames, index, frames, self.scale)?
+                .ok_or(TrackError::StartFrameDamaged {
+                    path: self.path.clone(),
+                    frame: index,
+                })?;
+            stepper.tracker = Some(r.tracker.clone().resumed(&image));
+        }
+        Ok(from)
     }
 }
 

@@ -13,7 +13,6 @@
 
 use super::body::{BodyTracker, JointResult};
 use super::params::Tuning;
-use super::pass::Scale;
 use crate::formats::{FrameIndex, KeyFrames};
 use crate::skeleton::PerJoint;
 use image::RgbImage;
@@ -74,14 +73,14 @@ impl SeenRun {
         path: PathBuf,
         frame_count: usize,
         tuning: Tuning,
-        scale: Scale,
+        work: (u32, u32, f64, f64),
         decoded: (u32, u32),
     ) -> SeenRun {
         SeenRun {
             path,
             frame_count,
             tuning,
-            work: (scale.width, scale.height, scale.sx, scale.sy),
+            work,
             decoded,
         }
     }
@@ -150,6 +149,15 @@ impl FrameStore {
                 self.bytes += bytes;
             }
             _ => {}
+        }
+    }
+
+    /// Keeps `other`'s frames too, while the budget allows.
+    pub(super) fn absorb(&mut self, other: FrameStore) {
+        for (index, image) in other.frames.into_iter().enumerate() {
+            if let Some(image) = image {
+                self.keep(index, &image);
+            }
         }
     }
 

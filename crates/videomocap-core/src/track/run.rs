@@ -24,7 +24,8 @@ use super::fuse::fuse;
 use super::occlusion::{WeakSpan, fill_weak_runs, weak_spans};
 use super::params::TrackerParams;
 use super::pass::{PassContext, Scale};
-use super::replay::{FrameStore, PassesSeen, Recorded, SeenRun};
+use super::passes::{Arrivals, PassResults, run_passes};
+use super::replay::{FrameStore, PassesSeen, SeenRun};
 use super::shared::{TrackError, TrackProgress};
 use super::smooth::smooth_tracks;
 use crate::camera::point_in_frame;
@@ -34,7 +35,6 @@ use crate::network::PoseNetwork;
 use crate::skeleton::{Joint, PerJoint, Proportions};
 use crate::video::{Video, VideoInfo};
 use nalgebra::Point2;
-use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -292,63 +292,6 @@ fn checked_start(
     Ok((first_key.get(), first_pose))
 }
 
-/// Per frame, one pass's result in video pixels (`None` = not tracked).
-type PassResults = Vec<Option<PerJoint<JointResult>>>;
-/// Where a pass arrived on the key frames it went through.
-type Arrivals = BTreeMap<usize, PerJoint<JointResult>>;
-
-/// The two passes: forwards from the first key frame `start` to the end, then backwards over
-/// `backward_frames` (from the last key frame to the start), each re-started at every key frame
-/// on the way; each pass starts from the pose on its first frame with the hand-placed joints
-/// put in, the joints not placed there keeping the reliability they had.
-fn run_passes(
-    ctx: &mut PassContext,
-    job: &TrackJob,
-    first_pose: &PerJoint<Point2<f64>>,
-    (start, backward_frames): (usize, &[usize]),
-    earlier: [Option<&Recorded>; 2],
-) -> Result<RanPasses, TrackError> {
-    let n = ctx.video.info().frame_count;
-    let mut results: [PassResults; 2] = [vec![None; n], vec![None; n]];
-    let mut arrivals: [Arrivals; 2] = Default::default();
-    let mut recorded: [Option<Recorded>; 2] = [None, None];
-    let starting = |results: &[Option<PerJoint<JointResult>>], f: usize| {
-        let base = results[f].unwrap_or_else(|| {
-            first_pose.map(|_, p| JointResult {
-                pos: *p,
-                reliability: 1.0,
-            })
-        });
-        (keyed(&base.map(|_, r| r.pos), &job.keys, f), base)
-    };
-    let forward_frames: Vec<usize> = (start..n).collect();
-    let orders: [&[usize]; 2] = [&forward_frames, backward_frames];
-    for (k, order) in orders.into_iter().enumerate() {
-        let Some(&first) = order.first() else {
-            continue;
-        };
-        // Both passes start from the forward pass's pose there.
-        let (pose, before) = starting(&results[0], first);
-        let (out, record) = ctx.pass(order, &pose, earlier[k])?;
-        recorded[k] = Some(record);
-        for (f, r) in order.iter().zip(out.results) {
-            results[k][*f] = Some(r);
-        }
-        arrivals[k].extend(out.arrivals);
-        if let Some(now) = results[k][first].as_mut() {
-            for j in Joint::ALL {
-                if !job.keys.is_key(FrameIndex(first), j) {
-                    now[j].reliability = before[j].reliability;
-                }
-            }
-        }
-    }
-    Ok((results, arrivals, recorded))
-}
-
-/// Per pass its results per frame and arrivals at keys, and the pass as it ran (`replay`).
-type RanPasses = ([PassResults; 2], [Arrivals; 2], [Option<Recorded>; 2]);
-
 /// The fused results as tracks in video pixels: a key's joints as placed (confidence 1), a
 /// joint outside the image off the frame (confidence 0), a frame no pass reached at the first
 /// key's pose with confidence 0.
@@ -428,7 +371,8 @@ fn track_at_working_scale(
     };
     let params = job.params.tuning(info.fps, job.threads);
     let backward_frames = backward_order(job, start);
-    let run = SeenRun::new(info.path.clone(), n, params, scale, decoded);
+    let work = (scale.width, scale.height, scale.sx, scale.sy);
+    let run = SeenRun::new(info.path.clone(), n, params, work, decoded);
     let earlier = job.previous_passes.as_ref().and_then(|p| p.for_run(&run));
     let (earlier_frames, earlier_passes) = earlier.unwrap_or((&[], [None, None]));
     let mut ctx = PassContext {
@@ -455,12 +399,8 @@ fn track_at_working_scale(
         .build()
         .ok();
     let orders = (start, backward_frames.as_slice());
-    let (results, arrivals, recorded) = match &pool {
-        Some(pool) => {
-            pool.install(|| run_passes(&mut ctx, job, &first_pose, orders, earlier_passes))?
-        }
-        None => run_passes(&mut ctx, job, &first_pose, orders, earlier_passes)?,
-    };
+    let (results, arrivals, recorded) =
+        run_passes(&mut ctx, pool.as_ref(), &first_pose, orders, earlier_passes)?;
     let tracks = fused(&results, &arrivals, &first_pose, job, info);
     let mut damaged = std::mem::take(&mut ctx.damaged);
     damaged.sort_unstable();
@@ -543,14 +483,6 @@ fn with_background(
     };
     Ok((job.params.arm_foreground > 0.0)
         .then(|| KnownBackground::new(size, tau, ctx.background.clone())))
-}
-
-/// A pose with the joints placed by hand on frame `f` put in.
-fn keyed(base: &PerJoint<Point2<f64>>, keys: &KeyFrames, f: usize) -> PerJoint<Point2<f64>> {
-    match keys.frames.get(&FrameIndex(f)) {
-        Some(k) => base.map(|j, p| k[j].unwrap_or(*p)),
-        None => *base,
-    }
 }
 
 #[cfg(test)]
