@@ -2,7 +2,8 @@
 //! what the network saw, the user's joints stay where they were placed, and a re-track after a
 //! correction that reuses the earlier network output gives what a fresh run gives, and an edit
 //! history replayed (corrections, the network turned off and on, an undo) ends where a fresh
-//! run with the same keys and settings does, byte for byte.
+//! run with the same keys and settings does, byte for byte, with the earlier runs' network
+//! output and VBA's passes (`TrackJob::previous_passes`) as caches.
 
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
@@ -110,7 +111,7 @@ fn an_edit_history_replayed_gives_the_tracks_of_a_fresh_run() {
         (&pelvis_moved, on),
         (&corrected, on),
     ];
-    let (mut background, mut seen) = (None, None);
+    let (mut background, mut seen, mut passes) = (None, None, None);
     let mut runs = Vec::new();
     for (keys, params) in history {
         let job = TrackJob {
@@ -120,9 +121,11 @@ fn an_edit_history_replayed_gives_the_tracks_of_a_fresh_run() {
             background: background.clone(),
             network: Some(network.clone()),
             previous_network: seen.clone(),
+            previous_passes: passes.clone(),
         };
         let out = track_video(&mut video, &job, &mut |_| {}, &AtomicBool::new(false)).unwrap();
         background = out.background.clone();
+        passes = out.passes.clone();
         if out.network.is_some() {
             seen = out.network.clone();
         }
@@ -145,6 +148,7 @@ fn an_edit_history_replayed_gives_the_tracks_of_a_fresh_run() {
             background: None,
             network: Some(network),
             previous_network: None,
+            previous_passes: None,
         },
         &mut |_| {},
         &AtomicBool::new(false),
@@ -211,6 +215,7 @@ fn the_network_run_ahead_of_vba_changes_nothing() {
             background: None,
             network: Some(network.clone()),
             previous_network: None,
+            previous_passes: None,
         };
         let mut ahead = Video::open(&clip.video, &OpenOptions::default()).unwrap();
         assert!(ahead.reopen(0).is_some(), "a video file can be read twice");

@@ -90,9 +90,8 @@ fn correct_clip(
         &AtomicBool::new(false),
     )
     .map_err(ExitError::failed)?;
-    let mut tracks = first.tracks;
-    let background = first.background;
-    let mut seen = first.network;
+    let (mut tracks, background) = (first.tracks, first.background);
+    let (mut seen, mut passes) = (first.network, first.passes);
     let mut keys = KeyFrames::from_marks(&marks);
     let mut done = BTreeSet::from([marks.frame.get()]);
     let score = |tracks: &Tracks2d| -> Result<Accuracy, ExitError> {
@@ -123,6 +122,7 @@ fn correct_clip(
             background: background.clone(),
             network: network.clone(),
             previous_network: seen.take(),
+            previous_passes: passes.take(),
         };
         let mut waiting: BTreeSet<usize> = next_to(c.frame, n).collect();
         // Timed as the app re-tracks: the job opens the video, reuses the background of the
@@ -143,7 +143,7 @@ fn correct_clip(
             .map_err(ExitError::failed)?;
         out.moved_out += moved_out(&gt, &before, &result.tracks, KEPT_TORSO);
         tracks = result.tracks;
-        seen = result.network;
+        (seen, passes) = (result.network, result.passes);
         out.redraw_s
             .push(arrived_s.unwrap_or_else(|| started.elapsed().as_secs_f64()));
         out.scores.push(score(&tracks)?);

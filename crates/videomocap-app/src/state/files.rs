@@ -444,6 +444,7 @@ impl State {
         self.project = Some(Project::new(path.to_owned()));
         self.background = None;
         self.network_seen = None;
+        self.passes_seen = None;
         self.results_changed();
         self.status = format!("Opening {}…", path.display());
     }
@@ -458,6 +459,7 @@ impl State {
         self.project = None;
         self.background = None;
         self.network_seen = None;
+        self.passes_seen = None;
         self.project_path = None;
         self.project_beside = None;
         self.history.clear();

@@ -135,6 +135,9 @@ pub(crate) struct State {
     /// What the pose network saw in the last tracking run of this video (a re-track runs it
     /// again only where a crop moved).
     network_seen: Option<videomocap_core::track::NetworkFrames>,
+    /// What VBA's passes computed in the last tracking run of this video, and the frames they
+    /// read (a re-track tracks again only from the first frame whose keys changed).
+    passes_seen: Option<videomocap_core::track::PassesSeen>,
     /// Why the pose network could not be loaded, once a tracking job found it could not (shown
     /// in the status bar and the Tracker panel).
     network_problem: Option<String>,
@@ -209,6 +212,7 @@ impl State {
             partial: BTreeMap::new(),
             background: None,
             network_seen: None,
+            passes_seen: None,
             network_problem: None,
             spans: Vec::new(),
             strips: None,
@@ -327,6 +331,7 @@ impl State {
         self.project = Some(p);
         self.background = None;
         self.network_seen = None;
+        self.passes_seen = None;
         self.subject_fit = None;
         self.history.clear();
         self.results_changed();

@@ -39,6 +39,7 @@ impl State {
             // The network is loaded on the job's thread (see `Job::track`).
             network: None,
             previous_network: self.network_seen.clone(),
+            previous_passes: self.passes_seen.clone(),
         };
         self.running = Some(Running {
             job: Job::track(p.video.clone(), job, self.ctx.clone()),
@@ -237,6 +238,7 @@ impl State {
                 }
                 self.background = out.background;
                 self.network_seen = out.network;
+                self.passes_seen = out.passes;
                 self.tracks_made_with(r.settings.tracker);
                 self.dirty = true;
                 self.autosave();

@@ -222,6 +222,23 @@ impl BodyTracker {
         self.trunk_points = TRUNK_JOINTS.map(|j| self.trunk.block.to_block(pose[j]));
     }
 
+    /// This tracker without its frame buffers, for a re-track ([`BodyTracker::resumed`]).
+    pub(super) fn checkpoint(&mut self) -> BodyTracker {
+        let frames = (
+            std::mem::take(&mut self.prev),
+            std::mem::take(&mut self.spare),
+        );
+        let copy = self.clone();
+        (self.prev, self.spare) = frames;
+        copy
+    }
+
+    /// A checkpoint tracking again from `image`, the frame it last saw (`step`'s conversion).
+    pub(super) fn resumed(mut self, image: &RgbImage) -> BodyTracker {
+        self.prev.fill_with(image, self.background.as_deref());
+        self
+    }
+
     /// The current pose (after the last step, or the starting pose).
     pub(super) fn pose(&self) -> PerJoint<JointResult> {
         let mut out = PerJoint::from_fn(|_| JointResult {

@@ -22,6 +22,8 @@
 //! - `smooth`: the finished tracks smoothed over time, weighted by reliability
 //! - `run`: tracking a video from its key frames, the order of the steps, re-tracking
 //! - `pass`: one pass over consecutive frames, forwards or backwards, re-started at key frames
+//! - `replay`: what the passes computed, kept for a re-track (a cache)
+//! - `passes`: the two passes, one after the other or at once
 //! - `fuse`: the forward and backward passes made one, per joint between its key frames
 //! - `shared`: the errors and progress every step uses (below them all)
 
@@ -40,6 +42,8 @@ mod occlusion;
 mod params;
 mod part;
 mod pass;
+mod passes;
+mod replay;
 mod run;
 mod search;
 mod shared;
@@ -51,6 +55,7 @@ pub use doubt::{DOUBT_FEATURES, FEATURE_COUNT, doubt_features};
 pub use evidence::{EvidenceParams, NetFrame, NetworkFrames, weigh};
 pub use occlusion::{SpanKind, WeakSpan, weak_spans};
 pub use params::TrackerParams;
+pub use replay::PassesSeen;
 pub use run::{KeyFrames, TrackJob, TrackOutput, track_video};
 pub use shared::{TrackError, TrackProgress};
 // Inner facts the app and the scoring need, exported by name.

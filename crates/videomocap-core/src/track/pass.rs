@@ -5,6 +5,7 @@
 use super::background::{self, Background};
 use super::body::{BodyTracker, JointResult};
 use super::params::Tuning;
+use super::replay::{FrameStore, Recorded, Resume, checkpoint_interval};
 use super::shared::{TrackError, TrackProgress};
 use crate::formats::{FrameIndex, FrameTracks, KeyFrames, PointSource, TrackedPoint};
 use crate::skeleton::{Joint, PerJoint, Proportions};
@@ -59,6 +60,8 @@ pub(crate) struct PassOutput {
     pub(crate) arrivals: BTreeMap<usize, PerJoint<JointResult>>,
 }
 
+/// What a pass runs with: the video and how its frames are checked and scaled, the keys, the
+/// progress, the background, and an earlier run's frames (`replay`).
 pub(crate) struct PassContext<'a, 'p> {
     pub(crate) video: &'a mut Video,
     pub(crate) scale: Scale,
@@ -77,6 +80,10 @@ pub(crate) struct PassContext<'a, 'p> {
     pub(crate) cancel: &'a AtomicBool,
     /// The static camera's background at the working size, when there is one.
     pub(crate) background: Option<Arc<Background>>,
+    /// An earlier run's working-size frames, per frame of the clip (`replay`).
+    pub(crate) earlier_frames: &'a [Option<Arc<RgbImage>>],
+    /// The working-size frames this run read, kept for the next.
+    pub(crate) store: FrameStore,
 }
 
 impl PassContext<'_, '_> {
@@ -118,17 +125,21 @@ impl PassContext<'_, '_> {
     /// its first frame and re-started with the hand-placed joints at every key frame on the way
     /// (the parts they touch; the others go on as they were, `BodyTracker::restart`); returns
     /// the results in video pixels, one per frame of `order` (the first is the starting pose),
-    /// and where the pass arrived on each key frame before it was re-started there.
+    /// and where the pass arrived on each key frame before it was re-started there. What an
+    /// `earlier` run of the pass computed before the first frame whose keys changed is taken
+    /// from it (`replay`); the pass is returned as it ran, for the next run.
     pub(crate) fn pass(
         &mut self,
         order: &[usize],
         pose: &PerJoint<Point2<f64>>,
-    ) -> Result<PassOutput, TrackError> {
+        earlier: Option<&Recorded>,
+    ) -> Result<(PassOutput, Recorded), TrackError> {
         let frames = FrameCheck {
             path: self.path.clone(),
             width: self.width,
             height: self.height,
         };
+        let resume = earlier.and_then(|r| r.resume(order, pose, self.keys));
         let mut stepper = Stepper {
             tracker: None,
             start: pose,
@@ -140,41 +151,94 @@ impl PassContext<'_, '_> {
             path: self.path.clone(),
             proportions: Proportions::default(),
             arrivals: BTreeMap::new(),
+            checkpoints: BTreeMap::new(),
+            interval: checkpoint_interval(order.len()),
         };
         let (scale, total) = (self.scale, self.total);
         let mut out = Vec::with_capacity(order.len());
+        let from = match resume {
+            Some(r) => self.take_up(order, r, &frames, &mut stepper, &mut out)?,
+            None => 0,
+        };
         let mut done = self.done;
         let progress = &mut *self.progress;
+        let store = &mut self.store;
         let mut take = |index: usize, image: Option<Arc<RgbImage>>| -> Result<(), TrackError> {
-            let r = stepper.step(index, image)?;
+            if let Some(image) = &image {
+                store.keep(index, image);
+            }
+            let r = stepper.step(out.len(), index, image)?;
             done += 1;
             emit(progress, done, total, index, &r);
             out.push(r);
             Ok(())
         };
+        let rest = &order[from..];
         if self.threads <= 1 {
-            for &index in order {
-                let image = decoded(self.video, index, &frames, scale)?;
+            for &index in rest {
+                let image = frame_at(self.video, self.earlier_frames, index, &frames, scale)?;
                 if image.is_none() {
                     self.damaged.push(index);
                 }
                 take(index, image)?;
             }
         } else {
-            decode_ahead(
-                self.video,
-                order,
-                &frames,
+            let source = Source {
+                earlier: self.earlier_frames,
+                frames: &frames,
                 scale,
-                &mut self.damaged,
-                &mut take,
-            )?;
+            };
+            decode_ahead(self.video, rest, &source, &mut self.damaged, &mut take)?;
         }
         self.done = done;
-        Ok(PassOutput {
-            results: out,
-            arrivals: stepper.arrivals,
-        })
+        let recorded = Recorded {
+            order: order.to_vec(),
+            start: *pose,
+            keys: self.keys.clone(),
+            results: out.clone(),
+            arrivals: stepper.arrivals.clone(),
+            checkpoints: stepper.checkpoints,
+        };
+        Ok((
+            PassOutput {
+                results: out,
+                arrivals: stepper.arrivals,
+            },
+            recorded,
+        ))
+    }
+}
+
+impl PassContext<'_, '_> {
+    /// Takes up an earlier run of the pass over `order` where `r` says: its results (told to
+    /// the progress) into `out`, its arrivals and checkpoints into `stepper`, and the tracker
+    /// there on the frame it last saw. Returns the position in `order` to go on from.
+    fn take_up(
+        &mut self,
+        order: &[usize],
+        r: Resume,
+        frames: &FrameCheck,
+        stepper: &mut Stepper,
+        out: &mut Vec<PerJoint<JointResult>>,
+    ) -> Result<usize, TrackError> {
+        for (&index, result) in order.iter().zip(r.results) {
+            self.done += 1;
+            emit(self.progress, self.done, self.total, index, result);
+        }
+        out.extend_from_slice(r.results);
+        stepper.arrivals = r.arrivals;
+        stepper.checkpoints = r.checkpoints;
+        let from = r.at + 1;
+        if from < order.len() {
+            let index = order[r.at];
+            let image = frame_at(self.video, self.earlier_frames, index, frames, self.scale)?
+                .ok_or(TrackError::StartFrameDamaged {
+                    path: self.path.clone(),
+                    frame: index,
+                })?;
+            stepper.tracker = Some(r.tracker.clone().resumed(&image));
+        }
+        Ok(from)
     }
 }
 
@@ -242,13 +306,36 @@ fn decoded(
         .transpose()
 }
 
+/// Frame `index` at the working scale: the earlier run's (`earlier`, per frame of the clip)
+/// where it kept it, else decoded ([`decoded`]).
+fn frame_at(
+    video: &mut Video,
+    earlier: &[Option<Arc<RgbImage>>],
+    index: usize,
+    frames: &FrameCheck,
+    scale: Scale,
+) -> Result<Option<Arc<RgbImage>>, TrackError> {
+    match earlier.get(index) {
+        Some(Some(image)) => Ok(Some(Arc::clone(image))),
+        _ => decoded(video, index, frames, scale),
+    }
+}
+
+/// Where a pass's frames come from: an earlier run's frames, else the video, checked and
+/// shrunk.
+struct Source<'a> {
+    earlier: &'a [Option<Arc<RgbImage>>],
+    frames: &'a FrameCheck,
+    scale: Scale,
+}
+
 /// Decodes (and shrinks) the frames of `order` on another thread while `take` tracks them
-/// here, in order; damaged frames are noted in `damaged`.
+/// here, in order (an earlier run's frames taken as they are); damaged frames are noted in
+/// `damaged`.
 fn decode_ahead(
     video: &mut Video,
     order: &[usize],
-    frames: &FrameCheck,
-    scale: Scale,
+    source: &Source,
     damaged: &mut Vec<usize>,
     take: &mut dyn FnMut(usize, Option<Arc<RgbImage>>) -> Result<(), TrackError>,
 ) -> Result<(), TrackError> {
@@ -256,7 +343,7 @@ fn decode_ahead(
     let stop = &stop_flag;
     std::thread::scope(|s| -> Result<(), TrackError> {
         let (tx, rx) = std::sync::mpsc::sync_channel::<Decoded>(6);
-        s.spawn(move || send_decoded(video, order, frames, scale, &tx, stop));
+        s.spawn(move || send_decoded(video, order, source, &tx, stop));
         let result = (|| {
             for _ in 0..order.len() {
                 let (index, image) = rx.recv().map_err(|_| TrackError::Cancelled)??;
@@ -281,8 +368,7 @@ type Decoded = Result<(usize, Option<Arc<RgbImage>>), TrackError>;
 fn send_decoded(
     video: &mut Video,
     order: &[usize],
-    frames: &FrameCheck,
-    scale: Scale,
+    source: &Source,
     tx: &std::sync::mpsc::SyncSender<Decoded>,
     stop: &AtomicBool,
 ) {
@@ -292,7 +378,8 @@ fn send_decoded(
             if stop.load(Ordering::Relaxed) {
                 return;
             }
-            let item = decoded(video, index, frames, scale).map(|image| (index, image));
+            let item = frame_at(video, source.earlier, index, source.frames, source.scale)
+                .map(|image| (index, image));
             if chunk.reverse {
                 images.push(item);
             } else if tx.send(item).is_err() {
@@ -325,12 +412,32 @@ struct Stepper<'a> {
     proportions: Proportions,
     /// Where the pass arrived on each key frame before it was re-started there.
     arrivals: BTreeMap<usize, PerJoint<JointResult>>,
+    /// The tracker after every `interval`-th frame of the pass, for a re-track (`replay`).
+    checkpoints: BTreeMap<usize, BodyTracker>,
+    interval: usize,
 }
 
 impl Stepper<'_> {
+    /// Frame `index`, at `position` in the pass: its joints, and the tracker kept every
+    /// `interval` frames ([`BodyTracker::checkpoint`]).
+    fn step(
+        &mut self,
+        position: usize,
+        index: usize,
+        image: Option<Arc<RgbImage>>,
+    ) -> Result<PerJoint<JointResult>, TrackError> {
+        let r = self.track(index, image)?;
+        if position.is_multiple_of(self.interval)
+            && let Some(t) = self.tracker.as_mut()
+        {
+            self.checkpoints.insert(position, t.checkpoint());
+        }
+        Ok(r)
+    }
+
     /// Frame `index`'s joints in video pixels. A damaged frame (`image` `None`) keeps the last
     /// pose, lost: the tracker waits for the next frame.
-    fn step(
+    fn track(
         &mut self,
         index: usize,
         image: Option<Arc<RgbImage>>,

@@ -24,6 +24,8 @@ use super::fuse::fuse;
 use super::occlusion::{WeakSpan, fill_weak_runs, weak_spans};
 use super::params::TrackerParams;
 use super::pass::{PassContext, Scale};
+use super::passes::{Arrivals, PassResults, run_passes};
+use super::replay::{FrameStore, PassesSeen, SeenRun};
 use super::shared::{TrackError, TrackProgress};
 use super::smooth::smooth_tracks;
 use crate::camera::point_in_frame;
@@ -33,7 +35,6 @@ use crate::network::PoseNetwork;
 use crate::skeleton::{Joint, PerJoint, Proportions};
 use crate::video::{Video, VideoInfo};
 use nalgebra::Point2;
-use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -60,6 +61,10 @@ pub struct TrackJob {
     /// frame whose crop is exactly the one it had then is not run again (a cache: the result is
     /// the same with or without it).
     pub previous_network: Option<NetworkFrames>,
+    /// What VBA's passes computed in an earlier run of this video ([`TrackOutput::passes`]):
+    /// a pass's frames before the first whose keys changed are not tracked again, nor its
+    /// frames decoded again (a cache: the result is the same with or without it).
+    pub previous_passes: Option<PassesSeen>,
 }
 
 impl TrackJob {
@@ -76,6 +81,7 @@ impl TrackJob {
             background: None,
             network: None,
             previous_network: None,
+            previous_passes: None,
         }
     }
 
@@ -104,6 +110,9 @@ pub struct TrackOutput {
     /// What the pose network saw on each frame (`None`: tracked with VBA alone): give it to
     /// the next job on this video ([`TrackJob::previous_network`]).
     pub network: Option<NetworkFrames>,
+    /// What VBA's passes computed (`None` when a frame could not be decoded): give it to the
+    /// next job on this video ([`TrackJob::previous_passes`]).
+    pub passes: Option<PassesSeen>,
 }
 
 /// Tracks the video from its key frames.
@@ -134,6 +143,7 @@ pub fn track_video(
         shrink,
         damaged,
         background,
+        seen,
     } = passes?;
     // 2. The network's evidence weighed in, the user's marks deciding whose body it is.
     let net = match network {
@@ -167,6 +177,7 @@ pub fn track_video(
         spans,
         shrink,
         network: net,
+        passes: seen,
     })
 }
 
@@ -234,6 +245,7 @@ struct Passes {
     shrink: f64,
     damaged: Vec<usize>,
     background: Option<KnownBackground>,
+    seen: Option<PassesSeen>,
 }
 
 /// The shrink factor that brings the marked person to the working stature (1 when they are no
@@ -278,58 +290,6 @@ fn checked_start(
     let (first_key, first_pose) = job.keys.first_full().ok_or(TrackError::NoFullKeyFrame)?;
     // The tracker works in video positions, which are frame numbers.
     Ok((first_key.get(), first_pose))
-}
-
-/// Per frame, one pass's result in video pixels (`None` = not tracked).
-type PassResults = Vec<Option<PerJoint<JointResult>>>;
-/// Where a pass arrived on the key frames it went through.
-type Arrivals = BTreeMap<usize, PerJoint<JointResult>>;
-
-/// The two passes: forwards from the first key frame `start` to the end, then backwards over
-/// `backward_frames` (from the last key frame to the start), each re-started at every key frame
-/// on the way; each pass starts from the pose on its first frame with the hand-placed joints
-/// put in, the joints not placed there keeping the reliability they had.
-fn run_passes(
-    ctx: &mut PassContext,
-    job: &TrackJob,
-    first_pose: &PerJoint<Point2<f64>>,
-    start: usize,
-    backward_frames: &[usize],
-) -> Result<([PassResults; 2], [Arrivals; 2]), TrackError> {
-    let n = ctx.video.info().frame_count;
-    let mut results: [PassResults; 2] = [vec![None; n], vec![None; n]];
-    let mut arrivals: [Arrivals; 2] = Default::default();
-    let starting = |results: &[Option<PerJoint<JointResult>>], f: usize| {
-        let base = results[f].unwrap_or_else(|| {
-            first_pose.map(|_, p| JointResult {
-                pos: *p,
-                reliability: 1.0,
-            })
-        });
-        (keyed(&base.map(|_, r| r.pos), &job.keys, f), base)
-    };
-    let forward_frames: Vec<usize> = (start..n).collect();
-    let orders: [&[usize]; 2] = [&forward_frames, backward_frames];
-    for (k, order) in orders.into_iter().enumerate() {
-        let Some(&first) = order.first() else {
-            continue;
-        };
-        // Both passes start from the forward pass's pose there.
-        let (pose, before) = starting(&results[0], first);
-        let out = ctx.pass(order, &pose)?;
-        for (f, r) in order.iter().zip(out.results) {
-            results[k][*f] = Some(r);
-        }
-        arrivals[k].extend(out.arrivals);
-        if let Some(now) = results[k][first].as_mut() {
-            for j in Joint::ALL {
-                if !job.keys.is_key(FrameIndex(first), j) {
-                    now[j].reliability = before[j].reliability;
-                }
-            }
-        }
-    }
-    Ok((results, arrivals))
 }
 
 /// The fused results as tracks in video pixels: a key's joints as placed (confidence 1), a
@@ -411,6 +371,10 @@ fn track_at_working_scale(
     };
     let params = job.params.tuning(info.fps, job.threads);
     let backward_frames = backward_order(job, start);
+    let work = (scale.width, scale.height, scale.sx, scale.sy);
+    let run = SeenRun::new(info.path.clone(), n, params, work, decoded);
+    let earlier = job.previous_passes.as_ref().and_then(|p| p.for_run(&run));
+    let (earlier_frames, earlier_passes) = earlier.unwrap_or((&[], [None, None]));
     let mut ctx = PassContext {
         video,
         scale,
@@ -426,22 +390,25 @@ fn track_at_working_scale(
         progress,
         cancel,
         background: None,
+        earlier_frames,
+        store: FrameStore::new(n, earlier_frames),
     };
     let background = with_background(&mut ctx, job, (ww, wh), n)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(job.threads.max(1))
         .build()
         .ok();
-    let (results, arrivals) = match &pool {
-        Some(pool) => {
-            pool.install(|| run_passes(&mut ctx, job, &first_pose, start, &backward_frames))?
-        }
-        None => run_passes(&mut ctx, job, &first_pose, start, &backward_frames)?,
-    };
+    let orders = (start, backward_frames.as_slice());
+    let (results, arrivals, recorded) =
+        run_passes(&mut ctx, pool.as_ref(), &first_pose, orders, earlier_passes)?;
     let tracks = fused(&results, &arrivals, &first_pose, job, info);
     let mut damaged = std::mem::take(&mut ctx.damaged);
     damaged.sort_unstable();
     damaged.dedup();
+    // A damaged frame's pass results are not kept: a re-track would not know it was damaged.
+    let seen = damaged
+        .is_empty()
+        .then(|| PassesSeen::new(run, ctx.store.into_frames(), recorded));
     Ok(Passes {
         tracks,
         done: ctx.done,
@@ -449,6 +416,7 @@ fn track_at_working_scale(
         shrink,
         damaged,
         background,
+        seen,
     })
 }
 
@@ -517,14 +485,6 @@ fn with_background(
         .then(|| KnownBackground::new(size, tau, ctx.background.clone())))
 }
 
-/// A pose with the joints placed by hand on frame `f` put in.
-fn keyed(base: &PerJoint<Point2<f64>>, keys: &KeyFrames, f: usize) -> PerJoint<Point2<f64>> {
-    match keys.frames.get(&FrameIndex(f)) {
-        Some(k) => base.map(|j, p| k[j].unwrap_or(*p)),
-        None => *base,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -540,6 +500,7 @@ mod tests {
             background: None,
             network: None,
             previous_network: None,
+            previous_passes: None,
         }
     }
 

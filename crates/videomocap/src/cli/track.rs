@@ -89,6 +89,7 @@ pub fn track_with_progress(
         background: None,
         network,
         previous_network: None,
+        previous_passes: None,
     };
     let bar = progress_bar(global, video.info().frame_count as u64, "tracking");
     let cancel = AtomicBool::new(false);
