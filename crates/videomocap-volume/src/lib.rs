@@ -95,9 +95,8 @@ pub struct VolumeParams {
     pub min_points: usize,
     /// The skeleton curve sees at most about this many points: a denser cloud is merged onto a
     /// coarser lattice first (the curve only starts the fit; the fit takes every point's share).
-    /// 6,000: the suite's 30 mm clouds (under it) are read as they are (at 3,000, whose
-    /// whole-number lattice halves a cloud just over it, test's 30 mm row went 28.5 → 29.9 mm);
-    /// about 11,000 points go to the curve as about 1,400, as dense as the 40 mm rows.
+    /// 6,000: the suite's clouds are read as they are, about 11,000 points reach the curve as
+    /// about 1,400 (docs/method.md, "Point volumes", Speed).
     pub curve_points: usize,
     /// The subject's articulated body fitted over the clip.
     pub articulated: ArticulatedParams,
