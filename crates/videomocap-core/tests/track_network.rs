@@ -237,9 +237,10 @@ fn the_network_run_ahead_of_vba_changes_nothing() {
 /// The network is left out where it adds nothing (issue 95, item 3): sitting down, some
 /// frames go without it, never two in a row nor on the marked frame, and each has the
 /// network's evidence all the same (its neighbours' midway, or the network after all); the
-/// marks and a correction of a limb on a frame left out stay where they were placed, and that
-/// correction leaves the network's chain as it was: every frame keeps its crop, and a frame the
-/// network ran on in both runs saw the same (a re-track runs none of them again).
+/// marks and a correction of a limb or the pelvis on a frame left out stay where they were
+/// placed, and that correction leaves the network's chain as it was: every frame keeps its crop
+/// and every other frame its choice, and a frame the network ran on in both runs saw the same (a
+/// re-track runs none of them again).
 #[test]
 fn the_network_is_left_out_on_some_frames_and_keys_stay_where_they_were_placed() {
     let dir = tempfile::tempdir().unwrap();
@@ -259,24 +260,32 @@ fn the_network_is_left_out_on_some_frames_and_keys_stay_where_they_were_placed()
     for j in Joint::ALL {
         assert_eq!(first.tracks.frames[0].points[j].pos, marks.points[j]);
     }
-    // The left wrist corrected on a frame left out.
+    // The left wrist corrected on a frame left out, then (separately) the pelvis nudged there:
+    // the pelvis key is looked at by the network, and every other frame is as it was.
     let t = left_out[0];
-    let mut keys = KeyFrames::from_marks(&marks);
-    let moved =
-        first.tracks.frames[t].points[Joint::LeftWrist].pos + nalgebra::Vector2::new(4.0, 0.0);
-    keys.set(FrameIndex(t), Joint::LeftWrist, moved);
-    let retrack = TrackJob {
-        keys,
-        previous_network: Some(seen.clone()),
-        ..job
-    };
-    let again = track_video(&mut video, &retrack, &mut |_| {}, &AtomicBool::new(false)).unwrap();
-    assert_eq!(again.tracks.frames[t].points[Joint::LeftWrist].pos, moved);
-    let after = again.network.unwrap();
-    for (s, (a, b)) in seen.iter().zip(&after).enumerate() {
-        assert_eq!(a.crop, b.crop, "frame {s}");
-        if !a.skipped && !b.skipped {
-            assert_eq!(a, b, "frame {s}");
+    for joint in [Joint::LeftWrist, Joint::Pelvis] {
+        let mut keys = KeyFrames::from_marks(&marks);
+        let moved = first.tracks.frames[t].points[joint].pos + nalgebra::Vector2::new(4.0, 0.0);
+        keys.set(FrameIndex(t), joint, moved);
+        let retrack = TrackJob {
+            keys,
+            previous_network: Some(seen.clone()),
+            ..job.clone()
+        };
+        let again =
+            track_video(&mut video, &retrack, &mut |_| {}, &AtomicBool::new(false)).unwrap();
+        assert_eq!(again.tracks.frames[t].points[joint].pos, moved);
+        let after = again.network.unwrap();
+        assert_eq!(after[t].skipped, joint != Joint::Pelvis, "{joint:?}");
+        for (s, (a, b)) in seen.iter().zip(&after).enumerate() {
+            assert_eq!(a.crop, b.crop, "{joint:?}, frame {s}");
+            assert_eq!(a.next, b.next, "{joint:?}, frame {s}");
+            if s != t {
+                assert_eq!(a.skipped, b.skipped, "{joint:?}, frame {s}");
+            }
+            if !a.skipped && !b.skipped {
+                assert_eq!(a, b, "{joint:?}, frame {s}");
+            }
         }
     }
 }

@@ -18,7 +18,7 @@
 //! the result is the same whether the worker got far, not far, or did not run at all, however
 //! the threads were scheduled.
 
-use super::chain::{SkipRule, may_skip, needs_network, skipped};
+use super::chain::{SkipRule, looked_at, may_skip, needs_network, skipped};
 use super::evidence::{NetFrame, NetworkFrames, look, refuses};
 use crate::formats::{FrameIndex, KeyFrames};
 use crate::network::{Crop, PoseNetwork};
@@ -42,6 +42,7 @@ pub(crate) fn run_ahead(
     let previous = previous.filter(|p| p.len() == n);
     let rule = SkipRule::default();
     let mut out: Vec<Option<NetFrame>> = vec![None; n];
+    let mut left_out = vec![false; n];
     // The crop the chain proposes for frame `t` (`None`: no chain runs there).
     let mut next: Option<Crop> = None;
     let halted = || stop.load(Ordering::Relaxed) || cancel.load(Ordering::Relaxed);
@@ -49,13 +50,16 @@ pub(crate) fn run_ahead(
         if halted() {
             break;
         }
-        if next.is_some() && may_skip(&rule, keys, n, t, |s| out[s].as_ref()) {
-            out[t] = Some(skipped(next));
-            continue;
-        }
         let key = keys.frames.get(&FrameIndex(t));
         // A full key's crop: VBA's body there is the marks themselves.
         let full = key.is_some_and(|k| k.iter().all(|(_, p)| p.is_some()));
+        let leave =
+            next.is_some() && !full && may_skip(&rule, n, t, &left_out, |s| out[s].as_ref());
+        if leave && !looked_at(keys, t) {
+            out[t] = Some(skipped(next));
+            left_out[t] = true;
+            continue;
+        }
         let marks = key
             .filter(|_| full)
             .map(|k| k.map(|_, p| p.unwrap_or(Point2::origin())));
@@ -65,11 +69,16 @@ pub(crate) fn run_ahead(
             // The chain needs VBA's body here: it waits for the next full key.
             (None, None) => continue,
         };
-        let frame = look(video, network, t, crop, previous);
+        let mut frame = look(video, network, t, crop, previous);
         if marks.is_none() && key.is_some_and(|k| refuses(k, &frame)) {
             // `run_network` looks again with VBA's body here: leave it the frame.
             next = None;
             continue;
+        }
+        if leave {
+            // As `run_network`: a key on a frame the chain leaves out passes its crop on.
+            frame.next = crop;
+            left_out[t] = true;
         }
         next = frame.next;
         out[t] = Some(frame);

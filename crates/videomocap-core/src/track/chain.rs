@@ -2,16 +2,18 @@
 //!
 //! Each frame is cropped where the network proposed on the frame before ([`run_network`]). A
 //! frame may go without the network ([`may_skip`]) when the network's joints moved slowly over
-//! the two frames it ran on before, never on a key that may re-start the crop
-//! and never two frames in a row; the chain then shows the next frame the crop the skipped one would have
-//! had. Once the chain is done each skipped frame is settled ([`settle`]): it gets the network
-//! after all (in the crop it would have had) where one of its two neighbours saw nobody or
-//! they are far apart (the joints moved fast), or where VBA is sure of a joint and puts it away from the neighbours'
-//! midway; elsewhere it takes the midway of its two neighbours.
+//! the two frames it ran on before, never two frames in a row, never the first two frames or the
+//! last; the chain then shows the next frame the crop the left-out one would have had. These
+//! choices read no key, so a correction that does not re-start the crop leaves them as they
+//! were: a key whose pelvis or head top may refuse the network's body ([`looked_at`]) on a
+//! left-out frame is looked at in the crop it would have had, and that crop passed on. Once the
+//! chain is done each skipped frame is settled ([`settle`]): it gets the network after all (in
+//! the crop it would have had) where one of its two neighbours saw nobody or they are far apart
+//! (the joints moved fast), or where VBA is sure of a joint and puts it away from the
+//! neighbours' midway; elsewhere it takes the midway of its two neighbours.
 //!
-//! The rule reads nothing but the keys and the network's own output, so the worker that runs
-//! the chain ahead of VBA's passes (`ahead`) skips the same frames; only the last check reads
-//! VBA's tracks.
+//! The rule reads nothing but the network's own output, so the worker that runs the chain ahead
+//! of VBA's passes (`ahead`) skips the same frames; only the last check reads VBA's tracks.
 
 use super::evidence::{NetFrame, NetworkFrames, look, refuses};
 use super::shared::TrackError;
@@ -74,36 +76,39 @@ fn steady(
         .all(|j| (to[j].pos - from[j].pos).norm() <= limit)
 }
 
-/// Whether a key on frame `t` may re-start the chain's crop there: one that places every joint,
-/// or the pelvis or head top (which may refuse the network's body, `evidence::refuses`).
-fn may_restart(keys: &KeyFrames, t: usize) -> bool {
-    keys.frames.get(&FrameIndex(t)).is_some_and(|k| {
-        k.iter().all(|(_, p)| p.is_some())
-            || k[Joint::Pelvis].is_some()
-            || k[Joint::HeadTop].is_some()
-    })
+/// Whether a key on frame `t` must be looked at by the network even where the chain leaves the
+/// frame out: one that places the pelvis or head top, which may refuse the network's body
+/// (`evidence::refuses`). A key placing every joint re-starts the crop from the marks anyway.
+pub(crate) fn looked_at(keys: &KeyFrames, t: usize) -> bool {
+    keys.frames
+        .get(&FrameIndex(t))
+        .is_some_and(|k| k[Joint::Pelvis].is_some() || k[Joint::HeadTop].is_some())
 }
 
-/// Whether the chain may leave frame `t` of `n` without the network, from what it saw before
-/// (`seen(s)` for `s < t`): no key on `t` that may re-start the crop, `t` neither of the first
-/// two frames nor the last, the network run on `t − 1` (so never two skipped in a row) and on
-/// the frame it ran before that, every joint moving slowly between them.
-/// A correction of the limbs alone leaves the chain as it was (its joints are the user's
-/// whatever the network sees), so it leaves every frame the network ran on as it was.
+/// Whether the chain leaves frame `t` of `n` without the network, from what it saw before
+/// (`seen(s)` for `s < t`) and the frames it left out before (`left_out[s]`): `t` neither of
+/// the first two frames nor the last, `t − 1` not left out (so never two in a row), and every
+/// joint moving slowly between the last two frames the network ran on.
+///
+/// It reads no key: a correction that does not re-start the crop leaves every choice of the
+/// chain as it was (the chain looks at a frame it leaves out where [`looked_at`] says so, in
+/// the crop it would have had, and passes that crop on unchanged), so a correction changes no
+/// network frame away from it.
 pub(crate) fn may_skip<'a>(
     rule: &SkipRule,
-    keys: &KeyFrames,
     n: usize,
     t: usize,
+    left_out: &[bool],
     seen: impl Fn(usize) -> Option<&'a NetFrame>,
 ) -> bool {
-    if t < 2 || t + 1 >= n || may_restart(keys, t) {
+    let out = |s: usize| left_out.get(s).copied().unwrap_or(false);
+    if t < 2 || t + 1 >= n || out(t - 1) {
         return false;
     }
     let Some(last) = ran(seen(t - 1)) else {
         return false;
     };
-    let before = if seen(t - 2).is_some_and(|f| f.skipped) {
+    let before = if out(t - 2) {
         t.checked_sub(3)
     } else {
         Some(t - 2)
@@ -225,27 +230,36 @@ pub fn run_network(
     let previous = reuse.filter(|p| p.len() == n);
     let rule = SkipRule::default();
     let mut out: NetworkFrames = Vec::with_capacity(n);
+    let mut left_out: Vec<bool> = Vec::with_capacity(n);
     let mut next: Option<Crop> = None;
     for (t, f) in tracks.frames.iter().enumerate() {
         if cancel.load(Ordering::Relaxed) {
             return Err(TrackError::Cancelled);
         }
         tick();
-        if next.is_some() && may_skip(&rule, keys, n, t, |s| out.get(s)) {
-            out.push(skipped(next));
-            continue;
-        }
         let key = keys.frames.get(&f.index);
         let full = key.is_some_and(|k| k.iter().all(|(_, p)| p.is_some()));
+        let leave = next.is_some() && !full && may_skip(&rule, n, t, &left_out, |s| out.get(s));
+        if leave && !looked_at(keys, t) {
+            out.push(skipped(next));
+            left_out.push(true);
+            continue;
+        }
         let marked = || Crop::around(&f.points.map(|_, p| p.pos));
         let crop = match next {
             Some(c) if !full => Some(c),
             _ => marked(),
         };
         let mut frame = look(video, network, t, crop, previous);
-        if key.is_some_and(|k| !full && refuses(k, &frame)) && crop != marked() {
+        let restart = key.is_some_and(|k| !full && refuses(k, &frame)) && crop != marked();
+        if restart {
             frame = look(video, network, t, marked(), previous);
+        } else if leave {
+            // A key on a frame the chain leaves out: seen in the crop it would have had, that
+            // crop passed on, so the chain's later frames are as they were without the key.
+            frame.next = crop;
         }
+        left_out.push(leave && !restart);
         next = frame.next;
         out.push(frame);
     }
@@ -292,18 +306,23 @@ mod tests {
         }
     }
 
-    /// The chain's decisions over `n` frames of a body moving `step` px a frame.
-    fn chain(n: usize, keys: &KeyFrames, step: f64, confidence: f64) -> Vec<bool> {
-        let mut out: Vec<NetFrame> = Vec::new();
+    /// The chain over `n` frames of a body moving `step` px a frame: per frame, whether it was
+    /// left out and whether the network ran on it.
+    fn chain(n: usize, keys: &KeyFrames, step: f64, confidence: f64) -> Vec<(bool, bool)> {
+        let (mut out, mut left_out): (Vec<NetFrame>, Vec<bool>) = (Vec::new(), Vec::new());
         for t in 0..n {
-            let skip = may_skip(&RULE, keys, n, t, |s| out.get(s));
-            out.push(if skip {
+            let leave = may_skip(&RULE, n, t, &left_out, |s| out.get(s));
+            out.push(if leave && !looked_at(keys, t) {
                 skipped(None)
             } else {
                 seen(step * t as f64, confidence)
             });
+            left_out.push(leave);
         }
-        out.iter().map(|f| f.skipped).collect()
+        left_out
+            .into_iter()
+            .zip(out.iter().map(|f| !f.skipped))
+            .collect()
     }
 
     fn key(t: usize, joints: &[Joint]) -> KeyFrames {
@@ -315,24 +334,32 @@ mod tests {
     }
 
     #[test]
-    fn a_steady_sure_body_is_skipped_every_other_frame_never_at_the_ends_or_a_restarting_key() {
+    fn a_steady_sure_body_is_left_out_every_other_frame_and_a_key_changes_no_other_frame() {
         assert_eq!(RULE, SkipRule::default());
         let none = KeyFrames::default();
-        let skips = chain(10, &none, 2.0, 0.95);
+        let plain = chain(10, &none, 2.0, 0.95);
+        let left: Vec<bool> = plain.iter().map(|c| c.0).collect();
         assert_eq!(
-            skips,
+            left,
             [
                 false, false, true, false, true, false, true, false, true, false
             ]
         );
-        // A key that may re-start the crop (every joint, or the pelvis) is run; one of the
-        // limbs alone leaves the chain as it was.
-        let full = key(4, &Joint::ALL);
-        assert!(!chain(10, &full, 2.0, 0.95)[4]);
-        assert!(!chain(10, &key(4, &[Joint::Pelvis]), 2.0, 0.95)[4]);
-        assert_eq!(chain(10, &key(4, &[Joint::LeftWrist]), 2.0, 0.95), skips);
+        assert!(plain.iter().all(|&(l, ran)| l != ran));
+        // A key on the pelvis (or the head top) of a left-out frame is looked at there, and
+        // every other frame is as without it; a key on a limb alone is not looked at.
+        let pelvis = chain(10, &key(4, &[Joint::Pelvis]), 2.0, 0.95);
+        assert_eq!(pelvis[4], (true, true));
+        for t in (0..10).filter(|&t| t != 4) {
+            assert_eq!(pelvis[t], plain[t], "frame {t}");
+        }
+        assert_eq!(chain(10, &key(4, &[Joint::LeftWrist]), 2.0, 0.95), plain);
         // Moving fast (25 px a frame on a 100 px torso): every frame run.
-        assert!(chain(10, &none, 25.0, 0.95).iter().all(|s| !s));
+        assert!(
+            chain(10, &none, 25.0, 0.95)
+                .iter()
+                .all(|&(l, ran)| !l && ran)
+        );
     }
 
     fn vba_at(x: f64, confidence: f32) -> FrameTracks {
