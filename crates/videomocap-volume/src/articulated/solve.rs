@@ -63,11 +63,49 @@ pub(crate) struct Quality {
     pub worst_gap: (usize, f64),
 }
 
-/// A capsule in space.
+/// A capsule in space, with what the nearest-capsule search reuses for every point: its axis
+/// `ab`, that squared, and its bounding sphere (centre `mid`, radius `reach`).
 struct Capsule {
     a: Point3<f64>,
     b: Point3<f64>,
     r: f64,
+    ab: Vector3<f64>,
+    l2: f64,
+    mid: Point3<f64>,
+    reach: f64,
+}
+
+impl Capsule {
+    fn new(a: Point3<f64>, b: Point3<f64>, r: f64) -> Capsule {
+        let ab = b - a;
+        let l2 = ab.norm_squared();
+        Capsule {
+            a,
+            b,
+            r,
+            ab,
+            l2,
+            mid: a + ab * 0.5,
+            reach: 0.5 * l2.sqrt() + r,
+        }
+    }
+
+    /// The point of the capsule's axis nearest `p` and its parameter along it.
+    fn closest(&self, p: &Point3<f64>) -> (Point3<f64>, f64) {
+        let t = if self.l2 > 1e-18 {
+            ((p - self.a).dot(&self.ab) / self.l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (self.a + self.ab * t, t)
+    }
+
+    /// Whether every point of this capsule's surface lies farther than `d` from `p` (then it
+    /// cannot be the nearest): the bounding sphere's surface is farther, with a margin.
+    fn beyond(&self, p: &Point3<f64>, d: f64) -> bool {
+        let bound = d + self.reach + 1e-9;
+        bound < 0.0 || (p - self.mid).norm_squared() > bound * bound
+    }
 }
 
 fn capsules(posed: &Posed, body: &SubjectBody) -> Vec<Capsule> {
@@ -84,21 +122,9 @@ fn capsules(posed: &Posed, body: &SubjectBody) -> Vec<Capsule> {
                     b = a + d * ((len - r).max(0.3 * len) / len);
                 }
             }
-            Capsule { a, b, r }
+            Capsule::new(a, b, r)
         })
         .collect()
-}
-
-/// The point of segment `a`–`b` nearest `p` and its parameter along it.
-fn closest(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> (Point3<f64>, f64) {
-    let ab = b - a;
-    let l2 = ab.norm_squared();
-    let t = if l2 > 1e-18 {
-        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (a + ab * t, t)
 }
 
 /// A sparse Jacobian row.
@@ -288,6 +314,30 @@ struct Evaluated {
     quality: Quality,
 }
 
+/// The capsule whose surface is nearest `p`: its signed distance, index, axis point and
+/// parameter. `guess` (the previous point's, as the points run along the surface) is tried
+/// first, then the others unless their bounding sphere is farther; ties go to the lower
+/// index, as a plain scan in order gives them (the same result, fewer capsules measured).
+fn nearest_capsule(
+    p: &Point3<f64>,
+    caps: &[Capsule],
+    guess: usize,
+) -> (f64, usize, Point3<f64>, f64) {
+    let mut best = (f64::INFINITY, 0, Point3::origin(), 0.0);
+    for s in std::iter::once(guess).chain((0..caps.len()).filter(|&s| s != guess)) {
+        let Some(c) = caps.get(s) else { continue };
+        if c.beyond(p, best.0) {
+            continue;
+        }
+        let (q, t) = c.closest(p);
+        let d = (p - q).norm() - c.r;
+        if d < best.0 || (d == best.0 && s < best.1) {
+            best = (d, s, q, t);
+        }
+    }
+    best
+}
+
 /// Every point's distance to the nearest capsule's surface (Cauchy-weighted) and every capsule's
 /// coverage, at `pose`.
 fn evaluate(pose: &Pose, body: &SubjectBody, data: &FrameData) -> Evaluated {
@@ -297,16 +347,10 @@ fn evaluate(pose: &Pose, body: &SubjectBody, data: &FrameData) -> Evaluated {
     let mut cost = 0.0;
     let mut far = 0usize;
     let mut residuals = Vec::with_capacity(data.points.len() + caps.len() * COVER_AT.len());
+    let mut guess = 0;
     for p in &data.points {
-        let mut best = (f64::INFINITY, 0, Point3::origin(), 0.0);
-        for (s, c) in caps.iter().enumerate() {
-            let (q, t) = closest(p, &c.a, &c.b);
-            let d = (p - q).norm() - c.r;
-            if d < best.0 {
-                best = (d, s, q, t);
-            }
-        }
-        let (d, seg, c, t) = best;
+        let (d, seg, c, t) = nearest_capsule(p, &caps, guess);
+        guess = seg;
         let Some(n) = (p - c).try_normalize(1e-9) else {
             continue;
         };
@@ -374,10 +418,13 @@ impl Evaluated {
         for e in &self.residuals {
             let row = row(e.seg, &e.c, e.t, &e.n, &self.posed, with_body);
             let (idx, val) = (&row.idx[..row.n], &row.val[..row.n]);
-            for (&ia, &a) in idx.iter().zip(val) {
+            for (k, (&ia, &a)) in idx.iter().zip(val).enumerate() {
                 let va = a * e.w;
                 g[ia] += va * e.r;
-                for (&ib, &b) in idx.iter().zip(val) {
+                // A pose's row lists its columns in increasing order (see [`row`]): the lower
+                // triangle is the entries up to this one.
+                let upto = if with_body { idx.len() } else { k + 1 };
+                for (&ib, &b) in idx[..upto].iter().zip(&val[..upto]) {
                     // Column-major: entry (ia, ib), lower triangle only.
                     if ia >= ib {
                         hs[ib * dof + ia] += va * b;
@@ -527,7 +574,7 @@ mod tests {
                     let p = at + u * (along * c.r) + (e1 * a.cos() + e2 * a.sin()) * r;
                     // Inside another capsule: not on the body's surface.
                     if caps.iter().all(|o| {
-                        let (q, _) = closest(&p, &o.a, &o.b);
+                        let (q, _) = o.closest(&p);
                         (p - q).norm() >= o.r - 1e-6
                     }) {
                         out.push(p);
@@ -544,6 +591,36 @@ mod tests {
             }
         }
         out
+    }
+
+    #[test]
+    fn the_pruned_nearest_capsule_search_is_the_plain_scan() {
+        let b = body();
+        let mut pose = Pose::default_standing();
+        pose.knee = [0.7, 0.2];
+        pose.elbow = [1.1, 0.3];
+        let caps = capsules(&pose.posed(&b), &b);
+        let mut guess = 0;
+        // Points on a grid through and around the body, some on the shared joints.
+        for i in 0..4000 {
+            let (x, y, z) = (i % 16, (i / 16) % 25, i / 400);
+            let p = Point3::new(
+                -0.6 + 0.08 * x as f64,
+                -0.1 + 0.08 * y as f64,
+                -0.4 + 0.09 * z as f64,
+            );
+            let mut plain = (f64::INFINITY, 0, Point3::origin(), 0.0);
+            for (s, c) in caps.iter().enumerate() {
+                let (q, t) = c.closest(&p);
+                let d = (p - q).norm() - c.r;
+                if d < plain.0 {
+                    plain = (d, s, q, t);
+                }
+            }
+            let pruned = nearest_capsule(&p, &caps, guess);
+            assert_eq!(pruned, plain, "at {p:?}");
+            guess = (guess + 7) % caps.len();
+        }
     }
 
     #[test]
