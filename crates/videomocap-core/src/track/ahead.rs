@@ -9,7 +9,8 @@
 //! and stops each chain where it would need VBA, going on from the next full key frame.
 //!
 //! It leaves out the frames the chain's rule leaves out (`chain::may_skip`, which reads only the
-//! keys and the network's output, so it skips what `run_network` skips), and once the chain is
+//! network's output, so it skips what `run_network` skips; a pelvis or head-top key there is
+//! looked at and its crop passed on, as `run_network` does), and once the chain is
 //! done runs the skipped frames the network's own checks send back to it
 //! (`chain::needs_network` without VBA), while VBA may still be running.
 //!
